@@ -1,0 +1,125 @@
+//! The closed-form image-motion velocity (the paper's Eqs. 14-15, re-derived and
+//! corrected; see `docs/derivation.md`), written once for any [`Real`].
+//!
+//! Lengths are scaled by the Earth radius R, so every intermediate is of order 1:
+//! k = (R + H)/R, q = cos e (e the incidence angle at the ground point), and the
+//! slant range enters only through den = k cos(eta) + q = (k^2 - 1) R / rho, the stable
+//! root of the ray/sphere quadratic. No asin, no cos(theta) - 1, no difference of
+//! slant-range terms, and per pixel no division and no transcendental call:
+//!
+//! ```text
+//! sin(eta), cos(eta) = angle sums of roll and field angle      (eta = phi + alpha)
+//! q^2       = (1 - k sin eta)(1 + k sin eta)                   (> 0 iff the ray meets the sphere)
+//! den       = k cos eta + q
+//! cos theta = q cos eta + k sin^2 eta
+//! v1 = f/cos(alpha)   * [ (b/c0) cos(theta) den - c sin(eta) ]
+//! v2 = -f/cos^2(alpha) * (a/c0) q den
+//! ```
+//! with c0 = k^2 - 1 = h(2 + h), h = H/R, and the rates of the relative rotation
+//! (a, b, c) = (w sin i0 cos g0, w cos i0 - Omega, w sin i0 sin g0).
+
+use core::marker::PhantomData;
+
+use crate::error::ModelError;
+use crate::model::{Backend, Camera, Geometry, ImageMotion};
+use crate::real::Real;
+
+/// The closed-form backend in scalar `T` (`f64` or `f32`).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct ClosedForm<T>(PhantomData<T>);
+
+impl<T> ClosedForm<T> {
+    pub const fn new() -> Self {
+        ClosedForm(PhantomData)
+    }
+}
+
+/// Constants of one field point, known at boot.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PixelConst<T> {
+    pub sin_field: T,
+    pub cos_field: T,
+    /// f / cos(alpha) (m).
+    pub w1_m: T,
+    /// f / cos^2(alpha) (m).
+    pub w2_m: T,
+}
+
+/// Constants of one instant.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct UpdateConst<T> {
+    pub sin_roll: T,
+    pub cos_roll: T,
+    /// (R + H) / R.
+    pub k: T,
+    /// w sin(i0) cos(g0) / (k^2 - 1) (rad/s).
+    pub a_rad_s: T,
+    /// (w cos(i0) - Omega) / (k^2 - 1) (rad/s).
+    pub b_rad_s: T,
+    /// w sin(i0) sin(g0) (rad/s).
+    pub c_rad_s: T,
+}
+
+impl<T: Real> Backend for ClosedForm<T> {
+    type Real = T;
+    type Pixel = PixelConst<T>;
+    type Update = UpdateConst<T>;
+
+    /// Boot-time work, done in f64 whatever `T` is, then rounded once: the constants
+    /// are as exact as `T` can hold, at no per-update cost.
+    fn pixel(&self, camera: &Camera, n_px: f64) -> Result<PixelConst<T>, ModelError> {
+        let t = camera.tan_field(n_px)?;
+        let sec2 = 1.0 + t * t;
+        let sec = libm::sqrt(sec2);
+        Ok(PixelConst {
+            sin_field: T::from_f64(t / sec),
+            cos_field: T::from_f64(1.0 / sec),
+            w1_m: T::from_f64(camera.focal_m * sec),
+            w2_m: T::from_f64(camera.focal_m * sec2),
+        })
+    }
+
+    fn update(&self, g: &Geometry<T>) -> Result<UpdateConst<T>, ModelError> {
+        g.validate()?;
+        let (sin_roll, cos_roll) = g.roll_rad.sin_cos();
+        let (sin_i, cos_i) = g.inclination_rad.sin_cos();
+        let (sin_g, cos_g) = g.arg_latitude_rad.sin_cos();
+        let h = g.altitude_m / g.earth_radius_m;
+        // k^2 - 1 without the cancellation of forming k^2 first.
+        let c0 = h * (T::ONE + T::ONE + h);
+        let w = g.earth_rate_rad_s;
+        Ok(UpdateConst {
+            sin_roll,
+            cos_roll,
+            k: T::ONE + h,
+            a_rad_s: w * sin_i * cos_g / c0,
+            b_rad_s: (w * cos_i - g.orbit_rate_rad_s) / c0,
+            c_rad_s: w * sin_i * sin_g,
+        })
+    }
+
+    #[inline]
+    fn motion(&self, u: &UpdateConst<T>, p: &PixelConst<T>) -> Result<ImageMotion<T>, ModelError> {
+        let sin_eta = u.sin_roll * p.cos_field + u.cos_roll * p.sin_field;
+        let cos_eta = u.cos_roll * p.cos_field - u.sin_roll * p.sin_field;
+        // The near root of the ray/sphere quadratic lies in front of the camera only
+        // when the ray points below the horizontal.
+        if !(cos_eta > T::ZERO) {
+            return Err(ModelError::LineOfSightMissesEarth);
+        }
+        let ks = u.k * sin_eta;
+        // 1 - ks is exact (Sterbenz) wherever it is small, so the only error near the
+        // limb is that of sin(eta) itself: the problem's conditioning, not ours.
+        let q2 = (T::ONE - ks) * (T::ONE + ks);
+        if !(q2 > T::ZERO) {
+            return Err(ModelError::LineOfSightMissesEarth);
+        }
+        let q = q2.sqrt();
+        let den = u.k * cos_eta + q;
+        let cos_theta = q * cos_eta + ks * sin_eta;
+        Ok(ImageMotion {
+            v1_mps: p.w1_m * (u.b_rad_s * cos_theta * den - u.c_rad_s * sin_eta),
+            v2_mps: -(p.w2_m * u.a_rad_s * q * den),
+        })
+    }
+}

@@ -1,0 +1,97 @@
+//! Typed errors: every rejected input or impossible geometry has its own variant,
+//! so that no function in this crate ever answers with NaN, an infinity or a panic.
+
+/// The input a [`ModelError::NonFinite`] or [`ModelError::OutOfDomain`] names.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Param {
+    Roll,
+    Inclination,
+    ArgLatitude,
+    Altitude,
+    EarthRadius,
+    EarthRate,
+    OrbitRate,
+    FocalLength,
+    PixelPitch,
+    PixelOffset,
+    ClockFrequency,
+    RelativeMismatch,
+    MtfFloor,
+}
+
+impl Param {
+    pub const fn name(self) -> &'static str {
+        match self {
+            Param::Roll => "roll",
+            Param::Inclination => "inclination",
+            Param::ArgLatitude => "arg_latitude",
+            Param::Altitude => "altitude",
+            Param::EarthRadius => "earth_radius",
+            Param::EarthRate => "earth_rate",
+            Param::OrbitRate => "orbit_rate",
+            Param::FocalLength => "focal_length",
+            Param::PixelPitch => "pixel_pitch",
+            Param::PixelOffset => "pixel_offset",
+            Param::ClockFrequency => "clock_frequency",
+            Param::RelativeMismatch => "relative_mismatch",
+            Param::MtfFloor => "mtf_floor",
+        }
+    }
+}
+
+/// Why a computation was refused.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum ModelError {
+    /// An input was NaN or infinite.
+    NonFinite(Param),
+    /// Altitude above the Earth's surface was zero or negative.
+    NonPositiveAltitude,
+    /// The Earth radius was zero or negative.
+    NonPositiveEarthRadius,
+    /// The focal length was zero or negative.
+    NonPositiveFocalLength,
+    /// The pixel pitch was zero or negative.
+    NonPositivePixelPitch,
+    /// A finite input beyond the model's documented domain (see [`crate::domain`]).
+    OutOfDomain(Param),
+    /// The line of sight does not meet the Earth: at or beyond the limb, or above the horizon.
+    LineOfSightMissesEarth,
+    /// The image does not move (|v_P| too small for a finite line period).
+    NoImageMotion,
+    /// The line period does not fit the tick counter (zero ticks or more than `u32::MAX`).
+    LinePeriodOutOfRange,
+}
+
+impl ModelError {
+    /// A stable, machine-readable name (used in the `eval` CSV `error` column).
+    pub const fn name(self) -> &'static str {
+        match self {
+            ModelError::NonFinite(_) => "non_finite_input",
+            ModelError::NonPositiveAltitude => "non_positive_altitude",
+            ModelError::NonPositiveEarthRadius => "non_positive_earth_radius",
+            ModelError::NonPositiveFocalLength => "non_positive_focal_length",
+            ModelError::NonPositivePixelPitch => "non_positive_pixel_pitch",
+            ModelError::OutOfDomain(_) => "out_of_domain",
+            ModelError::LineOfSightMissesEarth => "line_of_sight_misses_earth",
+            ModelError::NoImageMotion => "no_image_motion",
+            ModelError::LinePeriodOutOfRange => "line_period_out_of_range",
+        }
+    }
+
+    /// The parameter concerned, where there is one.
+    pub const fn param(self) -> Option<Param> {
+        match self {
+            ModelError::NonFinite(p) | ModelError::OutOfDomain(p) => Some(p),
+            _ => None,
+        }
+    }
+}
+
+impl core::fmt::Display for ModelError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self.param() {
+            Some(p) => write!(f, "{}({})", self.name(), p.name()),
+            None => f.write_str(self.name()),
+        }
+    }
+}

@@ -1,0 +1,44 @@
+//! Image-motion velocity of a rolling TDI push-broom camera, and what follows from it:
+//! MTF loss from a velocity mismatch, the line period, the TDI stage limit.
+//!
+//! After LI Guang-ze, KONG De-zhu, LIU Jin-guo, "Computation of scroll image motion
+//! velocity of wide coverage optical remote camera", Chinese Optics 6(5), 2013, with its
+//! Eqs. 14-15 re-derived and corrected (see `docs/derivation.md`).
+//!
+//! Backends, each one implementation of [`Backend`]:
+//! - [`Reference`]: the paper's transform chain (Eqs. 1-13) on dual numbers, f64;
+//! - [`ClosedForm<f64>`] and [`ClosedForm<f32>`]: the stable closed form.
+//!
+//! `no_std`, no allocation, no panics on any input: every refusal is a [`ModelError`].
+#![no_std]
+// The one exception is the documented `vsqrt.f32` wrapper in `sqrt.rs`, on the target only.
+#![cfg_attr(
+    not(all(target_arch = "arm", target_abi = "eabihf")),
+    forbid(unsafe_code)
+)]
+#![cfg_attr(all(target_arch = "arm", target_abi = "eabihf"), deny(unsafe_code))]
+
+pub mod closed_form;
+pub mod dual;
+pub mod error;
+pub mod line_period;
+pub mod model;
+pub mod mtf;
+pub mod real;
+pub mod reference;
+mod sqrt;
+
+pub use closed_form::ClosedForm;
+pub use error::{ModelError, Param};
+pub use line_period::{line_period_s, line_period_ticks, Ticks};
+pub use model::{
+    domain, orbital_rate_rad_s, Backend, Camera, Geometry, ImageMotion, EARTH_RATE_RAD_S, GM_M3_S2,
+};
+pub use mtf::{mtf_mismatch, sinc, StageRule};
+pub use real::Real;
+pub use reference::Reference;
+
+/// The closed form in f64.
+pub const CLOSED_F64: ClosedForm<f64> = ClosedForm::new();
+/// The closed form in f32, the shipped path.
+pub const CLOSED_F32: ClosedForm<f32> = ClosedForm::new();

@@ -1,0 +1,56 @@
+//! TDI line period: the time the image takes to cross one pixel, in seconds and in
+//! ticks of the line-clock counter.
+
+use crate::error::{ModelError, Param};
+use crate::real::Real;
+
+/// Line period A / |v_P| (s).
+pub fn line_period_s<T: Real>(pixel_m: T, speed_mps: T) -> Result<T, ModelError> {
+    if !pixel_m.is_finite() {
+        return Err(ModelError::NonFinite(Param::PixelPitch));
+    }
+    if !(pixel_m > T::ZERO) {
+        return Err(ModelError::NonPositivePixelPitch);
+    }
+    if !(speed_mps > T::ZERO) {
+        return Err(ModelError::NoImageMotion);
+    }
+    let t = pixel_m / speed_mps;
+    if !t.is_finite() {
+        return Err(ModelError::NoImageMotion);
+    }
+    Ok(t)
+}
+
+/// A line period as a whole number of clock ticks.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Ticks<T> {
+    pub ticks: u32,
+    /// ticks / f_clk - period (s): what rounding to whole ticks changed.
+    pub rounding_error_s: T,
+}
+
+/// The period rounded to the nearest whole tick of a `clock_hz` counter.
+/// Refused unless 1 <= ticks <= `u32::MAX`.
+pub fn line_period_ticks<T: Real>(period_s: T, clock_hz: T) -> Result<Ticks<T>, ModelError> {
+    if !clock_hz.is_finite() {
+        return Err(ModelError::NonFinite(Param::ClockFrequency));
+    }
+    if !(clock_hz > T::ZERO) {
+        return Err(ModelError::OutOfDomain(Param::ClockFrequency));
+    }
+    if !(period_s > T::ZERO) || !period_s.is_finite() {
+        return Err(ModelError::LinePeriodOutOfRange);
+    }
+    let exact = period_s * clock_hz;
+    let nearest = (exact + T::from_f64(0.5)).floor();
+    // Compared as reals before converting, since `as u32` would saturate silently.
+    if !(nearest >= T::ONE && nearest <= T::from_f64(u32::MAX as f64)) {
+        return Err(ModelError::LinePeriodOutOfRange);
+    }
+    let ticks = nearest.to_u32();
+    Ok(Ticks {
+        ticks,
+        rounding_error_s: (T::from_u32(ticks) - exact) / clock_hz,
+    })
+}

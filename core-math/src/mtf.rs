@@ -1,0 +1,120 @@
+//! Image-motion mismatch MTF (Eqs. 17-19) and the TDI stage limit it implies.
+//!
+//! At the Nyquist frequency f_c = 1/(2A) a relative velocity mismatch dv/v over M TDI
+//! stages smears the image by s = A M dv/v (Eq. 18), and
+//! MTF_mismatch = sinc(x) = sin(x)/x with x = pi M (dv/v) / 2 (Eq. 19).
+
+use crate::error::{ModelError, Param};
+use crate::real::Real;
+
+const HALF_PI: f64 = core::f64::consts::FRAC_PI_2;
+const PI: f64 = core::f64::consts::PI;
+
+/// Taylor coefficients of sin(x)/x in x^2, (-1)^k / (2k+1)!, k = 0..=10. On |x| <= pi the
+/// first omitted term is pi^22/23! < 1.2e-11, and the largest term is under 1.7, so the
+/// polynomial is good to a few ulp of 1 in f32 and to ~1e-11 in f64.
+const SINC_TAYLOR: [f64; 11] = [
+    1.0,
+    -1.0 / 6.0,
+    1.0 / 120.0,
+    -1.0 / 5_040.0,
+    1.0 / 362_880.0,
+    -1.0 / 39_916_800.0,
+    1.0 / 6_227_020_800.0,
+    -1.0 / 1_307_674_368_000.0,
+    1.0 / 355_687_428_096_000.0,
+    -1.0 / 121_645_100_408_832_000.0,
+    1.0 / 51_090_942_171_709_440_000.0,
+];
+
+/// sin(x)/x, with sinc(0) = 1: a polynomial on |x| <= pi (no call, no 0/0), sin(x)/x beyond.
+pub fn sinc<T: Real>(x: T) -> T {
+    let pi = T::from_f64(PI);
+    if x <= pi && -x <= pi {
+        let x2 = x * x;
+        let mut acc = T::from_f64(SINC_TAYLOR[SINC_TAYLOR.len() - 1]);
+        for &c in SINC_TAYLOR.iter().rev().skip(1) {
+            acc = acc * x2 + T::from_f64(c);
+        }
+        acc
+    } else {
+        x.sin_cos().0 / x
+    }
+}
+
+/// MTF_mismatch at Nyquist for `stages` TDI stages and a relative mismatch dv/v (Eq. 19).
+/// Negative values are the sinc's contrast reversal beyond x = pi, returned as they are.
+pub fn mtf_mismatch<T: Real>(stages: u32, rel_mismatch: T) -> Result<T, ModelError> {
+    if !rel_mismatch.is_finite() {
+        return Err(ModelError::NonFinite(Param::RelativeMismatch));
+    }
+    Ok(sinc(
+        T::from_f64(HALF_PI) * T::from_u32(stages) * rel_mismatch,
+    ))
+}
+
+/// The TDI stage limit for one MTF floor: computed once (per scene), used per update.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StageRule<T> {
+    mtf_floor: T,
+    /// x_f / (pi/2) where sinc(x_f) = floor on [0, pi]: M |dv/v| may not exceed it.
+    mismatch_budget: T,
+}
+
+impl<T: Real> StageRule<T> {
+    /// The rule for `mtf_floor` in (0, 1): solves sinc(x_f) = floor by bisection in f64
+    /// (sinc falls strictly on [0, pi]), so the per-update work is one division.
+    pub fn new(mtf_floor: f64) -> Result<Self, ModelError> {
+        if !mtf_floor.is_finite() {
+            return Err(ModelError::NonFinite(Param::MtfFloor));
+        }
+        if !(mtf_floor > 0.0 && mtf_floor < 1.0) {
+            return Err(ModelError::OutOfDomain(Param::MtfFloor));
+        }
+        let (mut lo, mut hi) = (0.0_f64, PI);
+        for _ in 0..80 {
+            let mid = 0.5 * (lo + hi);
+            if libm::sin(mid) / mid >= mtf_floor {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        Ok(StageRule {
+            mtf_floor: T::from_f64(mtf_floor),
+            mismatch_budget: T::from_f64(lo / HALF_PI),
+        })
+    }
+
+    /// The largest M in 0..=`stage_limit` with MTF_mismatch(M, dv/v) >= floor.
+    /// The closed-form guess is checked against [`mtf_mismatch`] itself and moved by
+    /// one stage where rounding put it on the wrong side of the floor.
+    pub fn max_stages(&self, rel_mismatch: T, stage_limit: u32) -> Result<u32, ModelError> {
+        if !rel_mismatch.is_finite() {
+            return Err(ModelError::NonFinite(Param::RelativeMismatch));
+        }
+        let d = if rel_mismatch < T::ZERO {
+            -rel_mismatch
+        } else {
+            rel_mismatch
+        };
+        let limit = T::from_u32(stage_limit);
+        let mut m = if d * limit <= self.mismatch_budget {
+            stage_limit
+        } else {
+            (self.mismatch_budget / d).floor().to_u32().min(stage_limit)
+        };
+        let meets = |m: u32| sinc(T::from_f64(HALF_PI) * T::from_u32(m) * d) >= self.mtf_floor;
+        while m > 0 && !meets(m) {
+            m -= 1;
+        }
+        while m < stage_limit && meets(m + 1) {
+            m += 1;
+        }
+        Ok(m)
+    }
+
+    pub fn mtf_floor(&self) -> T {
+        self.mtf_floor
+    }
+}

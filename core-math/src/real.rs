@@ -1,0 +1,108 @@
+//! The scalar interface the closed form is written against, once, for f64 and f32.
+//!
+//! Only what the model needs: field arithmetic, a correctly rounded square root,
+//! and sine/cosine for the per-update work (never per pixel).
+
+use core::ops::{Add, Mul, Neg, Sub};
+
+/// A binary floating-point scalar: `f64` or `f32`.
+pub trait Real:
+    Copy
+    + PartialOrd
+    + core::fmt::Debug
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + core::ops::Div<Output = Self>
+    + Neg<Output = Self>
+{
+    const ZERO: Self;
+    const ONE: Self;
+    /// Round an f64 to this type (round to nearest even).
+    fn from_f64(x: f64) -> Self;
+    fn to_f64(self) -> f64;
+    /// Correctly rounded square root.
+    fn sqrt(self) -> Self;
+    /// (sin x, cos x), each within 1 ulp.
+    fn sin_cos(self) -> (Self, Self);
+    fn is_finite(self) -> bool;
+    /// Largest integer not above `self`.
+    fn floor(self) -> Self;
+    /// Conversion to u32, saturating at 0 and `u32::MAX` (NaN gives 0), as Rust's `as`.
+    fn to_u32(self) -> u32;
+    fn from_u32(n: u32) -> Self;
+}
+
+impl Real for f64 {
+    const ZERO: Self = 0.0;
+    const ONE: Self = 1.0;
+    #[inline(always)]
+    fn from_f64(x: f64) -> Self {
+        x
+    }
+    #[inline(always)]
+    fn to_f64(self) -> f64 {
+        self
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        libm::sqrt(self)
+    }
+    #[inline(always)]
+    fn sin_cos(self) -> (Self, Self) {
+        libm::sincos(self)
+    }
+    #[inline(always)]
+    fn is_finite(self) -> bool {
+        f64::is_finite(self)
+    }
+    #[inline(always)]
+    fn floor(self) -> Self {
+        libm::floor(self)
+    }
+    #[inline(always)]
+    fn to_u32(self) -> u32 {
+        self as u32
+    }
+    #[inline(always)]
+    fn from_u32(n: u32) -> Self {
+        n as f64
+    }
+}
+
+impl Real for f32 {
+    const ZERO: Self = 0.0;
+    const ONE: Self = 1.0;
+    #[inline(always)]
+    fn from_f64(x: f64) -> Self {
+        x as f32
+    }
+    #[inline(always)]
+    fn to_f64(self) -> f64 {
+        self as f64
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        crate::sqrt::sqrt_f32(self)
+    }
+    #[inline(always)]
+    fn sin_cos(self) -> (Self, Self) {
+        libm::sincosf(self)
+    }
+    #[inline(always)]
+    fn is_finite(self) -> bool {
+        f32::is_finite(self)
+    }
+    #[inline(always)]
+    fn floor(self) -> Self {
+        libm::floorf(self)
+    }
+    #[inline(always)]
+    fn to_u32(self) -> u32 {
+        self as u32
+    }
+    #[inline(always)]
+    fn from_u32(n: u32) -> Self {
+        n as f32
+    }
+}

@@ -1,0 +1,47 @@
+//! Host tasks, run as `cargo xtask <command>`.
+//!
+//! Each command is one module; `main` only dispatches.
+
+mod accuracy;
+mod csv;
+mod eval;
+mod paper;
+mod test_cmd;
+
+use std::process::ExitCode;
+
+const USAGE: &str = "usage: cargo xtask <command>
+
+commands:
+  eval --backend <reference|f64|f32> --input CASES.csv   evaluate cases, CSV to stdout
+  accuracy [--quick]                                     f32/f64 error sweep against the reference
+  paper                                                  regenerate docs/paper/ (Figs. 5-8)
+  test                                                   every check CI runs
+";
+
+fn main() -> ExitCode {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let Some(cmd) = args.first() else {
+        eprint!("{USAGE}");
+        return ExitCode::from(2);
+    };
+    let rest = &args[1..];
+    let result = match cmd.as_str() {
+        "eval" => eval::run(rest),
+        "accuracy" => accuracy::run(rest),
+        "paper" => paper::run(rest),
+        "test" => test_cmd::run(rest),
+        "help" | "--help" | "-h" => {
+            print!("{USAGE}");
+            Ok(())
+        }
+        other => Err(format!("unknown command `{other}`\n{USAGE}")),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("xtask: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
