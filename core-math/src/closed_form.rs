@@ -37,6 +37,9 @@ impl<T> ClosedForm<T> {
 /// Constants of one field point, known at boot.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PixelConst<T> {
+    /// Field angle alpha as an unevaluated sum hi + lo (rad), for the limb distance.
+    pub field_hi_rad: T,
+    pub field_lo_rad: T,
     pub sin_field: T,
     pub cos_field: T,
     /// f / cos(alpha) (m).
@@ -48,6 +51,15 @@ pub struct PixelConst<T> {
 /// Constants of one instant.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct UpdateConst<T> {
+    /// L - phi and L + phi as unevaluated sums hi + lo (rad), L = asin(R/(R+H)) the
+    /// nadir angle of the limb: the angular distance to the left and right limbs of a
+    /// ray with field angle alpha is (L - phi) - alpha and (L + phi) + alpha.
+    pub limb_left_hi_rad: T,
+    pub limb_left_lo_rad: T,
+    pub limb_right_hi_rad: T,
+    pub limb_right_lo_rad: T,
+    /// sqrt(k^2 - 1) = k cos L.
+    pub sqrt_c0: T,
     pub sin_roll: T,
     pub cos_roll: T,
     /// (R + H) / R.
@@ -58,6 +70,17 @@ pub struct UpdateConst<T> {
     pub b_rad_s: T,
     /// w sin(i0) sin(g0) (rad/s).
     pub c_rad_s: T,
+}
+
+/// Below this limb distance (rad) the near-limb form is used, with x = delta/2 <= 0.15
+/// as [`Real::small_sin_cos`] requires. Above it, q^2 >= (about) 0.2 for every altitude of the domain and the direct form's
+/// error, ~3u/q, stays under 5e-7 (see docs/accuracy.md).
+pub const LIMB_BRANCH_RAD: f64 = 0.3;
+
+/// x as hi + lo in T, hi = round(x), lo = round(x - hi).
+fn split<T: Real>(x: f64) -> (T, T) {
+    let hi = T::from_f64(x);
+    (hi, T::from_f64(x - hi.to_f64()))
 }
 
 impl<T: Real> Backend for ClosedForm<T> {
@@ -71,7 +94,10 @@ impl<T: Real> Backend for ClosedForm<T> {
         let t = camera.tan_field(n_px)?;
         let sec2 = 1.0 + t * t;
         let sec = libm::sqrt(sec2);
+        let (field_hi_rad, field_lo_rad) = split::<T>(libm::atan(t));
         Ok(PixelConst {
+            field_hi_rad,
+            field_lo_rad,
             sin_field: T::from_f64(t / sec),
             cos_field: T::from_f64(1.0 / sec),
             w1_m: T::from_f64(camera.focal_m * sec),
@@ -88,7 +114,20 @@ impl<T: Real> Backend for ClosedForm<T> {
         // k^2 - 1 without the cancellation of forming k^2 first.
         let c0 = h * (T::ONE + T::ONE + h);
         let w = g.earth_rate_rad_s;
+        // The limb angle in f64 (once per update), so that L -/+ phi is known to far
+        // better than T's precision: near the limb it is the small difference that
+        // decides everything, and it must not inherit an absolute rounding of ~u.
+        let h64 = g.altitude_m.to_f64() / g.earth_radius_m.to_f64();
+        let limb = libm::asin(1.0 / (1.0 + h64));
+        let phi = g.roll_rad.to_f64();
+        let (limb_left_hi_rad, limb_left_lo_rad) = split::<T>(limb - phi);
+        let (limb_right_hi_rad, limb_right_lo_rad) = split::<T>(limb + phi);
         Ok(UpdateConst {
+            limb_left_hi_rad,
+            limb_left_lo_rad,
+            limb_right_hi_rad,
+            limb_right_lo_rad,
+            sqrt_c0: c0.sqrt(),
             sin_roll,
             cos_roll,
             k: T::ONE + h,
@@ -107,13 +146,29 @@ impl<T: Real> Backend for ClosedForm<T> {
         if !(cos_eta > T::ZERO) {
             return Err(ModelError::LineOfSightMissesEarth);
         }
-        let ks = u.k * sin_eta;
-        // 1 - ks is exact (Sterbenz) wherever it is small, so the only error near the
-        // limb is that of sin(eta) itself: the problem's conditioning, not ours.
-        let q2 = (T::ONE - ks) * (T::ONE + ks);
-        if !(q2 > T::ZERO) {
+        // Angular distance delta = L - |eta| to the limb the ray looks toward. The hi
+        // parts cancel exactly (Sterbenz) near the limb, so delta keeps T's relative
+        // precision however small it is.
+        let delta = if sin_eta >= T::ZERO {
+            (u.limb_left_hi_rad - p.field_hi_rad) + (u.limb_left_lo_rad - p.field_lo_rad)
+        } else {
+            (u.limb_right_hi_rad + p.field_hi_rad) + (u.limb_right_lo_rad + p.field_lo_rad)
+        };
+        if !(delta > T::ZERO) {
             return Err(ModelError::LineOfSightMissesEarth);
         }
+        let ks = u.k * sin_eta;
+        let abs_ks = if ks < T::ZERO { -ks } else { ks };
+        // 1 - k|sin eta|: near the limb from delta, where 1 - k|sin eta| =
+        // 2 s (s + sqrt(k^2-1) c), s = sin(delta/2), c = cos(delta/2), all terms positive;
+        // elsewhere directly, where it is not small and a rounding of ks costs little.
+        let one_minus = if delta < T::from_f64(LIMB_BRANCH_RAD) {
+            let (s, c) = T::small_sin_cos(T::from_f64(0.5) * delta);
+            (s + s) * (s + u.sqrt_c0 * c)
+        } else {
+            T::ONE - abs_ks
+        };
+        let q2 = one_minus * (T::ONE + T::ONE - one_minus);
         let q = q2.sqrt();
         let den = u.k * cos_eta + q;
         let cos_theta = q * cos_eta + ks * sin_eta;

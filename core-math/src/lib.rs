@@ -18,6 +18,7 @@
 )]
 #![cfg_attr(all(target_arch = "arm", target_abi = "eabihf"), deny(unsafe_code))]
 
+pub mod accuracy;
 pub mod closed_form;
 pub mod dual;
 pub mod error;

@@ -15,6 +15,13 @@ pub mod domain {
     pub const MAX_ALTITUDE_OVER_RADIUS: f64 = 16.0;
     /// Smallest altitude as a multiple of the Earth radius (6 mm for the Earth).
     pub const MIN_ALTITUDE_OVER_RADIUS: f64 = 1.0e-9;
+    /// Accepted Earth (body) radius (m): any planet or moon, no absurd scale that
+    /// could overflow (R + H)^3 or underflow the ratios.
+    pub const EARTH_RADIUS_M: (f64, f64) = (1.0e3, 1.0e8);
+    /// Largest focal length (m) and pixel pitch (m): well past any real instrument,
+    /// small enough that f (1 + tan^2 alpha) stays finite in f32.
+    pub const MAX_FOCAL_M: f64 = 1.0e3;
+    pub const MAX_PIXEL_M: f64 = 1.0;
     /// Largest |rate| accepted for the Earth and orbit rates (rad/s).
     pub const MAX_RATE_RAD_S: f64 = 1.0;
     /// Largest |tan(field angle)| = |n A / f| (field angle just under 90 deg).
@@ -136,6 +143,11 @@ impl<T: Real> Geometry<T> {
         if !(self.earth_radius_m > T::ZERO) {
             return Err(ModelError::NonPositiveEarthRadius);
         }
+        let (r_min, r_max) = domain::EARTH_RADIUS_M;
+        if !(self.earth_radius_m >= T::from_f64(r_min) && self.earth_radius_m <= T::from_f64(r_max))
+        {
+            return Err(ModelError::OutOfDomain(Param::EarthRadius));
+        }
         if !(self.altitude_m > T::ZERO) {
             return Err(ModelError::NonPositiveAltitude);
         }
@@ -171,6 +183,12 @@ impl Camera {
         }
         if self.pixel_m <= 0.0 {
             return Err(ModelError::NonPositivePixelPitch);
+        }
+        if self.focal_m > domain::MAX_FOCAL_M {
+            return Err(ModelError::OutOfDomain(Param::FocalLength));
+        }
+        if self.pixel_m > domain::MAX_PIXEL_M {
+            return Err(ModelError::OutOfDomain(Param::PixelPitch));
         }
         Ok(())
     }

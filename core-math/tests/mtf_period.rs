@@ -1,0 +1,171 @@
+//! MTF_mismatch, the TDI stage limit and the line period, each against an independent
+//! computation (libm's sin, a brute-force search, exact integer arithmetic).
+
+use core_math::{line_period_s, line_period_ticks, mtf_mismatch, sinc, ModelError, StageRule};
+
+#[test]
+fn sinc_polynomial_matches_libm() {
+    let mut worst64 = 0.0f64;
+    let mut worst32 = 0.0f64;
+    for i in 1..=20_000 {
+        let x = i as f64 * (std::f64::consts::PI / 20_000.0);
+        let exact = libm::sin(x) / x;
+        worst64 = worst64.max((sinc(x) - exact).abs());
+        worst32 = worst32.max((sinc(x as f32) as f64 - exact).abs());
+    }
+    assert!(worst64 < 1e-10, "f64 sinc error {worst64}");
+    assert!(worst32 < 5e-7, "f32 sinc error {worst32}");
+    assert_eq!(sinc(0.0f64), 1.0);
+    // Beyond pi the direct quotient is used; check it too.
+    assert!((sinc(4.0f64) - libm::sin(4.0) / 4.0).abs() < 1e-15);
+}
+
+#[test]
+fn mtf_mismatch_is_eq_19() {
+    // Eq. 19: sin(pi M dv/(2v)) / (pi M dv/(2v)).
+    for (m, d) in [(16u32, 0.01f64), (48, 0.019), (96, 0.001), (1, 0.5)] {
+        let x = std::f64::consts::PI * m as f64 * d / 2.0;
+        let expect = libm::sin(x) / x;
+        assert!((mtf_mismatch(m, d).unwrap() - expect).abs() < 1e-10);
+        assert!(
+            (mtf_mismatch(m, -d).unwrap() - expect).abs() < 1e-10,
+            "even in dv"
+        );
+    }
+    assert_eq!(mtf_mismatch(48, 0.0f64).unwrap(), 1.0);
+    assert_eq!(
+        mtf_mismatch(48, f64::NAN),
+        Err(ModelError::NonFinite(core_math::Param::RelativeMismatch))
+    );
+}
+
+/// The largest M with sin(x)/x >= floor, by walking M upward with libm.
+fn brute_max_stages(d: f64, floor: f64, limit: u32) -> u32 {
+    let mut best = 0;
+    for m in 1..=limit {
+        let x = std::f64::consts::PI * m as f64 * d.abs() / 2.0;
+        let v = if x == 0.0 { 1.0 } else { libm::sin(x) / x };
+        if v >= floor {
+            best = m;
+        } else {
+            break;
+        }
+    }
+    best
+}
+
+#[test]
+fn stage_rule_matches_brute_force() {
+    for floor in [0.5, 0.8, 0.9, 0.95, 0.99, 0.999] {
+        let rule = StageRule::<f64>::new(floor).unwrap();
+        let rule32 = StageRule::<f32>::new(floor).unwrap();
+        for i in 0..2_000 {
+            let d = 1e-5 * 1.005f64.powi(i);
+            let expect = brute_max_stages(d, floor, 256);
+            assert_eq!(
+                rule.max_stages(d, 256).unwrap(),
+                expect,
+                "floor {floor} d {d}"
+            );
+            let got32 = rule32.max_stages(d as f32, 256).unwrap();
+            // f32 may decide a case that sits on the floor to within its rounding either way.
+            assert!(
+                got32.abs_diff(expect) <= 1,
+                "f32: floor {floor} d {d}: {got32} vs {expect}"
+            );
+        }
+        assert_eq!(
+            rule.max_stages(0.0, 96).unwrap(),
+            96,
+            "no mismatch: the sensor's limit"
+        );
+    }
+}
+
+#[test]
+fn stage_rule_refuses_bad_floors() {
+    for f in [0.0, 1.0, -0.1, 1.5] {
+        assert!(matches!(
+            StageRule::<f64>::new(f),
+            Err(ModelError::OutOfDomain(_))
+        ));
+    }
+    assert!(matches!(
+        StageRule::<f64>::new(f64::NAN),
+        Err(ModelError::NonFinite(_))
+    ));
+}
+
+#[test]
+fn line_period_and_ticks() {
+    // 13 um at 5.81 mm/s.
+    let t = line_period_s(13e-6, 5.81e-3f64).unwrap();
+    assert!((t - 13e-6 / 5.81e-3).abs() < 1e-18);
+    // 10 MHz clock: exact integer rounding and its error.
+    let ticks = line_period_ticks(t, 10e6).unwrap();
+    let exact = t * 10e6;
+    assert_eq!(ticks.ticks as f64, (exact + 0.5).floor());
+    assert!((ticks.rounding_error_s - (ticks.ticks as f64 - exact) / 10e6).abs() < 1e-18);
+    assert!(ticks.rounding_error_s.abs() <= 0.5 / 10e6);
+    // The same in f32.
+    let t32 = line_period_s(13e-6f32, 5.81e-3).unwrap();
+    assert_eq!(line_period_ticks(t32, 10e6f32).unwrap().ticks, ticks.ticks);
+}
+
+#[test]
+fn line_period_refusals() {
+    assert_eq!(line_period_s(13e-6, 0.0f64), Err(ModelError::NoImageMotion));
+    assert_eq!(
+        line_period_s(13e-6, -1.0f64),
+        Err(ModelError::NoImageMotion)
+    );
+    assert_eq!(
+        line_period_s(13e-6, f64::NAN),
+        Err(ModelError::NoImageMotion)
+    );
+    assert_eq!(
+        line_period_s(13e-6f32, 1e-44),
+        Err(ModelError::NoImageMotion),
+        "overflow to inf"
+    );
+    assert_eq!(
+        line_period_s(0.0, 1.0f64),
+        Err(ModelError::NonPositivePixelPitch)
+    );
+    // Largest and smallest periods the 32-bit counter holds.
+    assert_eq!(
+        line_period_ticks(u32::MAX as f64 / 1e6, 1e6).unwrap().ticks,
+        u32::MAX
+    );
+    assert_eq!(
+        line_period_ticks(4.3e9 / 1e6, 1e6f64),
+        Err(ModelError::LinePeriodOutOfRange)
+    );
+    assert_eq!(line_period_ticks(1e-6, 1e6f64).unwrap().ticks, 1);
+    assert_eq!(
+        line_period_ticks(0.4e-6, 1e6f64),
+        Err(ModelError::LinePeriodOutOfRange)
+    );
+    assert!(line_period_ticks(1e-3, 0.0f64).is_err());
+    assert!(line_period_ticks(1e-3, f64::INFINITY).is_err());
+}
+
+#[test]
+fn dual_numbers_differentiate_exactly() {
+    use core_math::dual::Dual;
+    // d/dt [sin(3t) * cos(t) / (2 + t)] at t = 0.7, against the hand derivative.
+    let t0 = 0.7f64;
+    let t = Dual::new(t0, 1.0);
+    let f = (Dual::constant(3.0) * t).sin() * t.cos() / (Dual::constant(2.0) + t);
+    let (s3, c3, s, c) = (
+        libm::sin(3.0 * t0),
+        libm::cos(3.0 * t0),
+        libm::sin(t0),
+        libm::cos(t0),
+    );
+    let num = s3 * c;
+    let dnum = 3.0 * c3 * c - s3 * s;
+    let expect = (dnum * (2.0 + t0) - num) / ((2.0 + t0) * (2.0 + t0));
+    assert!((f.du - expect).abs() < 1e-15, "{} vs {}", f.du, expect);
+    assert!((f.re - num / (2.0 + t0)).abs() < 1e-16);
+}
