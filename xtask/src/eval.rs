@@ -1,3 +1,196 @@
-pub fn run(_args: &[String]) -> Result<(), String> {
-    Err("not implemented yet".into())
+//! `cargo xtask eval --backend <reference|f64|f32> --input CASES.csv`: the model on
+//! user-supplied cases, CSV out, so the firmware's numbers can be checked on the ground.
+
+use core_math::{
+    line_period_s, Backend, Camera, Geometry, ModelError, Real, Reference, CLOSED_F32, CLOSED_F64,
+};
+
+use crate::csv::Table;
+
+/// Input columns, in the order the model takes them.
+pub const INPUT_COLUMNS: [&str; 8] = [
+    "n_px",
+    "phi_deg",
+    "i0_deg",
+    "gamma0_deg",
+    "h_m",
+    "f_m",
+    "pixel_m",
+    "r_m",
+];
+pub const OUTPUT_COLUMNS: [&str; 5] = ["v1_mps", "v2_mps", "v_mps", "line_period_s", "error"];
+
+pub fn run(args: &[String]) -> Result<(), String> {
+    let mut backend = None;
+    let mut input = None;
+    let mut it = args.iter();
+    while let Some(a) = it.next() {
+        match a.as_str() {
+            "--backend" => backend = it.next().cloned(),
+            "--input" => input = it.next().cloned(),
+            other => return Err(format!("eval: unknown argument `{other}`")),
+        }
+    }
+    let backend = backend.ok_or("eval: --backend <reference|f64|f32> is required")?;
+    let input = input.ok_or("eval: --input CASES.csv is required")?;
+    let text = if input == "-" {
+        std::io::read_to_string(std::io::stdin()).map_err(|e| format!("reading stdin: {e}"))?
+    } else {
+        std::fs::read_to_string(&input).map_err(|e| format!("reading {input}: {e}"))?
+    };
+    print!("{}", eval_csv(&backend, &text)?);
+    Ok(())
+}
+
+/// The whole command on a CSV text: one output row per input row, always.
+pub fn eval_csv(backend: &str, text: &str) -> Result<String, String> {
+    let table = Table::parse(text)?;
+    let cols = table.columns(&INPUT_COLUMNS)?;
+    let mut out = String::new();
+    out.push_str(&table.header.join(","));
+    out.push(',');
+    out.push_str(&OUTPUT_COLUMNS.join(","));
+    out.push('\n');
+    for row in &table.rows {
+        let result = parse_case(row, &cols).and_then(|case| match backend {
+            "reference" => evaluate(&Reference, &case, |g| g),
+            "f64" => evaluate(&CLOSED_F64, &case, |g| g),
+            "f32" => evaluate(&CLOSED_F32, &case, |g| g.to::<f32>()),
+            other => Err(EvalError::Usage(format!(
+                "unknown backend `{other}` (reference|f64|f32)"
+            ))),
+        });
+        let outputs = match result {
+            Ok(nums) => format!("{},{},{},{},", nums[0], nums[1], nums[2], nums[3]),
+            Err(EvalError::Model(e)) => format!(",,,,{}", e.name()),
+            Err(EvalError::Unparsable) => ",,,,unparsable_input".to_string(),
+            Err(EvalError::Usage(msg)) => return Err(msg),
+        };
+        out.push_str(&row.join(","));
+        out.push(',');
+        out.push_str(&outputs);
+        out.push('\n');
+    }
+    Ok(out)
+}
+
+enum EvalError {
+    Model(ModelError),
+    Unparsable,
+    Usage(String),
+}
+
+impl From<ModelError> for EvalError {
+    fn from(e: ModelError) -> Self {
+        EvalError::Model(e)
+    }
+}
+
+/// One case in SI units: optics, geometry (f64, to be rounded by the backend), pixel.
+pub struct Case {
+    pub camera: Camera,
+    pub geometry: Geometry<f64>,
+    pub n_px: f64,
+}
+
+fn parse_case(row: &[String], cols: &[usize]) -> Result<Case, EvalError> {
+    let mut v = [0.0f64; 8];
+    for (slot, &c) in v.iter_mut().zip(cols) {
+        *slot = row
+            .get(c)
+            .and_then(|s| s.parse::<f64>().ok())
+            .ok_or(EvalError::Unparsable)?;
+    }
+    let [n_px, phi_deg, i0_deg, gamma0_deg, h_m, f_m, pixel_m, r_m] = v;
+    Ok(Case {
+        camera: Camera {
+            focal_m: f_m,
+            pixel_m,
+        },
+        geometry: Geometry::circular(
+            phi_deg.to_radians(),
+            i0_deg.to_radians(),
+            gamma0_deg.to_radians(),
+            h_m,
+            r_m,
+        ),
+        n_px,
+    })
+}
+
+/// v1, v2, |v| and the line period, formatted in the backend's own precision
+/// (shortest text that reads back to the same value).
+fn evaluate<B: Backend>(
+    backend: &B,
+    case: &Case,
+    to_real: impl Fn(Geometry<f64>) -> Geometry<B::Real>,
+) -> Result<[String; 4], EvalError>
+where
+    B::Real: std::fmt::Display,
+{
+    let m = backend.evaluate(&case.camera, &to_real(case.geometry), case.n_px)?;
+    let speed = m.speed_mps();
+    let period = line_period_s(B::Real::from_f64(case.camera.pixel_m), speed)?;
+    Ok([
+        m.v1_mps.to_string(),
+        m.v2_mps.to_string(),
+        speed.to_string(),
+        period.to_string(),
+    ])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const CASES: &str = "case,n_px,phi_deg,i0_deg,gamma0_deg,h_m,f_m,pixel_m,r_m
+nadir,0,0,97.98,0,645000,0.555,13e-6,6370000
+far,30000,25,97.98,45,645000,0.555,13e-6,6370000
+beyond_limb,30000,45,97.98,45,645000,0.555,13e-6,6370000
+bad_focal,0,0,97.98,0,645000,0,13e-6,6370000
+garbled,x,0,97.98,0,645000,0.555,13e-6,6370000
+";
+
+    fn field<'a>(line: &'a str, header: &str, name: &str) -> &'a str {
+        let i = header.split(',').position(|h| h == name).unwrap();
+        line.split(',').nth(i).unwrap()
+    }
+
+    #[test]
+    fn one_row_per_input_row_with_typed_errors() {
+        for backend in ["reference", "f64", "f32"] {
+            let out = eval_csv(backend, CASES).unwrap();
+            let lines: Vec<&str> = out.lines().collect();
+            assert_eq!(lines.len(), 6);
+            let h = lines[0];
+            assert!(h.ends_with("v1_mps,v2_mps,v_mps,line_period_s,error"));
+            assert_eq!(
+                field(lines[1], h, "case"),
+                "nadir",
+                "extra columns are kept"
+            );
+            assert_eq!(field(lines[1], h, "error"), "");
+            assert_eq!(field(lines[3], h, "error"), "line_of_sight_misses_earth");
+            assert_eq!(field(lines[3], h, "v1_mps"), "");
+            assert_eq!(field(lines[4], h, "error"), "non_positive_focal_length");
+            assert_eq!(field(lines[5], h, "error"), "unparsable_input");
+        }
+        assert!(eval_csv("f16", CASES).is_err());
+    }
+
+    #[test]
+    fn backends_agree_and_period_is_pixel_over_speed() {
+        let r = eval_csv("reference", CASES).unwrap();
+        let f = eval_csv("f32", CASES).unwrap();
+        let h = r.lines().next().unwrap().to_string();
+        for (lr, lf) in r.lines().zip(f.lines()).skip(1).take(2) {
+            let (vr, vf): (f64, f64) = (
+                field(lr, &h, "v_mps").parse().unwrap(),
+                field(lf, &h, "v_mps").parse().unwrap(),
+            );
+            assert!((vf - vr).abs() / vr < 1e-6, "{vf} vs {vr}");
+            let t: f64 = field(lr, &h, "line_period_s").parse().unwrap();
+            assert!((t - 13e-6 / vr).abs() < 1e-15 * t);
+        }
+    }
 }

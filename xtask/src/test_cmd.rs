@@ -1,3 +1,52 @@
-pub fn run(_args: &[String]) -> Result<(), String> {
-    Err("not implemented yet".into())
+//! `cargo xtask test`: every check CI runs, in the order a failure is cheapest to see.
+
+use std::process::Command;
+
+/// Runs a command with inherited output; an error names it and its status.
+pub fn run_step(program: &str, args: &[&str]) -> Result<(), String> {
+    eprintln!("\n==> {program} {}", args.join(" "));
+    let status = Command::new(program)
+        .args(args)
+        .status()
+        .map_err(|e| format!("cannot start `{program}`: {e}"))?;
+    if status.success() {
+        Ok(())
+    } else {
+        Err(format!("`{program} {}` failed ({status})", args.join(" ")))
+    }
+}
+
+fn cargo(args: &[&str]) -> Result<(), String> {
+    run_step(env!("CARGO"), args)
+}
+
+pub fn run(args: &[String]) -> Result<(), String> {
+    if let Some(a) = args.first() {
+        return Err(format!("test: unknown argument `{a}`"));
+    }
+    let t0 = std::time::Instant::now();
+    cargo(&["fmt", "--all", "--check"])?;
+    // The default members are the host crates; the target crates are linted by
+    // `target::test_target` for thumbv7em.
+    cargo(&["clippy", "--all-targets", "--", "-D", "warnings"])?;
+    // Host unit, property and golden tests; release, since the property tests evaluate
+    // the reference chain tens of thousands of times.
+    cargo(&["test", "--release"])?;
+    derivation_check()?;
+    crate::target::test_target()?;
+    eprintln!("\nxtask test: all checks passed in {:.0} s", t0.elapsed().as_secs_f64());
+    Ok(())
+}
+
+/// The computer-algebra proof of the derivation (tools/derivation/derive.py).
+fn derivation_check() -> Result<(), String> {
+    let has_sympy = Command::new("python3")
+        .args(["-c", "import sympy, mpmath"])
+        .output()
+        .map(|o| o.status.success())
+        .map_err(|e| format!("python3 is needed for the derivation check: {e}"))?;
+    if !has_sympy {
+        run_step("python3", &["-m", "pip", "install", "--quiet", "-r", "tools/derivation/requirements.txt"])?;
+    }
+    run_step("python3", &["tools/derivation/derive.py"])
 }
