@@ -17,6 +17,8 @@ pub enum Param {
     ClockFrequency,
     RelativeMismatch,
     MtfFloor,
+    Position,
+    Velocity,
 }
 
 impl Param {
@@ -35,6 +37,8 @@ impl Param {
             Param::ClockFrequency => "clock_frequency",
             Param::RelativeMismatch => "relative_mismatch",
             Param::MtfFloor => "mtf_floor",
+            Param::Position => "position",
+            Param::Velocity => "velocity",
         }
     }
 }

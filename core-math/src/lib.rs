@@ -25,6 +25,7 @@ pub mod error;
 pub mod line_period;
 pub mod model;
 pub mod mtf;
+pub mod orbit;
 pub mod real;
 pub mod reference;
 mod sqrt;
@@ -36,6 +37,7 @@ pub use model::{
     domain, orbital_rate_rad_s, Backend, Camera, Geometry, ImageMotion, EARTH_RATE_RAD_S, GM_M3_S2,
 };
 pub use mtf::{mtf_mismatch, sinc, StageRule};
+pub use orbit::{OrbitState, StateVector};
 pub use real::Real;
 pub use reference::Reference;
 
