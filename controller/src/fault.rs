@@ -1,0 +1,127 @@
+//! Every reason the controller refuses an input or an output, and their counters.
+//! A refusal never changes the line periods in force: the last good ones stay.
+
+use core_math::ModelError;
+
+use crate::frame::FrameError;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[repr(u8)]
+pub enum Fault {
+    /// Frame CRC mismatch.
+    BadCrc = 0,
+    /// A frame cut short by the next one.
+    Truncated,
+    /// Length field beyond the maximum payload.
+    Oversized,
+    /// Unknown protocol version.
+    UnknownVersion,
+    /// Unknown frame kind.
+    UnknownKind,
+    /// Payload length wrong for its kind.
+    BadLength,
+    /// A NaN or infinity in a payload.
+    NonFinite,
+    /// A finite value outside the controller's envelope (altitude, speed, roll, rates,
+    /// scene geometry).
+    OutOfRange,
+    /// Time tag not after the last accepted one.
+    TimeWentBackwards,
+    /// Pitch, yaw or an attitude rate beyond the roll-only model's configured tolerance.
+    AttitudeOutsideModel,
+    /// An active segment's line of sight misses the Earth at the commanded roll.
+    BeyondLimb,
+    /// No valid NAV frame for longer than the configured time.
+    Stale,
+    /// A computed line period outside the physically possible range.
+    PeriodOutOfRange,
+    /// A scene upload that does not describe a usable focal plane.
+    InvalidScene,
+}
+
+impl Fault {
+    pub const COUNT: usize = 14;
+    pub const ALL: [Fault; Fault::COUNT] = [
+        Fault::BadCrc,
+        Fault::Truncated,
+        Fault::Oversized,
+        Fault::UnknownVersion,
+        Fault::UnknownKind,
+        Fault::BadLength,
+        Fault::NonFinite,
+        Fault::OutOfRange,
+        Fault::TimeWentBackwards,
+        Fault::AttitudeOutsideModel,
+        Fault::BeyondLimb,
+        Fault::Stale,
+        Fault::PeriodOutOfRange,
+        Fault::InvalidScene,
+    ];
+
+    pub const fn name(self) -> &'static str {
+        match self {
+            Fault::BadCrc => "bad_crc",
+            Fault::Truncated => "truncated",
+            Fault::Oversized => "oversized",
+            Fault::UnknownVersion => "unknown_version",
+            Fault::UnknownKind => "unknown_kind",
+            Fault::BadLength => "bad_length",
+            Fault::NonFinite => "non_finite",
+            Fault::OutOfRange => "out_of_range",
+            Fault::TimeWentBackwards => "time_went_backwards",
+            Fault::AttitudeOutsideModel => "attitude_outside_model",
+            Fault::BeyondLimb => "beyond_limb",
+            Fault::Stale => "stale",
+            Fault::PeriodOutOfRange => "period_out_of_range",
+            Fault::InvalidScene => "invalid_scene",
+        }
+    }
+}
+
+impl From<FrameError> for Fault {
+    fn from(e: FrameError) -> Self {
+        match e {
+            FrameError::BadCrc => Fault::BadCrc,
+            FrameError::Truncated => Fault::Truncated,
+            FrameError::Oversized => Fault::Oversized,
+            FrameError::UnknownVersion => Fault::UnknownVersion,
+        }
+    }
+}
+
+impl From<ModelError> for Fault {
+    fn from(e: ModelError) -> Self {
+        match e {
+            ModelError::NonFinite(_) => Fault::NonFinite,
+            ModelError::LineOfSightMissesEarth => Fault::BeyondLimb,
+            ModelError::NoImageMotion | ModelError::LinePeriodOutOfRange => Fault::PeriodOutOfRange,
+            ModelError::NonPositiveAltitude
+            | ModelError::NonPositiveEarthRadius
+            | ModelError::NonPositiveFocalLength
+            | ModelError::NonPositivePixelPitch
+            | ModelError::OutOfDomain(_) => Fault::OutOfRange,
+        }
+    }
+}
+
+/// One counter per fault, saturating.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Counters {
+    counts: [u32; Fault::COUNT],
+}
+
+impl Counters {
+    pub fn count(&mut self, f: Fault) {
+        let c = &mut self.counts[f as usize];
+        *c = c.saturating_add(1);
+    }
+    pub fn get(&self, f: Fault) -> u32 {
+        self.counts[f as usize]
+    }
+    pub fn total(&self) -> u32 {
+        self.counts.iter().fold(0u32, |a, &c| a.saturating_add(c))
+    }
+    pub fn as_array(&self) -> &[u32; Fault::COUNT] {
+        &self.counts
+    }
+}

@@ -1,0 +1,213 @@
+//! Telemetry framing: sync word, version, kind, length, sequence number, time tag,
+//! payload, CRC. Layout and rationale: `docs/telemetry.md`.
+//!
+//! The decoder is a byte-stream state machine over a fixed buffer: it never blocks,
+//! never allocates, and after any bad frame it rescans the bytes it already holds for the
+//! next sync word, so a corrupted or truncated frame costs that frame only.
+
+use crate::crc;
+
+pub const SYNC: [u8; 2] = [0xEB, 0x90];
+pub const VERSION: u8 = 1;
+/// sync (2) + version (1) + kind (1) + length (2) + sequence (2) + time tag (8).
+pub const HEADER_LEN: usize = 16;
+pub const CRC_LEN: usize = 2;
+pub const MAX_PAYLOAD: usize = 328;
+pub const MAX_FRAME: usize = HEADER_LEN + MAX_PAYLOAD + CRC_LEN;
+
+/// Frame kinds. Ground/bus to camera below 0x80, camera to ground from 0x80.
+pub mod kind {
+    /// Orbit state and attitude (payload: `nav::NAV_LEN` bytes).
+    pub const NAV: u8 = 0x01;
+    /// Imaging scene upload (payload: `scene` module).
+    pub const SCENE: u8 = 0x02;
+    /// Time only: a tick of the time source (the simulation's clock; on a board the
+    /// on-board timer plays this part and the frame is not needed).
+    pub const TIME: u8 = 0x03;
+    /// Line periods, one record per active segment.
+    pub const PERIODS: u8 = 0x81;
+    /// Fault counters and state.
+    pub const STATUS: u8 = 0x82;
+}
+
+/// Why bytes on the link were not a frame.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FrameError {
+    /// The CRC did not match.
+    BadCrc,
+    /// The frame stopped short: another frame's sync and header start inside its span.
+    Truncated,
+    /// The length field exceeds [`MAX_PAYLOAD`].
+    Oversized,
+    /// A version this firmware does not speak.
+    UnknownVersion,
+}
+
+/// A decoded frame; the payload borrows the decoder's buffer.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Frame<'a> {
+    pub kind: u8,
+    pub sequence: u16,
+    pub time_us: u64,
+    pub payload: &'a [u8],
+}
+
+/// What the decoder reports, one event per frame or per rejected frame.
+#[derive(Debug, PartialEq, Eq)]
+pub enum Event<'a> {
+    Frame(Frame<'a>),
+    Rejected(FrameError),
+}
+
+/// The streaming decoder.
+pub struct Decoder {
+    buf: [u8; MAX_FRAME],
+    len: usize,
+    /// Bytes dropped while hunting for a sync word (line noise, not frames).
+    pub skipped_bytes: u32,
+}
+
+impl Default for Decoder {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+enum Step {
+    /// Need more bytes.
+    Wait,
+    /// Drop this many bytes from the front and look again.
+    Drop(usize),
+    /// A good frame of this total length at the front.
+    Frame(usize),
+    /// A bad frame at the front: report it, drop its sync's first byte, rescan.
+    Reject(FrameError),
+}
+
+impl Decoder {
+    pub const fn new() -> Self {
+        Decoder {
+            buf: [0; MAX_FRAME],
+            len: 0,
+            skipped_bytes: 0,
+        }
+    }
+
+    /// Feeds received bytes; `on_event` is called for every frame and every rejected frame.
+    pub fn feed(&mut self, bytes: &[u8], mut on_event: impl FnMut(Event<'_>)) {
+        for &b in bytes {
+            // The buffer holds at most one frame, so it always has room after parsing.
+            if self.len < MAX_FRAME {
+                self.buf[self.len] = b;
+                self.len += 1;
+            }
+            self.parse(&mut on_event);
+        }
+    }
+
+    fn parse(&mut self, on_event: &mut impl FnMut(Event<'_>)) {
+        loop {
+            match self.step() {
+                Step::Wait => return,
+                Step::Drop(n) => {
+                    self.skipped_bytes = self.skipped_bytes.saturating_add(n as u32);
+                    self.consume(n);
+                }
+                Step::Frame(n) => {
+                    let b = &self.buf;
+                    on_event(Event::Frame(Frame {
+                        kind: b[3],
+                        sequence: u16::from_le_bytes([b[6], b[7]]),
+                        time_us: u64::from_le_bytes([
+                            b[8], b[9], b[10], b[11], b[12], b[13], b[14], b[15],
+                        ]),
+                        payload: &b[HEADER_LEN..n - CRC_LEN],
+                    }));
+                    self.consume(n);
+                }
+                Step::Reject(e) => {
+                    on_event(Event::Rejected(e));
+                    self.consume(1);
+                }
+            }
+        }
+    }
+
+    fn step(&self) -> Step {
+        let b = &self.buf[..self.len];
+        if b.is_empty() {
+            return Step::Wait;
+        }
+        if b[0] != SYNC[0] {
+            let n = b.iter().position(|&x| x == SYNC[0]).unwrap_or(b.len());
+            return Step::Drop(n);
+        }
+        if b.len() < 2 {
+            return Step::Wait;
+        }
+        if b[1] != SYNC[1] {
+            return Step::Drop(1);
+        }
+        if b.len() < HEADER_LEN {
+            return Step::Wait;
+        }
+        if b[2] != VERSION {
+            return Step::Reject(FrameError::UnknownVersion);
+        }
+        let payload_len = usize::from(u16::from_le_bytes([b[4], b[5]]));
+        if payload_len > MAX_PAYLOAD {
+            return Step::Reject(FrameError::Oversized);
+        }
+        let total = HEADER_LEN + payload_len + CRC_LEN;
+        if b.len() < total {
+            return Step::Wait;
+        }
+        let body = &b[2..total - CRC_LEN];
+        let sent = u16::from_le_bytes([b[total - 2], b[total - 1]]);
+        if crc::crc16(body) == sent {
+            return Step::Frame(total);
+        }
+        // A sync word with our version inside the span says the frame was cut short
+        // and another began; otherwise the bytes were damaged in place.
+        let restarted = b[1..total]
+            .windows(3)
+            .any(|w| w == [SYNC[0], SYNC[1], VERSION]);
+        Step::Reject(if restarted {
+            FrameError::Truncated
+        } else {
+            FrameError::BadCrc
+        })
+    }
+
+    fn consume(&mut self, n: usize) {
+        let n = n.min(self.len);
+        self.buf.copy_within(n..self.len, 0);
+        self.len -= n;
+    }
+}
+
+/// Writes one frame into `out`; returns its length, or `None` if the payload is too
+/// long or `out` too short.
+pub fn encode(
+    kind: u8,
+    sequence: u16,
+    time_us: u64,
+    payload: &[u8],
+    out: &mut [u8],
+) -> Option<usize> {
+    if payload.len() > MAX_PAYLOAD {
+        return None;
+    }
+    let total = HEADER_LEN + payload.len() + CRC_LEN;
+    let out = out.get_mut(..total)?;
+    out[0..2].copy_from_slice(&SYNC);
+    out[2] = VERSION;
+    out[3] = kind;
+    out[4..6].copy_from_slice(&(payload.len() as u16).to_le_bytes());
+    out[6..8].copy_from_slice(&sequence.to_le_bytes());
+    out[8..16].copy_from_slice(&time_us.to_le_bytes());
+    out[HEADER_LEN..total - CRC_LEN].copy_from_slice(payload);
+    let c = crc::crc16(&out[2..total - CRC_LEN]);
+    out[total - CRC_LEN..].copy_from_slice(&c.to_le_bytes());
+    Some(total)
+}

@@ -1,0 +1,24 @@
+//! The line-rate controller of a TDI push-broom camera: telemetry frames in, the imaging
+//! scene and its plan, per-segment TDI line periods out. `no_std`, no allocation, no
+//! hardware: the firmware feeds it bytes and a clock, and gives it a [`LinePeriodSink`].
+//!
+//! telemetry in ([`frame`], [`nav`]) -> scene ([`scene`], [`plan`]) -> math (core-math)
+//! -> line periods out ([`control`], [`status`]).
+#![no_std]
+#![forbid(unsafe_code)]
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
+pub mod bytes;
+pub mod control;
+pub mod crc;
+pub mod fault;
+pub mod frame;
+pub mod nav;
+pub mod plan;
+pub mod report;
+pub mod scene;
+
+pub use control::{Config, Controller, LinePeriodSink, Mode, SegmentOutput};
+pub use fault::{Counters, Fault};
+pub use frame::{Decoder, Event, Frame, FrameError};
+pub use scene::Scene;

@@ -1,0 +1,144 @@
+//! Camera-to-ground frames: PERIODS (what was programmed) and STATUS (fault counters).
+//! Encoded by the firmware, decoded by the host tools; one codec for both sides.
+
+use crate::bytes::{Reader, Writer};
+use crate::control::{Controller, Mode, SegmentOutput};
+use crate::fault::Fault;
+use crate::scene::MAX_SEGMENTS;
+
+/// PERIODS payload: mode, count, 2 reserved, then one [`RECORD_LEN`]-byte record per
+/// segment in force.
+pub const PERIODS_HEADER_LEN: usize = 4;
+pub const RECORD_LEN: usize = 20;
+/// STATUS payload length.
+pub const STATUS_LEN: usize = 16 + 4 * Fault::COUNT;
+
+/// Flag bit of a record: the value is the last good one, held over a fault.
+pub const FLAG_HELD: u8 = 1;
+
+/// Writes the PERIODS payload of the outputs in force.
+pub fn encode_periods(c: &Controller, out: &mut [u8]) -> Option<usize> {
+    let mut w = Writer::new(out);
+    let count = c.outputs().count() as u8;
+    w.put(&[c.mode() as u8, count, 0, 0])?;
+    for o in c.outputs() {
+        w.put(&[o.index, if o.held { FLAG_HELD } else { 0 }])?;
+        w.put(&o.max_stages.to_le_bytes())?;
+        w.put(&o.ticks.to_le_bytes())?;
+        w.put(&o.mtf.to_le_bytes())?;
+        w.put(&o.drift_rad.to_le_bytes())?;
+        w.put(&o.worst_mismatch.to_le_bytes())?;
+    }
+    Some(w.len())
+}
+
+/// A decoded PERIODS payload.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Periods {
+    pub mode: u8,
+    pub count: u8,
+    pub records: [SegmentOutput; MAX_SEGMENTS],
+}
+
+impl Periods {
+    pub fn decode(payload: &[u8]) -> Option<Periods> {
+        let mut r = Reader::new(payload);
+        let mode = r.u8()?;
+        let count = r.u8()?;
+        r.u16()?;
+        if usize::from(count) > MAX_SEGMENTS {
+            return None;
+        }
+        let mut records = [SegmentOutput::default(); MAX_SEGMENTS];
+        for rec in records.iter_mut().take(usize::from(count)) {
+            let index = r.u8()?;
+            let flags = r.u8()?;
+            *rec = SegmentOutput {
+                index,
+                held: flags & FLAG_HELD != 0,
+                max_stages: r.u16()?,
+                ticks: r.u32()?,
+                mtf: r.f32()?,
+                drift_rad: r.f32()?,
+                worst_mismatch: r.f32()?,
+            };
+        }
+        r.is_done().then_some(Periods {
+            mode,
+            count,
+            records,
+        })
+    }
+
+    pub fn records(&self) -> &[SegmentOutput] {
+        &self.records[..usize::from(self.count)]
+    }
+}
+
+/// Writes the STATUS payload: mode, last fault (0xFF: none), 2 reserved, frames
+/// accepted, updates run, noise bytes skipped by the decoder, then one u32 counter per
+/// [`Fault`] in [`Fault::ALL`] order.
+pub fn encode_status(c: &Controller, skipped_bytes: u32, out: &mut [u8]) -> Option<usize> {
+    let mut w = Writer::new(out);
+    w.put(&[c.mode() as u8, c.last_fault.map_or(0xFF, |f| f as u8), 0, 0])?;
+    w.put(&c.frames_accepted.to_le_bytes())?;
+    w.put(&c.updates.to_le_bytes())?;
+    w.put(&skipped_bytes.to_le_bytes())?;
+    for n in c.counters.as_array() {
+        w.put(&n.to_le_bytes())?;
+    }
+    Some(w.len())
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Status {
+    pub mode: u8,
+    pub last_fault: Option<Fault>,
+    pub frames_accepted: u32,
+    pub updates: u32,
+    pub skipped_bytes: u32,
+    pub counts: [u32; Fault::COUNT],
+}
+
+impl Status {
+    pub fn decode(payload: &[u8]) -> Option<Status> {
+        let mut r = Reader::new(payload);
+        let mode = r.u8()?;
+        let last = r.u8()?;
+        r.u16()?;
+        let frames_accepted = r.u32()?;
+        let updates = r.u32()?;
+        let skipped_bytes = r.u32()?;
+        let mut counts = [0u32; Fault::COUNT];
+        for c in counts.iter_mut() {
+            *c = r.u32()?;
+        }
+        let last_fault = Fault::ALL.get(usize::from(last)).copied();
+        r.is_done().then_some(Status {
+            mode,
+            last_fault,
+            frames_accepted,
+            updates,
+            skipped_bytes,
+            counts,
+        })
+    }
+
+    pub fn count(&self, f: Fault) -> u32 {
+        self.counts[f as usize]
+    }
+
+    pub fn total(&self) -> u32 {
+        self.counts.iter().fold(0u32, |a, &c| a.saturating_add(c))
+    }
+}
+
+/// Mode from its wire value.
+pub fn mode_from_u8(m: u8) -> Option<Mode> {
+    match m {
+        0 => Some(Mode::WaitingForNav),
+        1 => Some(Mode::Nominal),
+        2 => Some(Mode::Stale),
+        _ => None,
+    }
+}

@@ -1,0 +1,46 @@
+//! Shared by the controller tests: frames built from a circular orbit.
+#![allow(dead_code)]
+
+use controller::frame::{encode, kind, MAX_FRAME};
+use controller::nav::{Attitude, Nav};
+use core_math::{StateVector, GM_M3_S2};
+
+pub const R: f64 = 6_371_000.0;
+
+/// ECI state on a circular orbit (node longitude 0.4 rad) at argument of latitude `u`.
+pub fn state(i: f64, u: f64, h: f64) -> StateVector {
+    let a = R + h;
+    let speed = libm::sqrt(GM_M3_S2 / a);
+    let (si, ci) = (libm::sin(i), libm::cos(i));
+    let (su, cu) = (libm::sin(u), libm::cos(u));
+    let (sn, cn) = (libm::sin(0.4), libm::cos(0.4));
+    // In-plane unit vectors: node direction and 90 deg ahead.
+    let p = [cn, sn, 0.0];
+    let q = [-sn * ci, cn * ci, si];
+    let r: [f64; 3] = core::array::from_fn(|k| a * (cu * p[k] + su * q[k]));
+    let v: [f64; 3] = core::array::from_fn(|k| speed * (-su * p[k] + cu * q[k]));
+    StateVector {
+        position_m: r,
+        velocity_mps: v,
+    }
+}
+
+pub fn nav_frame(seq: u16, time_us: u64, sv: StateVector, attitude: Attitude) -> Vec<u8> {
+    let mut payload = [0u8; 128];
+    let n = Nav {
+        state: sv,
+        attitude,
+    }
+    .encode(&mut payload)
+    .unwrap();
+    let mut buf = [0u8; MAX_FRAME];
+    let len = encode(kind::NAV, seq, time_us, &payload[..n], &mut buf).unwrap();
+    buf[..len].to_vec()
+}
+
+pub fn roll(rad: f32) -> Attitude {
+    Attitude {
+        roll_rad: rad,
+        ..Attitude::default()
+    }
+}
