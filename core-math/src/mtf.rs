@@ -117,4 +117,10 @@ impl<T: Real> StageRule<T> {
     pub fn mtf_floor(&self) -> T {
         self.mtf_floor
     }
+
+    /// The largest M |dv/v| that keeps MTF_mismatch at or above the floor: a segment
+    /// with M stages may be mismatched by at most this over M.
+    pub fn mismatch_budget(&self) -> T {
+        self.mismatch_budget
+    }
 }
