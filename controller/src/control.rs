@@ -13,7 +13,7 @@ use core_math::{
 use crate::fault::{Counters, Fault};
 use crate::frame::{kind, Frame};
 use crate::nav::{Attitude, Nav};
-use crate::plan::Plan;
+use crate::plan::{Envelope, Plan};
 use crate::scene::{Scene, MAX_SEGMENTS};
 
 /// Where line periods go: the period registers of the camera's line clock (one per
@@ -33,12 +33,24 @@ pub struct Config {
     pub stale_after_us: u64,
     /// Round-Earth radius of the model (m).
     pub earth_radius_m: f64,
-    /// Altitudes the controller accepts (m).
+    /// The mission's altitude band (m): NAV frames outside it are refused, and scenes
+    /// are planned and the period guard set for it. The model itself holds over
+    /// 200-2000 km; a narrower band lets the planner sample less and the guard be tighter.
     pub altitude_range_m: (f64, f64),
     /// Largest |pitch| and |yaw| for the roll-only model (rad).
     pub pitch_yaw_tolerance_rad: f32,
     /// Largest |pitch rate| and |yaw rate| for the roll-only model (rad/s).
     pub pitch_yaw_rate_tolerance_rad_s: f32,
+}
+
+impl Config {
+    /// The orbits a plan must hold for.
+    pub fn envelope(&self) -> Envelope {
+        Envelope {
+            earth_radius_m: self.earth_radius_m,
+            altitude_range_m: self.altitude_range_m,
+        }
+    }
 }
 
 impl Default for Config {
@@ -47,7 +59,7 @@ impl Default for Config {
             update_period_us: 50_000,
             stale_after_us: 1_000_000,
             earth_radius_m: 6_371_000.0,
-            altitude_range_m: (200e3, 2_000e3),
+            altitude_range_m: (500e3, 800e3),
             pitch_yaw_tolerance_rad: 0.5f32.to_radians(),
             pitch_yaw_rate_tolerance_rad_s: 1.0e-6,
         }
@@ -112,7 +124,7 @@ pub struct Controller {
 impl Controller {
     /// A controller with `scene` in force (normally [`Scene::paper_default`]).
     pub fn new(config: Config, scene: Scene) -> Result<Controller, Fault> {
-        let plan = Plan::new(&scene)?;
+        let plan = Plan::new(&scene, &config.envelope())?;
         let period_bounds_s = period_bounds_s(&scene, &config);
         Ok(Controller {
             config,
@@ -229,7 +241,7 @@ impl Controller {
 
     fn accept_scene(&mut self, payload: &[u8]) -> Result<(), Fault> {
         let scene = Scene::decode(payload)?;
-        let plan = Plan::new(&scene)?;
+        let plan = Plan::new(&scene, &self.config.envelope())?;
         self.period_bounds_s = period_bounds_s(&scene, &self.config);
         self.scene = scene;
         self.plan = plan;
