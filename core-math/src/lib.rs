@@ -7,7 +7,9 @@
 //!
 //! Backends, each one implementation of [`Backend`]:
 //! - [`Reference`]: the paper's transform chain (Eqs. 1-13) on dual numbers, f64;
-//! - [`ClosedForm<f64>`] and [`ClosedForm<f32>`]: the stable closed form.
+//! - [`ClosedForm<f64>`] and [`ClosedForm<f32>`]: the stable closed form;
+//! - [`Fixed`]: the same closed form in fixed point (I24F40 interface, integer-only
+//!   `update` and `motion`) for controllers without an FPU.
 //!
 //! `no_std`, no allocation, no panics on any input: every refusal is a [`ModelError`].
 #![no_std]
@@ -17,11 +19,15 @@
     forbid(unsafe_code)
 )]
 #![cfg_attr(all(target_arch = "arm", target_abi = "eabihf"), deny(unsafe_code))]
+// `!(x > 0.0)` is how this crate says "not positive, or NaN": every such test must also
+// refuse NaN, which `x <= 0.0` would let through.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod accuracy;
 pub mod closed_form;
 pub mod dual;
 pub mod error;
+pub mod fixed_point;
 pub mod line_period;
 pub mod model;
 pub mod mtf;
@@ -32,13 +38,14 @@ mod sqrt;
 
 pub use closed_form::ClosedForm;
 pub use error::{ModelError, Param};
+pub use fixed_point::{Fixed, FixedReal, FIXED};
 pub use line_period::{line_period_s, line_period_ticks, Ticks};
 pub use model::{
     domain, orbital_rate_rad_s, Backend, Camera, Geometry, ImageMotion, EARTH_RATE_RAD_S, GM_M3_S2,
 };
 pub use mtf::{mtf_mismatch, sinc, StageRule};
 pub use orbit::{OrbitState, StateVector};
-pub use real::Real;
+pub use real::{Real, Scalar};
 pub use reference::Reference;
 
 /// The closed form in f64.

@@ -1,7 +1,7 @@
 //! The inputs, the output and the one interface every numeric backend implements.
 
 use crate::error::{ModelError, Param};
-use crate::real::Real;
+use crate::real::{Real, Scalar};
 
 /// Earth rotation rate (rad/s), the value the project uses everywhere.
 pub const EARTH_RATE_RAD_S: f64 = 7.292_115_9e-5;
@@ -89,8 +89,9 @@ impl Geometry<f64> {
     }
 }
 
-impl<T: Real> Geometry<T> {
-    /// The geometry with every field widened to f64 (exact for f32).
+impl<T: Scalar> Geometry<T> {
+    /// The geometry with every field widened to f64 (exact for f32; I24F40 rounded to
+    /// nearest, 53 of its 64 bits).
     pub fn to_f64(&self) -> Geometry<f64> {
         Geometry {
             roll_rad: self.roll_rad.to_f64(),
@@ -102,7 +103,9 @@ impl<T: Real> Geometry<T> {
             orbit_rate_rad_s: self.orbit_rate_rad_s.to_f64(),
         }
     }
+}
 
+impl<T: Real> Geometry<T> {
     /// Checks every field against the model's domain; the backends call it first.
     /// Works in `T` so that the f32 path does no soft-f64 work per update.
     pub fn validate(&self) -> Result<(), ModelError> {
@@ -231,8 +234,9 @@ impl<T: Real> ImageMotion<T> {
 /// point at boot or scene upload, [`Backend::update`] once per telemetry update,
 /// [`Backend::motion`] per field point per update (no transcendental calls there).
 pub trait Backend {
-    /// The scalar the per-update and per-pixel work runs in.
-    type Real: Real;
+    /// The scalar of the per-update input and of the output: a [`Real`] (f64, f32) for
+    /// the float backends, I24F40 for [`crate::Fixed`]. Only [`Scalar`] is required.
+    type Real: Scalar;
     /// Constants of one field point (depend only on the optics and the pixel).
     type Pixel: Copy;
     /// Constants of one instant (depend only on orbit and attitude).

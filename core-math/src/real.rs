@@ -5,9 +5,17 @@
 
 use core::ops::{Add, Mul, Neg, Sub};
 
+/// The least a backend's scalar must offer: a widening to f64 for tools and tests.
+/// [`Real`] (f64, f32) extends it; the fixed-point backend's I24F40 implements only this.
+pub trait Scalar: Copy + core::fmt::Debug {
+    /// The value as an f64 (exact for f32 and f64; rounded to nearest for I24F40).
+    fn to_f64(self) -> f64;
+}
+
 /// A binary floating-point scalar: `f64` or `f32`.
 pub trait Real:
-    Copy
+    Scalar
+    + Copy
     + PartialOrd
     + core::fmt::Debug
     + Add<Output = Self>
@@ -20,7 +28,6 @@ pub trait Real:
     const ONE: Self;
     /// Round an f64 to this type (round to nearest even).
     fn from_f64(x: f64) -> Self;
-    fn to_f64(self) -> f64;
     /// Correctly rounded square root.
     fn sqrt(self) -> Self;
     /// (sin x, cos x), each within 1 ulp.
@@ -36,16 +43,26 @@ pub trait Real:
     fn small_sin_cos(x: Self) -> (Self, Self);
 }
 
+impl Scalar for f64 {
+    #[inline(always)]
+    fn to_f64(self) -> f64 {
+        self
+    }
+}
+
+impl Scalar for f32 {
+    #[inline(always)]
+    fn to_f64(self) -> f64 {
+        self as f64
+    }
+}
+
 impl Real for f64 {
     const ZERO: Self = 0.0;
     const ONE: Self = 1.0;
     #[inline(always)]
     fn from_f64(x: f64) -> Self {
         x
-    }
-    #[inline(always)]
-    fn to_f64(self) -> f64 {
-        self
     }
     #[inline(always)]
     fn sqrt(self) -> Self {
@@ -89,10 +106,6 @@ impl Real for f32 {
     #[inline(always)]
     fn from_f64(x: f64) -> Self {
         x as f32
-    }
-    #[inline(always)]
-    fn to_f64(self) -> f64 {
-        self as f64
     }
     #[inline(always)]
     fn sqrt(self) -> Self {

@@ -85,8 +85,18 @@ fn at_and_beyond_the_limb_is_an_error() {
     }
     // Exactly at the limb (to the rounding of its pixel): refused, or, if rounding put the
     // pixel a hair inside, a finite answer. Never NaN.
-    for r in [CLOSED_F64.evaluate(&CAM, &g, at).map(|m| m.speed_mps())] {
-        assert!(r.map_or(true, |v| v.is_finite()));
+    let at_limb = [
+        Reference.evaluate(&CAM, &g, at).map(|m| m.speed_mps()),
+        CLOSED_F64.evaluate(&CAM, &g, at).map(|m| m.speed_mps()),
+        CLOSED_F32
+            .evaluate(&CAM, &g.to(), at)
+            .map(|m| m.speed_mps() as f64),
+    ];
+    for r in at_limb {
+        match r {
+            Ok(v) => assert!(v.is_finite() && v > 0.0, "{v}"),
+            Err(e) => assert_eq!(e, ModelError::LineOfSightMissesEarth),
+        }
     }
     // A ray pointing above the horizontal.
     let up = geo(100.0, 97.98, 30.0);

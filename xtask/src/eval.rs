@@ -1,8 +1,10 @@
-//! `cargo xtask eval --backend <reference|f64|f32> --input CASES.csv`: the model on
+//! `cargo xtask eval --backend <reference|f64|f32|fixed> --input CASES.csv`: the model on
 //! user-supplied cases, CSV out, so the firmware's numbers can be checked on the ground.
 
+use core_math::fixed_point::{geometry_from_f64, motion_to_f64};
 use core_math::{
     line_period_s, Backend, Camera, Geometry, ModelError, Real, Reference, CLOSED_F32, CLOSED_F64,
+    FIXED,
 };
 
 use crate::csv::Table;
@@ -31,7 +33,7 @@ pub fn run(args: &[String]) -> Result<(), String> {
             other => return Err(format!("eval: unknown argument `{other}`")),
         }
     }
-    let backend = backend.ok_or("eval: --backend <reference|f64|f32> is required")?;
+    let backend = backend.ok_or("eval: --backend <reference|f64|f32|fixed> is required")?;
     let input = input.ok_or("eval: --input CASES.csv is required")?;
     let text = if input == "-" {
         std::io::read_to_string(std::io::stdin()).map_err(|e| format!("reading stdin: {e}"))?
@@ -56,8 +58,9 @@ pub fn eval_csv(backend: &str, text: &str) -> Result<String, String> {
             "reference" => evaluate(&Reference, &case, |g| g),
             "f64" => evaluate(&CLOSED_F64, &case, |g| g),
             "f32" => evaluate(&CLOSED_F32, &case, |g| g.to::<f32>()),
+            "fixed" => evaluate_fixed(&case),
             other => Err(EvalError::Usage(format!(
-                "unknown backend `{other}` (reference|f64|f32)"
+                "unknown backend `{other}` (reference|f64|f32|fixed)"
             ))),
         });
         let outputs = match result {
@@ -126,11 +129,26 @@ fn evaluate<B: Backend>(
     to_real: impl Fn(Geometry<f64>) -> Geometry<B::Real>,
 ) -> Result<[String; 4], EvalError>
 where
-    B::Real: std::fmt::Display,
+    B::Real: Real + std::fmt::Display,
 {
     let m = backend.evaluate(&case.camera, &to_real(case.geometry), case.n_px)?;
     let speed = m.speed_mps();
     let period = line_period_s(B::Real::from_f64(case.camera.pixel_m), speed)?;
+    Ok([
+        m.v1_mps.to_string(),
+        m.v2_mps.to_string(),
+        speed.to_string(),
+        period.to_string(),
+    ])
+}
+
+/// The fixed-point backend: the geometry rounded to I24F40, the results widened to f64
+/// (exact) and printed as f64; |v| and the line period in f64 from them.
+fn evaluate_fixed(case: &Case) -> Result<[String; 4], EvalError> {
+    let g = geometry_from_f64(&case.geometry)?;
+    let m = motion_to_f64(&FIXED.evaluate(&case.camera, &g, case.n_px)?);
+    let speed = m.speed_mps();
+    let period = line_period_s(case.camera.pixel_m, speed)?;
     Ok([
         m.v1_mps.to_string(),
         m.v2_mps.to_string(),
@@ -158,7 +176,7 @@ garbled,x,0,97.98,0,645000,0.555,13e-6,6370000
 
     #[test]
     fn one_row_per_input_row_with_typed_errors() {
-        for backend in ["reference", "f64", "f32"] {
+        for backend in ["reference", "f64", "f32", "fixed"] {
             let out = eval_csv(backend, CASES).unwrap();
             let lines: Vec<&str> = out.lines().collect();
             assert_eq!(lines.len(), 6);
@@ -191,6 +209,14 @@ garbled,x,0,97.98,0,645000,0.555,13e-6,6370000
             assert!((vf - vr).abs() / vr < 1e-6, "{vf} vs {vr}");
             let t: f64 = field(lr, &h, "line_period_s").parse().unwrap();
             assert!((t - 13e-6 / vr).abs() < 1e-15 * t);
+        }
+        let x = eval_csv("fixed", CASES).unwrap();
+        for (lr, lx) in r.lines().zip(x.lines()).skip(1).take(2) {
+            let (vr, vx): (f64, f64) = (
+                field(lr, &h, "v_mps").parse().unwrap(),
+                field(lx, &h, "v_mps").parse().unwrap(),
+            );
+            assert!((vx - vr).abs() / vr < 2e-6, "fixed {vx} vs {vr}");
         }
     }
 }
