@@ -35,6 +35,7 @@ pub mod orbit;
 pub mod real;
 pub mod reference;
 mod sqrt;
+pub mod trig;
 
 pub use closed_form::ClosedForm;
 pub use error::{ModelError, Param};

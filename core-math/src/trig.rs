@@ -1,0 +1,48 @@
+//! f32 sine and cosine in f32 arithmetic only, for the per-update work.
+//!
+//! `libm::sincosf` is correctly rounded to 0.5 ulp but evaluates in (soft) f64 on the
+//! Cortex-M4F: about 2 200 instructions a call (shared/EMBEDDED-NOTES.md). Here: reduce by
+//! pi/2 with a three-part Cody-Waite constant (each k * part exact for |k| < 2^13, i.e.
+//! |x| < 12 800 rad), then the minimax polynomials of Cephes' `sinf`/`cosf` on
+//! [-pi/4, pi/4]. Measured error against f64 over |x| <= 100 rad: at most 1.54 ulp
+//! (`core-math/tests/trig.rs`). Larger arguments, which the model never produces, fall
+//! back to libm.
+
+/// pi/2 = P1 + P2 + P3, P1 and P2 with trailing zero bits (Cephes' DP1..DP3, doubled).
+const P1: f32 = 1.570_312_5;
+const P2: f32 = 4.837_512_969_970_703e-4;
+const P3: f32 = 7.549_789_954_891_882e-8;
+const TWO_OVER_PI: f32 = core::f32::consts::FRAC_2_PI;
+/// Beyond this |x| the reduction is not exact: use libm.
+const FAST_LIMIT: f32 = 12_800.0;
+
+/// sin r and cos r for |r| <= pi/4 (Cephes coefficients).
+#[inline(always)]
+fn kernel(r: f32) -> (f32, f32) {
+    let z = r * r;
+    let s = r + r * z * (-1.666_665_461_1e-1 + z * (8.332_160_873_6e-3 + z * -1.951_529_589_1e-4));
+    let c = 1.0 - 0.5 * z
+        + z * z
+            * (4.166_664_568_298_827e-2
+                + z * (-1.388_731_625_493_765e-3 + z * 2.443_315_711_809_948e-5));
+    (s, c)
+}
+
+/// (sin x, cos x) in f32.
+pub fn sin_cos_f32(x: f32) -> (f32, f32) {
+    if !(x.abs() < FAST_LIMIT) {
+        return libm::sincosf(x);
+    }
+    // Nearest quadrant; `as i32` of a value under 2^13 in magnitude is exact.
+    let q = x * TWO_OVER_PI;
+    let k = (q + if q >= 0.0 { 0.5 } else { -0.5 }) as i32;
+    let kf = k as f32;
+    let r = ((x - kf * P1) - kf * P2) - kf * P3;
+    let (s, c) = kernel(r);
+    match k & 3 {
+        0 => (s, c),
+        1 => (c, -s),
+        2 => (-s, -c),
+        _ => (-c, s),
+    }
+}

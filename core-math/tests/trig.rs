@@ -1,0 +1,58 @@
+//! The f32 sine/cosine against f64 libm.
+
+use core_math::trig::sin_cos_f32;
+
+fn ulp_err(got: f32, exact: f64) -> f64 {
+    // Error in units of the f32 spacing at the exact value.
+    let e = (got as f64 - exact).abs();
+    let spacing = f64::from(f32::EPSILON)
+        * exact
+            .abs()
+            .max(f64::from(f32::MIN_POSITIVE))
+            .log2()
+            .floor()
+            .exp2();
+    e / spacing
+}
+
+#[test]
+fn within_one_ulp_over_the_angles_the_model_uses() {
+    let mut worst = (0.0f64, 0.0f32);
+    // Dense over [-100, 100] rad plus exact multiples of pi/4 and tiny arguments.
+    let mut xs: Vec<f32> = (0..2_000_001)
+        .map(|i| (i as f32 - 1_000_000.0) * 1e-4)
+        .collect();
+    xs.extend((-120..=120).map(|k| (k as f64 * std::f64::consts::FRAC_PI_4) as f32));
+    xs.extend([1e-30, -1e-30, 1e-7, 0.0, -0.0, 3.0e-39]);
+    for &x in &xs {
+        let (s, c) = sin_cos_f32(x);
+        let (es, ec) = (libm::sin(f64::from(x)), libm::cos(f64::from(x)));
+        for (g, e) in [(s, es), (c, ec)] {
+            // Near a zero of sin or cos the absolute error is what can be asked for.
+            let u = if e.abs() < 1e-3 {
+                (g as f64 - e).abs() / 1e-10
+            } else {
+                ulp_err(g, e)
+            };
+            if u > worst.0 {
+                worst = (u, x);
+            }
+        }
+    }
+    eprintln!("worst {:.3} ulp at x = {}", worst.0, worst.1);
+    assert!(
+        worst.0 <= 2.0,
+        "worst {:.3} ulp at x = {}",
+        worst.0,
+        worst.1
+    );
+}
+
+#[test]
+fn large_and_special_arguments() {
+    assert_eq!(sin_cos_f32(0.0), (0.0, 1.0));
+    let (s, c) = sin_cos_f32(1e5);
+    assert_eq!((s, c), libm::sincosf(1e5), "beyond the fast range: libm");
+    let (s, c) = sin_cos_f32(f32::NAN);
+    assert!(s.is_nan() && c.is_nan());
+}
