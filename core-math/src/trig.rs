@@ -10,8 +10,8 @@
 
 /// pi/2 = P1 + P2 + P3, P1 and P2 with trailing zero bits (Cephes' DP1..DP3, doubled).
 const P1: f32 = 1.570_312_5;
-const P2: f32 = 4.837_512_969_970_703e-4;
-const P3: f32 = 7.549_789_954_891_882e-8;
+const P2: f32 = 4.837_513e-4;
+const P3: f32 = 7.549_79e-8;
 const TWO_OVER_PI: f32 = core::f32::consts::FRAC_2_PI;
 /// Beyond this |x| the reduction is not exact: use libm.
 const FAST_LIMIT: f32 = 12_800.0;
@@ -20,11 +20,8 @@ const FAST_LIMIT: f32 = 12_800.0;
 #[inline(always)]
 fn kernel(r: f32) -> (f32, f32) {
     let z = r * r;
-    let s = r + r * z * (-1.666_665_461_1e-1 + z * (8.332_160_873_6e-3 + z * -1.951_529_589_1e-4));
-    let c = 1.0 - 0.5 * z
-        + z * z
-            * (4.166_664_568_298_827e-2
-                + z * (-1.388_731_625_493_765e-3 + z * 2.443_315_711_809_948e-5));
+    let s = r + r * z * (-1.666_665_5e-1 + z * (8.332_161e-3 + z * -1.951_529_6e-4));
+    let c = 1.0 - 0.5 * z + z * z * (4.166_664_6e-2 + z * (-1.388_731_6e-3 + z * 2.443_315_7e-5));
     (s, c)
 }
 
