@@ -1,3 +1,757 @@
-pub fn run(_args: &[String]) -> Result<(), String> {
-    Err("not implemented yet".into())
+//! `cargo xtask paper`: the worked example of the paper's Section 5 (Figs. 5-8) from
+//! the independent reference chain, as CSV and PNG under `docs/paper/`, with a summary
+//! of the headline numbers next to the paper's and a table of candidate explanations
+//! for where they differ. `docs/paper-reproduction.md` discusses the results.
+//!
+//! Everything is computed with [`core_math::Reference`] (the paper's transform chain,
+//! Eqs. 1-13, on dual numbers). The only other formulas here are in [`Variant`]: the
+//! paper's printed Eq. 14 with switches for the suspected mistakes, used only to explain
+//! the differences, never to produce our numbers; with every switch off it is checked
+//! against the reference before anything is written.
+//!
+//! Conventions: paper pixel p (0 = near point, 60 000 = far point, rolling left) is
+//! array offset n = p - 30 000; velocities are reported as magnitudes in mm/s.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use core_math::{
+    mtf_mismatch, Backend, Camera, Geometry, ImageMotion, Reference, StageRule, EARTH_RATE_RAD_S,
+};
+
+use crate::plot::{Legend, Plot, Series};
+
+/// Section 5's camera: f = 555 mm, A = 13 um.
+const CAMERA: Camera = Camera {
+    focal_m: 0.555,
+    pixel_m: 13.0e-6,
+};
+const ALTITUDE_M: f64 = 645.0e3;
+const EARTH_RADIUS_M: f64 = 6370.0e3;
+/// Not given in the paper: sun-synchronous at 645 km.
+const INCLINATION_DEG: f64 = 97.98;
+/// Paper pixel of the array centre (60 000 pixels, |N| <= 30 000).
+const CENTRE_PX: f64 = 30_000.0;
+const NEAR_PX: f64 = 0.0;
+const FAR_PX: f64 = 60_000.0;
+
+/// Figs. 6-7 grid: roll 0..=25 deg by 0.5, gamma0 0..=90 deg by 5.
+const ROLL_STEPS: usize = 50;
+const ROLL_MAX_DEG: f64 = 25.0;
+const G0_STEPS: usize = 18;
+const G0_MAX_DEG: f64 = 90.0;
+/// Fig. 8: gamma0 by 1 deg, these stage counts, this MTF floor.
+const FIG8_STAGES: [u32; 6] = [8, 16, 24, 32, 48, 64];
+const MTF_FLOOR: f64 = 0.95;
+const STAGE_LIMIT: u32 = 512;
+
+/// The paper's numbers (Section 5).
+mod published {
+    pub const NEAR_MIN: f64 = 5.81;
+    pub const NEAR_MAX: f64 = 7.26;
+    pub const NEAR_CHANGE_PCT: f64 = 24.9;
+    pub const FAR_MIN: f64 = 3.65;
+    pub const FAR_MAX: f64 = 5.97;
+    pub const FAR_CHANGE_PCT: f64 = 63.5;
+    pub const MTF_M48: f64 = 0.681;
+    pub const MAX_STAGES: u32 = 16;
+}
+
+fn deg_steps(max_deg: f64, steps: usize) -> Vec<f64> {
+    (0..=steps)
+        .map(|k| max_deg * k as f64 / steps as f64)
+        .collect()
+}
+
+fn geometry(roll_deg: f64, g0_deg: f64, i0_deg: f64) -> Geometry<f64> {
+    Geometry::circular(
+        roll_deg.to_radians(),
+        i0_deg.to_radians(),
+        g0_deg.to_radians(),
+        ALTITUDE_M,
+        EARTH_RADIUS_M,
+    )
+}
+
+/// The reference image motion of paper pixel `paper_px` (m/s).
+fn motion(paper_px: f64, roll_deg: f64, g0_deg: f64) -> Result<ImageMotion<f64>, String> {
+    motion_i0(paper_px, roll_deg, g0_deg, INCLINATION_DEG)
+}
+
+fn motion_i0(
+    paper_px: f64,
+    roll_deg: f64,
+    g0_deg: f64,
+    i0_deg: f64,
+) -> Result<ImageMotion<f64>, String> {
+    Reference
+        .evaluate(
+            &CAMERA,
+            &geometry(roll_deg, g0_deg, i0_deg),
+            paper_px - CENTRE_PX,
+        )
+        .map_err(|e| {
+            format!(
+                "reference at pixel {paper_px}, roll {roll_deg} deg, gamma0 {g0_deg} deg: {e:?}"
+            )
+        })
+}
+
+fn mm_s(x: f64) -> f64 {
+    x * 1e3
+}
+
+/// min, max, (max - min)/min, (max - min)/max of a non-empty list.
+#[derive(Clone, Copy, Debug)]
+struct Range {
+    min: f64,
+    max: f64,
+}
+
+impl Range {
+    fn of(values: impl IntoIterator<Item = f64>) -> Option<Range> {
+        let mut r: Option<Range> = None;
+        for v in values {
+            if !v.is_finite() {
+                return None;
+            }
+            r = Some(match r {
+                None => Range { min: v, max: v },
+                Some(r) => Range {
+                    min: r.min.min(v),
+                    max: r.max.max(v),
+                },
+            });
+        }
+        r
+    }
+    fn change_over_min_pct(&self) -> f64 {
+        100.0 * (self.max - self.min) / self.min
+    }
+    fn change_over_max_pct(&self) -> f64 {
+        100.0 * (self.max - self.min) / self.max
+    }
+}
+
+/// The paper's Eq. 14 for v_P1 (from Eqs. 1-6), with a switch for each suspected
+/// mistake; v_P2 is taken from the reference chain. Only for explaining differences.
+#[derive(Clone, Copy, Debug)]
+struct Variant {
+    name: &'static str,
+    /// g2 = H tan(eta), g3 = 0 (slant range H / cos eta) instead of the sphere.
+    flat_earth: bool,
+    /// The cross term f w g2 (cos(i0 + g0) - cos(i0 - g0)) as printed, rather than
+    /// the half of it that differentiating the chain gives.
+    printed_cross_term: bool,
+    i0_deg: f64,
+    /// alpha = N A / f instead of atan(N A / f) (Eq. 2).
+    linear_field: bool,
+    /// beta = asin(...) instead of pi - asin(...) in Eq. 1.
+    acute_branch: bool,
+}
+
+const CHAIN: Variant = Variant {
+    name: "chain, as derived (ours)",
+    flat_earth: false,
+    printed_cross_term: false,
+    i0_deg: INCLINATION_DEG,
+    linear_field: false,
+    acute_branch: false,
+};
+
+const VARIANTS: [Variant; 8] = [
+    CHAIN,
+    Variant {
+        name: "Eq. 14 as printed (cross term x2)",
+        printed_cross_term: true,
+        ..CHAIN
+    },
+    Variant {
+        name: "flat Earth (slant range H/cos(eta))",
+        flat_earth: true,
+        ..CHAIN
+    },
+    Variant {
+        name: "flat Earth + Eq. 14 as printed",
+        flat_earth: true,
+        printed_cross_term: true,
+        ..CHAIN
+    },
+    Variant {
+        name: "i0 = 90 deg",
+        i0_deg: 90.0,
+        ..CHAIN
+    },
+    Variant {
+        name: "i0 = 82.02 deg (180 - 97.98)",
+        i0_deg: 180.0 - INCLINATION_DEG,
+        ..CHAIN
+    },
+    Variant {
+        name: "alpha = N A / f (no atan)",
+        linear_field: true,
+        ..CHAIN
+    },
+    Variant {
+        name: "beta = asin(..) (acute branch of Eq. 1)",
+        acute_branch: true,
+        ..CHAIN
+    },
+];
+
+impl Variant {
+    /// |v| in mm/s, or None where the line of sight misses the Earth.
+    fn speed_mm_s(&self, paper_px: f64, roll_deg: f64, g0_deg: f64) -> Option<f64> {
+        let v1 = self.v1(paper_px, roll_deg, g0_deg)?;
+        // v_P2 of the reference chain at the same field angle and inclination.
+        let x = (paper_px - CENTRE_PX) * CAMERA.pixel_m / CAMERA.focal_m;
+        let n_ref = if self.linear_field {
+            if x.abs() >= core::f64::consts::FRAC_PI_2 {
+                return None;
+            }
+            x.tan() * CAMERA.focal_m / CAMERA.pixel_m
+        } else {
+            paper_px - CENTRE_PX
+        };
+        let v2 = motion_i0(n_ref + CENTRE_PX, roll_deg, g0_deg, self.i0_deg)
+            .ok()?
+            .v2_mps;
+        Some(mm_s(v1.hypot(v2)))
+    }
+
+    /// v_P1 (m/s) from Eqs. 1-6 and Eq. 14.
+    fn v1(&self, paper_px: f64, roll_deg: f64, g0_deg: f64) -> Option<f64> {
+        let (r, h, f) = (EARTH_RADIUS_M, ALTITUDE_M, CAMERA.focal_m);
+        let x = (paper_px - CENTRE_PX) * CAMERA.pixel_m / f;
+        let alpha = if self.linear_field { x } else { x.atan() };
+        let (phi, g0, i0) = (
+            roll_deg.to_radians(),
+            g0_deg.to_radians(),
+            self.i0_deg.to_radians(),
+        );
+        let eta = phi + alpha;
+        if eta.cos() <= 0.0 {
+            return None;
+        }
+        let (g2, g3) = if self.flat_earth {
+            (h * eta.tan(), 0.0)
+        } else {
+            let sin_beta = (h + r) * eta.sin() / r;
+            if sin_beta.abs() >= 1.0 {
+                return None;
+            }
+            let beta = if self.acute_branch {
+                sin_beta.asin()
+            } else {
+                core::f64::consts::PI - sin_beta.asin()
+            };
+            let theta = core::f64::consts::PI - eta - beta;
+            (r * theta.sin(), r * (theta.cos() - 1.0))
+        };
+        let g = geometry(roll_deg, g0_deg, self.i0_deg);
+        let (w, big_omega) = (g.earth_rate_rad_s, g.orbit_rate_rad_s);
+        let cross = if self.printed_cross_term { 1.0 } else { 0.5 };
+        let num = f * (g3 + r) * (i0.cos() * w - big_omega)
+            + cross * f * w * g2 * ((i0 + g0).cos() - (i0 - g0).cos());
+        let den = phi.sin() * g2 - phi.cos() * g3 + phi.cos() * h;
+        Some(num / den)
+    }
+}
+
+/// Fig. 8's quantities at one point for one velocity model: relative mismatch
+/// (v(g0) - v(0)) / v(0) over gamma0 with the line period held at gamma0 = 0.
+struct MismatchSweep {
+    g0_deg: Vec<f64>,
+    speed_mm_s: Vec<f64>,
+    rel: Vec<f64>,
+}
+
+impl MismatchSweep {
+    fn new(speed: impl Fn(f64) -> Option<f64>) -> Option<Self> {
+        let g0_deg = deg_steps(G0_MAX_DEG, 90);
+        let speed_mm_s: Option<Vec<f64>> = g0_deg.iter().map(|&g| speed(g)).collect();
+        let speed_mm_s = speed_mm_s?;
+        let v_set = speed_mm_s[0];
+        let rel = speed_mm_s.iter().map(|v| (v - v_set) / v_set).collect();
+        Some(MismatchSweep {
+            g0_deg,
+            speed_mm_s,
+            rel,
+        })
+    }
+
+    fn worst_rel(&self) -> f64 {
+        self.rel.iter().fold(0.0_f64, |a, &r| a.max(r.abs()))
+    }
+
+    /// The lowest MTF over the sweep for `stages`.
+    fn min_mtf(&self, stages: u32) -> Result<f64, String> {
+        let mut m = f64::INFINITY;
+        for &r in &self.rel {
+            m = m.min(mtf_mismatch(stages, r).map_err(|e| format!("{e:?}"))?);
+        }
+        Ok(m)
+    }
+
+    /// Largest M with MTF >= floor everywhere on the sweep, from `StageRule`,
+    /// cross-checked by trying every M.
+    fn max_stages(&self) -> Result<u32, String> {
+        let rule = StageRule::<f64>::new(MTF_FLOOR).map_err(|e| format!("{e:?}"))?;
+        let m = rule
+            .max_stages(self.worst_rel(), STAGE_LIMIT)
+            .map_err(|e| format!("{e:?}"))?;
+        let mut brute = 0;
+        for k in 1..=STAGE_LIMIT {
+            if self.min_mtf(k)? >= MTF_FLOOR {
+                brute = k;
+            } else {
+                break;
+            }
+        }
+        if brute != m {
+            return Err(format!(
+                "StageRule gives {m} stages, trying every M gives {brute}"
+            ));
+        }
+        Ok(m)
+    }
+}
+
+/// The Figs. 6-7 grid at one paper pixel: rows of (roll, gamma0, motion).
+fn grid(paper_px: f64) -> Result<Vec<(f64, f64, ImageMotion<f64>)>, String> {
+    let mut rows = Vec::new();
+    for &phi in &deg_steps(ROLL_MAX_DEG, ROLL_STEPS) {
+        for &g0 in &deg_steps(G0_MAX_DEG, G0_STEPS) {
+            rows.push((phi, g0, motion(paper_px, phi, g0)?));
+        }
+    }
+    Ok(rows)
+}
+
+struct Out {
+    dir: PathBuf,
+    written: Vec<PathBuf>,
+}
+
+impl Out {
+    fn write(&mut self, name: &str, bytes: &[u8]) -> Result<(), String> {
+        let path = self.dir.join(name);
+        std::fs::write(&path, bytes).map_err(|e| format!("writing {}: {e}", path.display()))?;
+        self.written.push(path);
+        Ok(())
+    }
+    fn plot(&mut self, name: &str, plot: &Plot) -> Result<(), String> {
+        let bytes = plot.to_png()?;
+        self.write(name, &bytes)
+    }
+}
+
+const GENERATED: &str = "# generated by `cargo xtask paper`; do not edit\n";
+
+pub fn run(args: &[String]) -> Result<(), String> {
+    let mut dir = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .ok_or("no workspace root")?
+        .join("docs")
+        .join("paper");
+    let mut it = args.iter();
+    while let Some(a) = it.next() {
+        match a.as_str() {
+            "--out" => dir = PathBuf::from(it.next().ok_or("--out needs a directory")?),
+            other => {
+                return Err(format!(
+                    "paper: unknown argument `{other}` (usage: paper [--out DIR])"
+                ))
+            }
+        }
+    }
+    std::fs::create_dir_all(&dir).map_err(|e| format!("creating {}: {e}", dir.display()))?;
+    let mut out = Out {
+        dir,
+        written: Vec::new(),
+    };
+
+    self_check()?;
+    fig5(&mut out)?;
+    let near = fig67(
+        &mut out,
+        "fig6_near_point",
+        NEAR_PX,
+        "Fig. 6: near point (paper pixel 0)",
+    )?;
+    let far = fig67(
+        &mut out,
+        "fig7_far_point",
+        FAR_PX,
+        "Fig. 7: far point (paper pixel 60000)",
+    )?;
+    let (mtf48, max_m, worst) = fig8(&mut out)?;
+    summary(&mut out, near, far, mtf48, max_m, worst)?;
+    hypotheses(&mut out)?;
+
+    for p in &out.written {
+        println!("wrote {}", p.display());
+    }
+    Ok(())
+}
+
+/// The Eq. 14 route with every switch off must be the chain's v_P1.
+fn self_check() -> Result<(), String> {
+    for &px in &[NEAR_PX, 15_000.0, CENTRE_PX + 1.0, 45_000.0, FAR_PX] {
+        for &phi in &[0.0, 15.0, 25.0] {
+            for &g0 in &[0.0, 37.0, 90.0] {
+                let want = motion(px, phi, g0)?.v1_mps;
+                let got = CHAIN.v1(px, phi, g0).ok_or("Eq. 14 route failed")?;
+                if (got - want).abs() > 1e-9 * want.abs() {
+                    return Err(format!(
+                        "Eq. 14 route disagrees with the chain at pixel {px}, roll {phi}, \
+                         gamma0 {g0}: {got} vs {want}"
+                    ));
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+fn fig5(out: &mut Out) -> Result<(), String> {
+    let rolls = [0.0, 15.0, 25.0];
+    let g0s = deg_steps(G0_MAX_DEG, 90);
+    let mut csv = String::from(GENERATED);
+    csv.push_str("# |v| in mm/s; min/max over gamma0 in [0, 90] deg by 1 deg\n");
+    csv.push_str("paper_pixel,n_px,field_angle_deg");
+    for phi in rolls {
+        write!(
+            csv,
+            ",phi{phi}_g0_0_mm_s,phi{phi}_g0_90_mm_s,phi{phi}_min_mm_s,phi{phi}_max_mm_s"
+        )
+        .unwrap();
+    }
+    csv.push('\n');
+    let mut lines: Vec<Vec<(f64, f64)>> = vec![Vec::new(); 2 * rolls.len()];
+    for k in 0..=240 {
+        let px = 250.0 * k as f64;
+        let n = px - CENTRE_PX;
+        let field = (n * CAMERA.pixel_m / CAMERA.focal_m).atan().to_degrees();
+        write!(csv, "{px:.0},{n:.0},{field:.6}").unwrap();
+        for (j, &phi) in rolls.iter().enumerate() {
+            let speeds: Vec<f64> = g0s
+                .iter()
+                .map(|&g| motion(px, phi, g).map(|m| mm_s(m.speed_mps())))
+                .collect::<Result<_, _>>()?;
+            let r = Range::of(speeds.iter().copied()).ok_or("non-finite speed")?;
+            let (s0, s90) = (speeds[0], speeds[speeds.len() - 1]);
+            write!(csv, ",{s0:.6},{s90:.6},{:.6},{:.6}", r.min, r.max).unwrap();
+            lines[2 * j].push((px, s0));
+            lines[2 * j + 1].push((px, s90));
+        }
+        csv.push('\n');
+    }
+    out.write("fig5_velocity_across_array.csv", csv.as_bytes())?;
+
+    let mut plot = Plot::new(
+        "Fig. 5: image-motion speed across the array (rolling left)",
+        "paper pixel (0 = near point, 60000 = far point)",
+        "speed v_P (mm/s)",
+    )
+    .x_range(0.0, 60_000.0)
+    .legend(Legend::BottomLeft);
+    for (j, phi) in rolls.iter().enumerate() {
+        plot = plot.series(
+            Series::line(
+                &format!("phi = {phi} deg, gamma0 = 0"),
+                lines[2 * j].clone(),
+            )
+            .palette(j),
+        );
+        plot = plot.series(
+            Series::line(
+                &format!("phi = {phi} deg, gamma0 = 90 deg"),
+                lines[2 * j + 1].clone(),
+            )
+            .palette(j)
+            .dashed(),
+        );
+    }
+    out.plot("fig5_velocity_across_array.png", &plot)
+}
+
+fn fig67(out: &mut Out, stem: &str, paper_px: f64, title: &str) -> Result<Range, String> {
+    let rows = grid(paper_px)?;
+    let mut csv = String::from(GENERATED);
+    writeln!(
+        csv,
+        "# paper pixel {paper_px:.0} (n = {:.0}); v1 = dP1/dt (along track), v2 = dP2/dt (along the array), signed, mm/s",
+        paper_px - CENTRE_PX
+    )
+    .unwrap();
+    csv.push_str("phi_deg,gamma0_deg,v1_mm_s,v2_mm_s,speed_mm_s\n");
+    for (phi, g0, m) in &rows {
+        writeln!(
+            csv,
+            "{phi:.1},{g0:.1},{:.6},{:.6},{:.6}",
+            mm_s(m.v1_mps),
+            mm_s(m.v2_mps),
+            mm_s(m.speed_mps())
+        )
+        .unwrap();
+    }
+    out.write(&format!("{stem}.csv"), csv.as_bytes())?;
+    let range = Range::of(rows.iter().map(|r| mm_s(r.2.speed_mps()))).ok_or("non-finite speed")?;
+
+    let mut plot = Plot::new(title, "roll angle phi (deg)", "speed v_P (mm/s)")
+        .x_range(0.0, ROLL_MAX_DEG)
+        .legend(if paper_px == NEAR_PX {
+            Legend::BottomRight
+        } else {
+            Legend::TopRight
+        });
+    for (j, g0) in [0.0, 30.0, 60.0, 90.0].iter().enumerate() {
+        let pts: Vec<(f64, f64)> = rows
+            .iter()
+            .filter(|r| r.1 == *g0)
+            .map(|r| (r.0, mm_s(r.2.speed_mps())))
+            .collect();
+        plot = plot.series(Series::line(&format!("gamma0 = {g0} deg"), pts).palette(j));
+    }
+    out.plot(&format!("{stem}.png"), &plot)?;
+    Ok(range)
+}
+
+/// Returns (min MTF at M = 48, largest M for the floor, worst relative mismatch).
+fn fig8(out: &mut Out) -> Result<(f64, u32, f64), String> {
+    let sweep = MismatchSweep::new(|g| motion(FAR_PX, 25.0, g).ok().map(|m| mm_s(m.speed_mps())))
+        .ok_or("far point at 25 deg misses the Earth")?;
+    let mut csv = String::from(GENERATED);
+    csv.push_str("# far point, phi = 25 deg; line period set for |v| at gamma0 = 0 and held;\n");
+    csv.push_str("# rel_mismatch = (v - v(0)) / v(0); MTF = sinc(pi M rel / 2) (Eq. 19)\n");
+    csv.push_str("gamma0_deg,speed_mm_s,rel_mismatch");
+    for m in FIG8_STAGES {
+        write!(csv, ",mtf_M{m}").unwrap();
+    }
+    csv.push('\n');
+    let mut curves: Vec<Vec<(f64, f64)>> = vec![Vec::new(); FIG8_STAGES.len()];
+    for (k, &g) in sweep.g0_deg.iter().enumerate() {
+        let rel = sweep.rel[k];
+        write!(csv, "{g:.0},{:.6},{rel:.8}", sweep.speed_mm_s[k]).unwrap();
+        for (j, &m) in FIG8_STAGES.iter().enumerate() {
+            let mtf = mtf_mismatch(m, rel).map_err(|e| format!("{e:?}"))?;
+            write!(csv, ",{mtf:.6}").unwrap();
+            curves[j].push((g, mtf));
+        }
+        csv.push('\n');
+    }
+    out.write("fig8_mtf_mismatch.csv", csv.as_bytes())?;
+
+    let mut plot = Plot::new(
+        "Fig. 8: MTF_mismatch, far point, phi = 25 deg",
+        "gamma0, argument of latitude (deg)",
+        "MTF_mismatch at Nyquist",
+    )
+    .x_range(0.0, 90.0)
+    .y_range(0.5, 1.0)
+    .legend(Legend::BottomLeft);
+    for (j, m) in FIG8_STAGES.iter().enumerate() {
+        plot = plot.series(Series::line(&format!("M = {m}"), curves[j].clone()).palette(j));
+    }
+    plot = plot.series(
+        Series::line(
+            &format!("MTF floor {MTF_FLOOR}"),
+            vec![(0.0, MTF_FLOOR), (90.0, MTF_FLOOR)],
+        )
+        .colour([0, 0, 0])
+        .width(1.5)
+        .dashed(),
+    );
+    out.plot("fig8_mtf_mismatch.png", &plot)?;
+    Ok((sweep.min_mtf(48)?, sweep.max_stages()?, sweep.worst_rel()))
+}
+
+fn summary(
+    out: &mut Out,
+    near: Range,
+    far: Range,
+    mtf48: f64,
+    max_m: u32,
+    worst: f64,
+) -> Result<(), String> {
+    let mut csv = String::from(GENERATED);
+    writeln!(
+        csv,
+        "# H = 645 km, f = 555 mm, A = 13 um, R = 6370 km, i0 = {INCLINATION_DEG} deg, GM = 3.986004418e14, omega = {EARTH_RATE_RAD_S}; reference chain"
+    )
+    .unwrap();
+    csv.push_str("quantity,paper,ours,unit,definition\n");
+    let rows: Vec<(&str, String, String, &str, &str)> = vec![
+        (
+            "near_min",
+            fmt2(published::NEAR_MIN),
+            format!("{:.3}", near.min),
+            "mm/s",
+            "min |v|, pixel 0, phi 0..25, gamma0 0..90",
+        ),
+        (
+            "near_max",
+            fmt2(published::NEAR_MAX),
+            format!("{:.3}", near.max),
+            "mm/s",
+            "max |v|, pixel 0, phi 0..25, gamma0 0..90",
+        ),
+        (
+            "near_change",
+            format!("{:.1}", published::NEAR_CHANGE_PCT),
+            format!("{:.2}", near.change_over_min_pct()),
+            "%",
+            "(max - min) / min",
+        ),
+        (
+            "near_change_over_max",
+            "".into(),
+            format!("{:.2}", near.change_over_max_pct()),
+            "%",
+            "(max - min) / max (not the paper's)",
+        ),
+        (
+            "far_min",
+            fmt2(published::FAR_MIN),
+            format!("{:.3}", far.min),
+            "mm/s",
+            "min |v|, pixel 60000, phi 0..25, gamma0 0..90",
+        ),
+        (
+            "far_max",
+            fmt2(published::FAR_MAX),
+            format!("{:.3}", far.max),
+            "mm/s",
+            "max |v|, pixel 60000, phi 0..25, gamma0 0..90",
+        ),
+        (
+            "far_change",
+            format!("{:.1}", published::FAR_CHANGE_PCT),
+            format!("{:.2}", far.change_over_min_pct()),
+            "%",
+            "(max - min) / min",
+        ),
+        (
+            "far_change_over_max",
+            "".into(),
+            format!("{:.2}", far.change_over_max_pct()),
+            "%",
+            "(max - min) / max (not the paper's)",
+        ),
+        (
+            "far_phi25_worst_rel_mismatch",
+            format!("{:.3}", 100.0 * implied_rel(published::MTF_M48, 48)),
+            format!("{:.3}", 100.0 * worst),
+            "%",
+            "max |v(g0) - v(0)| / v(0), g0 0..90; paper's value implied by its 0.681 at M = 48",
+        ),
+        (
+            "mtf_mismatch_M48",
+            format!("{:.3}", published::MTF_M48),
+            format!("{mtf48:.4}"),
+            "",
+            "min over g0 0..90, far point, phi 25, line period held at g0 = 0",
+        ),
+        (
+            "max_stages_mtf_0.95",
+            published::MAX_STAGES.to_string(),
+            max_m.to_string(),
+            "stages",
+            "largest M with MTF_mismatch >= 0.95 over g0 0..90 (any M)",
+        ),
+    ];
+    for (q, p, o, u, d) in rows {
+        writeln!(csv, "{q},{p},{o},{u},\"{d}\"").unwrap();
+    }
+    out.write("summary.csv", csv.as_bytes())?;
+    println!(
+        "near [{:.3}, {:.3}] mm/s, {:.2} %; far [{:.3}, {:.3}] mm/s, {:.2} %; MTF(M=48) {:.4}; max M {}",
+        near.min,
+        near.max,
+        near.change_over_min_pct(),
+        far.min,
+        far.max,
+        far.change_over_min_pct(),
+        mtf48,
+        max_m
+    );
+    Ok(())
+}
+
+fn fmt2(x: f64) -> String {
+    format!("{x:.2}")
+}
+
+/// The relative mismatch dv/v with sinc(pi M dv/v / 2) = `mtf` on the first lobe.
+fn implied_rel(mtf: f64, stages: u32) -> f64 {
+    let (mut lo, mut hi) = (0.0_f64, core::f64::consts::PI);
+    for _ in 0..80 {
+        let mid = 0.5 * (lo + hi);
+        if mid.sin() / mid >= mtf {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    2.0 * lo / (core::f64::consts::PI * stages as f64)
+}
+
+/// Each candidate explanation on the Figs. 6-8 quantities.
+fn hypotheses(out: &mut Out) -> Result<(), String> {
+    let mut csv = String::from(GENERATED);
+    csv.push_str("# what the paper's numbers would be under each suspected mistake (Eq. 14 route, v2 from the chain); empty = the line of sight misses the Earth somewhere\n");
+    csv.push_str("variant,near_min_mm_s,near_max_mm_s,near_change_pct,far_min_mm_s,far_max_mm_s,far_change_pct,far_phi25_worst_rel_pct,mtf_M48,max_stages\n");
+    writeln!(
+        csv,
+        "paper,{:.2},{:.2},{:.1},{:.2},{:.2},{:.1},{:.3},{:.3},{}",
+        published::NEAR_MIN,
+        published::NEAR_MAX,
+        published::NEAR_CHANGE_PCT,
+        published::FAR_MIN,
+        published::FAR_MAX,
+        published::FAR_CHANGE_PCT,
+        100.0 * implied_rel(published::MTF_M48, 48),
+        published::MTF_M48,
+        published::MAX_STAGES
+    )
+    .unwrap();
+    let rolls = deg_steps(ROLL_MAX_DEG, ROLL_STEPS);
+    let g0s = deg_steps(G0_MAX_DEG, G0_STEPS);
+    for v in VARIANTS {
+        let range_at = |px: f64| {
+            let all: Option<Vec<f64>> = rolls
+                .iter()
+                .flat_map(|&phi| g0s.iter().map(move |&g| (phi, g)))
+                .map(|(phi, g)| v.speed_mm_s(px, phi, g))
+                .collect();
+            all.and_then(Range::of)
+        };
+        write!(csv, "\"{}\"", v.name).unwrap();
+        for r in [range_at(NEAR_PX), range_at(FAR_PX)] {
+            match r {
+                Some(r) => write!(
+                    csv,
+                    ",{:.3},{:.3},{:.2}",
+                    r.min,
+                    r.max,
+                    r.change_over_min_pct()
+                )
+                .unwrap(),
+                None => csv.push_str(",,,"),
+            }
+        }
+        match MismatchSweep::new(|g| v.speed_mm_s(FAR_PX, 25.0, g)) {
+            Some(s) => writeln!(
+                csv,
+                ",{:.3},{:.4},{}",
+                100.0 * s.worst_rel(),
+                s.min_mtf(48)?,
+                s.max_stages()?
+            )
+            .unwrap(),
+            None => csv.push_str(",,,\n"),
+        }
+    }
+    out.write("hypotheses.csv", csv.as_bytes())
 }
