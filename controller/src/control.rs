@@ -114,6 +114,7 @@ pub struct Controller {
     last_time_us: Option<u64>,
     now_us: u64,
     next_update_us: u64,
+    last_update_us: Option<u64>,
     pub counters: Counters,
     pub last_fault: Option<Fault>,
     pub frames_accepted: u32,
@@ -137,6 +138,7 @@ impl Controller {
             last_time_us: None,
             now_us: 0,
             next_update_us: 0,
+            last_update_us: None,
             counters: Counters::default(),
             last_fault: None,
             frames_accepted: 0,
@@ -159,6 +161,10 @@ impl Controller {
     }
     pub fn now_us(&self) -> u64 {
         self.now_us
+    }
+    /// The instant of the last update `advance` ran (a multiple of the update period).
+    pub fn last_update_us(&self) -> Option<u64> {
+        self.last_update_us
     }
     /// The smallest and largest line period (s) any register may receive.
     pub fn period_bounds_s(&self) -> (f32, f32) {
@@ -264,7 +270,9 @@ impl Controller {
         // updates would only delay the current one.
         let period = self.config.update_period_us.max(1);
         let t = self.now_us - self.now_us % period;
-        self.next_update_us = t + period;
+        // Saturating: a (valid) time tag near u64::MAX must not wrap the schedule.
+        self.next_update_us = t.saturating_add(period);
+        self.last_update_us = Some(t);
         self.update_at(t, sink);
         true
     }

@@ -24,6 +24,10 @@ pub mod kind {
     /// Time only: a tick of the time source (the simulation's clock; on a board the
     /// on-board timer plays this part and the frame is not needed).
     pub const TIME: u8 = 0x03;
+    /// End of a simulated pass (empty payload): the host asks for a final STATUS frame
+    /// and for the program to stop. Handled by [`crate::session::Session`], never
+    /// passed to the controller; a flight build may ignore it.
+    pub const END: u8 = 0x04;
     /// Line periods, one record per active segment.
     pub const PERIODS: u8 = 0x81;
     /// Fault counters and state.

@@ -17,6 +17,7 @@ pub mod nav;
 pub mod plan;
 pub mod report;
 pub mod scene;
+pub mod session;
 
 pub use control::{Config, Controller, LinePeriodSink, Mode, SegmentOutput};
 pub use fault::{Counters, Fault};

@@ -351,3 +351,18 @@ fn periods_and_status_frames_round_trip() {
     assert_eq!(s.skipped_bytes, 7);
     assert_eq!(s.frames_accepted, c.frames_accepted);
 }
+
+#[test]
+fn time_tags_near_the_end_of_the_clock_do_not_wrap_the_schedule() {
+    let mut c = Controller::new(Config::default(), Scene::paper_default()).unwrap();
+    let mut regs = Registers::default();
+    let t = u64::MAX - 5;
+    feed(
+        &mut c,
+        &nav_frame(1, t, state(I0.to_radians(), 0.3, H), roll(0.2)),
+    );
+    assert!(c.advance(t, &mut regs));
+    assert_eq!(c.last_update_us(), Some(t - t % 20_000));
+    // The next update is due at u64::MAX (saturated), not at a wrapped small instant.
+    assert!(!c.advance(t, &mut regs));
+}

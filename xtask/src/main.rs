@@ -6,6 +6,8 @@ mod accuracy;
 mod csv;
 mod eval;
 mod paper;
+mod plot;
+mod target;
 mod test_cmd;
 
 use std::process::ExitCode;
@@ -17,6 +19,11 @@ commands:
   accuracy [--quick]                                     f32/f64 error sweep against the reference
   paper                                                  regenerate docs/paper/ (Figs. 5-8)
   test                                                   every check CI runs
+  run [--short] [--telemetry FILE.csv] [--debug]         a pass through the firmware under QEMU (docs/telemetry.md)
+      [--plot PNG] [--every S] [--segments 0,5,9|all]
+      [--export-telemetry FILE.csv] [--demo]             (--demo: the default-scene demo)
+  bench                                                  guest instructions per evaluation (QEMU plugin)
+  qemu ELF                                               cargo runner: ELF under QEMU, defmt decoded
 ";
 
 fn main() -> ExitCode {
@@ -31,6 +38,9 @@ fn main() -> ExitCode {
         "accuracy" => accuracy::run(rest),
         "paper" => paper::run(rest),
         "test" => test_cmd::run(rest),
+        "run" => target::run(rest),
+        "bench" => target::bench(rest),
+        "qemu" => target::qemu(rest),
         "help" | "--help" | "-h" => {
             print!("{USAGE}");
             Ok(())

@@ -34,7 +34,10 @@ pub fn run(args: &[String]) -> Result<(), String> {
     cargo(&["test", "--release"])?;
     derivation_check()?;
     crate::target::test_target()?;
-    eprintln!("\nxtask test: all checks passed in {:.0} s", t0.elapsed().as_secs_f64());
+    eprintln!(
+        "\nxtask test: all checks passed in {:.0} s",
+        t0.elapsed().as_secs_f64()
+    );
     Ok(())
 }
 
@@ -46,7 +49,17 @@ fn derivation_check() -> Result<(), String> {
         .map(|o| o.status.success())
         .map_err(|e| format!("python3 is needed for the derivation check: {e}"))?;
     if !has_sympy {
-        run_step("python3", &["-m", "pip", "install", "--quiet", "-r", "tools/derivation/requirements.txt"])?;
+        run_step(
+            "python3",
+            &[
+                "-m",
+                "pip",
+                "install",
+                "--quiet",
+                "-r",
+                "tools/derivation/requirements.txt",
+            ],
+        )?;
     }
     run_step("python3", &["tools/derivation/derive.py"])
 }

@@ -1,0 +1,199 @@
+//! The controller's loop around a byte link, shared by every host of the controller:
+//! the firmware (bytes from its UART) and the host tools (the twin run of
+//! `cargo xtask run`, the tests). Bytes in, frames to the controller, after every frame
+//! the update that is due, frames out: PERIODS after each update, STATUS every second of
+//! controller time and at the end of a pass. Because the firmware and its host twin run
+//! this very code, a difference between their outputs can only come from their inputs
+//! (or from the target's arithmetic, which is bit-identical for this code).
+//!
+//! Bytes are processed one at a time (the decoder sees every byte alone), so that the
+//! outputs do not depend on how the bytes were chunked by the link.
+
+use crate::control::{Controller, LinePeriodSink};
+use crate::fault::Fault;
+use crate::frame::{encode, kind, Decoder, Event, MAX_FRAME, MAX_PAYLOAD};
+use crate::report::{encode_periods, encode_status};
+
+/// Time between STATUS frames (controller time, us).
+pub const STATUS_PERIOD_US: u64 = 1_000_000;
+
+/// The controller, its decoder and the downlink's state.
+pub struct Session {
+    pub decoder: Decoder,
+    pub controller: Controller,
+    sequence: u16,
+    next_status_us: u64,
+    end_requested: bool,
+    ended: bool,
+    /// Downlink frames that could not be encoded (never expected: the payloads are
+    /// bounded by construction).
+    pub encode_failures: u32,
+}
+
+impl Session {
+    pub fn new(controller: Controller) -> Session {
+        Session {
+            decoder: Decoder::new(),
+            controller,
+            sequence: 0,
+            next_status_us: 0,
+            end_requested: false,
+            ended: false,
+            encode_failures: 0,
+        }
+    }
+
+    /// True once an END frame has been received (and the final STATUS sent).
+    pub fn is_ended(&self) -> bool {
+        self.ended
+    }
+
+    /// Feeds received bytes; `sink` receives the line periods, `send` every downlink
+    /// frame (whole, ready for the link). Returns true when the pass has ended (an END
+    /// frame arrived): the final STATUS has been sent and later bytes are ignored.
+    pub fn feed<S: LinePeriodSink>(
+        &mut self,
+        bytes: &[u8],
+        sink: &mut S,
+        mut send: impl FnMut(&[u8]),
+    ) -> bool {
+        for &b in bytes {
+            if self.ended {
+                break;
+            }
+            self.feed_byte(b, sink, &mut send);
+        }
+        self.ended
+    }
+
+    fn feed_byte<S: LinePeriodSink>(
+        &mut self,
+        byte: u8,
+        sink: &mut S,
+        send: &mut impl FnMut(&[u8]),
+    ) {
+        let Session {
+            decoder,
+            controller,
+            sequence,
+            end_requested,
+            encode_failures,
+            ..
+        } = self;
+        decoder.feed(&[byte], |event| {
+            if *end_requested {
+                return;
+            }
+            match event {
+                Event::Rejected(e) => controller.reject(Fault::from(e)),
+                Event::Frame(f) if f.kind == kind::END => {
+                    if f.payload.is_empty() {
+                        *end_requested = true;
+                    } else {
+                        controller.reject(Fault::BadLength);
+                    }
+                }
+                Event::Frame(f) => {
+                    controller.on_frame(&f);
+                    let now = controller.now_us();
+                    advance(controller, now, sink, sequence, encode_failures, send);
+                }
+            }
+        });
+        self.status_if_due(send);
+    }
+
+    /// Moves the clock to `now_us` from a time source of the firmware's own (a board's
+    /// timer), with the same consequences as a frame's time tag: the update that is
+    /// due, its PERIODS frame, a STATUS frame when one is due. Under QEMU the telemetry
+    /// is the only time source and this is not called.
+    pub fn tick<S: LinePeriodSink>(
+        &mut self,
+        now_us: u64,
+        sink: &mut S,
+        mut send: impl FnMut(&[u8]),
+    ) {
+        if self.ended {
+            return;
+        }
+        advance(
+            &mut self.controller,
+            now_us,
+            sink,
+            &mut self.sequence,
+            &mut self.encode_failures,
+            &mut send,
+        );
+        self.status_if_due(&mut send);
+    }
+
+    fn status_if_due(&mut self, send: &mut impl FnMut(&[u8])) {
+        let now = self.controller.now_us();
+        if self.end_requested || now >= self.next_status_us {
+            // Saturating: time tags come from the link, and any u64 is a valid one.
+            self.next_status_us = (now / STATUS_PERIOD_US + 1).saturating_mul(STATUS_PERIOD_US);
+            self.send_status(send);
+        }
+        if self.end_requested {
+            self.ended = true;
+        }
+    }
+
+    /// Sends a STATUS frame (time tag: the controller's clock).
+    pub fn send_status(&mut self, send: &mut impl FnMut(&[u8])) {
+        let mut payload = [0u8; MAX_PAYLOAD];
+        let skipped = self.decoder.skipped_bytes;
+        let now = self.controller.now_us();
+        let sent = encode_status(&self.controller, skipped, &mut payload).and_then(|n| {
+            send_frame(
+                kind::STATUS,
+                &mut self.sequence,
+                now,
+                payload.get(..n)?,
+                send,
+            )
+        });
+        if sent.is_none() {
+            self.encode_failures = self.encode_failures.saturating_add(1);
+        }
+    }
+}
+
+/// Runs the update due at `now_us`, if any, and sends its PERIODS frame (time tag: the
+/// update instant).
+fn advance<S: LinePeriodSink>(
+    controller: &mut Controller,
+    now_us: u64,
+    sink: &mut S,
+    sequence: &mut u16,
+    encode_failures: &mut u32,
+    send: &mut impl FnMut(&[u8]),
+) {
+    if !controller.advance(now_us, sink) {
+        return;
+    }
+    let Some(t) = controller.last_update_us() else {
+        return;
+    };
+    let mut payload = [0u8; MAX_PAYLOAD];
+    let sent = encode_periods(controller, &mut payload)
+        .and_then(|n| send_frame(kind::PERIODS, sequence, t, payload.get(..n)?, send));
+    if sent.is_none() {
+        *encode_failures = encode_failures.saturating_add(1);
+    }
+}
+
+/// Encodes one frame with the next sequence number and hands it to `send`.
+fn send_frame(
+    kind: u8,
+    sequence: &mut u16,
+    time_us: u64,
+    payload: &[u8],
+    send: &mut impl FnMut(&[u8]),
+) -> Option<()> {
+    let mut frame = [0u8; MAX_FRAME];
+    let n = encode(kind, *sequence, time_us, payload, &mut frame)?;
+    *sequence = sequence.wrapping_add(1);
+    send(frame.get(..n)?);
+    Some(())
+}

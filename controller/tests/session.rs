@@ -1,0 +1,117 @@
+//! The session loop shared by the firmware and the host twin: what it sends, when, and
+//! that its output does not depend on how the link chunks the bytes.
+
+mod common;
+
+use common::{nav_frame, roll, state};
+use controller::frame::{encode, kind, Decoder, Event, MAX_FRAME};
+use controller::report::{Periods, Status};
+use controller::session::Session;
+use controller::{Config, Controller, Fault, LinePeriodSink, Scene};
+
+struct Accept;
+
+impl LinePeriodSink for Accept {
+    type Error = ();
+    fn write_period(&mut self, _index: u8, _ticks: u32) -> Result<(), ()> {
+        Ok(())
+    }
+}
+
+fn frame(kind: u8, seq: u16, time_us: u64, payload: &[u8]) -> Vec<u8> {
+    let mut buf = [0u8; MAX_FRAME];
+    let n = encode(kind, seq, time_us, payload, &mut buf).unwrap();
+    buf[..n].to_vec()
+}
+
+/// Two seconds: NAV at 4 Hz, TIME at every other 20 ms tick, a bad CRC, END.
+fn uplink() -> Vec<u8> {
+    let mut out = Vec::new();
+    let i0 = 97.98f64.to_radians();
+    let mut seq = 0;
+    for k in 0..=100u64 {
+        let t = k * 20_000;
+        let f = if t % 250_000 == 0 {
+            nav_frame(
+                seq,
+                t,
+                state(i0, 0.3 + 1e-3 * t as f64 * 1e-6, 645e3),
+                roll(0.1),
+            )
+        } else {
+            frame(kind::TIME, seq, t, &[])
+        };
+        seq += 1;
+        out.extend_from_slice(&f);
+        if k == 30 {
+            let mut bad = frame(kind::TIME, seq, t + 1, &[]);
+            bad[10] ^= 0x10;
+            out.extend_from_slice(&bad);
+        }
+    }
+    out.extend_from_slice(&frame(kind::END, seq, 2_000_001, &[]));
+    // Ignored: after END.
+    out.extend_from_slice(&frame(kind::TIME, seq + 1, 2_100_000, &[]));
+    out
+}
+
+fn run(bytes: &[u8], chunk: usize) -> (Vec<u8>, bool) {
+    let c = Controller::new(Config::default(), Scene::paper_default()).unwrap();
+    let mut s = Session::new(c);
+    let mut out = Vec::new();
+    let mut ended = false;
+    for part in bytes.chunks(chunk) {
+        ended = s.feed(part, &mut Accept, |f| out.extend_from_slice(f));
+    }
+    assert!(s.is_ended() == ended);
+    (out, ended)
+}
+
+#[test]
+fn periods_after_each_update_status_every_second_and_at_the_end() {
+    let (out, ended) = run(&uplink(), 1);
+    assert!(ended);
+    let mut periods = Vec::new();
+    let mut status = Vec::new();
+    let mut d = Decoder::new();
+    d.feed(&out, |e| match e {
+        Event::Frame(f) if f.kind == kind::PERIODS => {
+            periods.push((f.time_us, Periods::decode(f.payload).unwrap()))
+        }
+        Event::Frame(f) if f.kind == kind::STATUS => {
+            status.push((f.time_us, Status::decode(f.payload).unwrap()))
+        }
+        other => panic!("unexpected downlink event {other:?}"),
+    });
+    // One update per 20 ms tick from 0 to 2 s, each with all ten segments.
+    assert_eq!(periods.len(), 101);
+    for (k, (t, p)) in periods.iter().enumerate() {
+        assert_eq!(*t, k as u64 * 20_000);
+        assert_eq!(p.count, 10);
+    }
+    // STATUS at 0, 1 s, 2 s and the final one after END.
+    let times: Vec<u64> = status.iter().map(|(t, _)| *t).collect();
+    assert_eq!(times, [0, 1_000_000, 2_000_000, 2_000_000]);
+    let last = status.last().unwrap().1;
+    assert_eq!(last.count(Fault::BadCrc), 1);
+    assert_eq!(last.total(), 1);
+    assert_eq!(last.updates, 101);
+}
+
+#[test]
+fn output_does_not_depend_on_how_the_bytes_arrive() {
+    let bytes = uplink();
+    let (one, _) = run(&bytes, 1);
+    for chunk in [2, 7, 64, 1000, bytes.len()] {
+        assert_eq!(run(&bytes, chunk).0, one, "chunks of {chunk}");
+    }
+}
+
+#[test]
+fn an_end_frame_with_a_payload_is_refused() {
+    let c = Controller::new(Config::default(), Scene::paper_default()).unwrap();
+    let mut s = Session::new(c);
+    let ended = s.feed(&frame(kind::END, 0, 5, &[1]), &mut Accept, |_| {});
+    assert!(!ended);
+    assert_eq!(s.controller.counters.get(Fault::BadLength), 1);
+}

@@ -1,0 +1,161 @@
+//! Instruction-count benchmark, run by `cargo xtask bench` under QEMU with the
+//! `stopwatch` TCG plugin (tools/qemu-stopwatch): the plugin counts the guest
+//! instructions between each call of [`bench_start`] and the next of [`bench_stop`].
+//!
+//! Before each region the firmware logs `BENCH <label>`; the xtask pairs the n-th label
+//! with the n-th count. The first region is empty: its count is the markers' own
+//! overhead, which the xtask subtracts. Inputs go through `black_box` after the start
+//! marker and results through `black_box` before the stop marker, so that nothing is
+//! computed outside the region or optimised away.
+#![no_std]
+#![no_main]
+
+use core::hint::black_box;
+
+use core_math::fixed_point::geometry_from_f64;
+use core_math::{Backend, Camera, Geometry, Reference, CLOSED_F32, CLOSED_F64, FIXED};
+use cortex_m_rt::entry;
+use firmware::pipeline::{Plan, SamplePoint};
+use firmware::platform;
+use firmware::scene::{NoTelemetry, Scene, SceneSource};
+use firmware::FirmwareError;
+
+/// Start of a measured region (the plugin watches its first instruction). The
+/// `black_box` of a constant of its own is a side effect the optimiser must keep, and
+/// makes the two markers differ, so that neither the calls nor the functions are merged
+/// or removed.
+#[no_mangle]
+#[inline(never)]
+pub extern "C" fn bench_start() {
+    black_box(0x5354_4152_u32);
+}
+
+/// End of a measured region.
+#[no_mangle]
+#[inline(never)]
+pub extern "C" fn bench_stop() {
+    black_box(0x5354_4f50_u32);
+}
+
+/// Runs `f` on `input` between the markers, logging `label` first.
+#[inline(always)]
+fn region<I, O>(label: &str, input: I, f: impl FnOnce(I) -> O) {
+    defmt::info!("BENCH {=str}", label);
+    bench_start();
+    let out = f(black_box(input));
+    black_box(out);
+    bench_stop();
+}
+
+fn run() -> Result<(), FirmwareError> {
+    let scene: Scene = NoTelemetry.scene()?;
+    let camera: Camera = scene.camera;
+    let g32: Geometry<f32> = scene.geometry;
+    let g64: Geometry<f64> = g32.to_f64();
+    let plan = Plan::new(&scene)?;
+    let update = plan.update(&g32)?;
+    let axis = CLOSED_F32.pixel(&camera, 0.0)?;
+    let edge = CLOSED_F32.pixel(&camera, 30_000.0)?;
+    let axis64 = CLOSED_F64.pixel(&camera, 0.0)?;
+    let update64 = CLOSED_F64.update(&g64)?;
+    let ref_pixel = Reference.pixel(&camera, 0.0)?;
+    let gfx = geometry_from_f64(&g64)?;
+    let update_fx = FIXED.update(&gfx)?;
+    let axis_fx = FIXED.pixel(&camera, 0.0)?;
+    let edge_fx = FIXED.pixel(&camera, 30_000.0)?;
+    // Roll 45 deg: pixel 15 735 looks 9.7e-5 rad short of the limb (near-limb form).
+    let g45 = Geometry {
+        roll_rad: 45f64.to_radians(),
+        ..g64
+    };
+    let update_fx45 = FIXED.update(&geometry_from_f64(&g45)?)?;
+    let near_fx = FIXED.pixel(&camera, 15_735.0)?;
+    let axis_sample = SamplePoint {
+        n_px: 0,
+        pixel: axis,
+    };
+
+    region("empty region (marker overhead)", (), |()| ());
+    region(
+        "CLOSED_F32 motion, 1 pixel (n = 0)",
+        (&update, &axis),
+        |(u, p)| CLOSED_F32.motion(u, p),
+    );
+    region(
+        "CLOSED_F32 motion, 1 pixel (n = +30000, near-limb form)",
+        (&update, &edge),
+        |(u, p)| CLOSED_F32.motion(u, p),
+    );
+    region(
+        "CLOSED_F32 motion + |v| + line period + ticks, 1 pixel (n = 0; the firmware's per-point work)",
+        (&plan, &update, &axis_sample),
+        |(plan, u, s)| plan.point(u, s),
+    );
+    region("CLOSED_F32 update (once per telemetry update)", &g32, |g| {
+        CLOSED_F32.update(g)
+    });
+    region(
+        "CLOSED_F32 pixel (boot, f64 inside), 1 pixel",
+        &camera,
+        |c| CLOSED_F32.pixel(c, 12_345.0),
+    );
+    region(
+        "CLOSED_F64 motion, 1 pixel (n = 0)",
+        (&update64, &axis64),
+        |(u, p)| CLOSED_F64.motion(u, p),
+    );
+    region("CLOSED_F64 update", &g64, |g| CLOSED_F64.update(g));
+    region(
+        "Reference motion (f64 chain), 1 pixel (n = 0)",
+        (&g64, &ref_pixel),
+        |(g, p)| Reference.motion(g, p),
+    );
+    region(
+        "whole update: CLOSED_F32 update + 10 segments x 3 points (motion, |v|, period, ticks)",
+        (&plan, &g32),
+        |(plan, g)| -> Result<u32, FirmwareError> {
+            let u = plan.update(g)?;
+            let mut sum = 0_u32;
+            for seg in plan.segments() {
+                let r = plan.segment_report(&u, seg)?;
+                for p in r.points {
+                    sum = sum.wrapping_add(p.ticks);
+                }
+            }
+            Ok(sum)
+        },
+    );
+    region(
+        "FIXED motion, 1 pixel (n = 0; integer only)",
+        (&update_fx, &axis_fx),
+        |(u, p)| FIXED.motion(u, p),
+    );
+    region(
+        "FIXED motion, 1 pixel (n = +30000)",
+        (&update_fx, &edge_fx),
+        |(u, p)| FIXED.motion(u, p),
+    );
+    region(
+        "FIXED motion, 1 pixel (roll 45 deg, n = +15735: 9.7e-5 rad from the limb, near-limb form)",
+        (&update_fx45, &near_fx),
+        |(u, p)| FIXED.motion(u, p),
+    );
+    region(
+        "FIXED update (once per telemetry update; integer only)",
+        &gfx,
+        |g| FIXED.update(g),
+    );
+    Ok(())
+}
+
+#[entry]
+fn main() -> ! {
+    let code = match run() {
+        Ok(()) => 0,
+        Err(e) => {
+            defmt::error!("{}", e);
+            1
+        }
+    };
+    platform::exit(code)
+}

@@ -1,0 +1,177 @@
+//! The two CMSDK APB peripherals of the mps2-an386 (QEMU's `-machine mps2-an386`) the
+//! controller drives: UART0, the telemetry link, and TIMER0, standing in for segment
+//! 0's line clock. Register maps from the Cortex-M System Design Kit TRM (ARM DDI0479C)
+//! as QEMU models them (hw/char/cmsdk-apb-uart.c, hw/timer/cmsdk-apb-timer.c).
+//!
+//! UART, as modelled by QEMU: a one-byte receive buffer (STATE.RXFULL set on arrival,
+//! cleared by reading DATA) and QEMU offers the next byte only once it is empty, so the
+//! host side is flow-controlled and nothing is lost however slowly the firmware polls;
+//! a one-byte transmit buffer (STATE.TXFULL) that stays full while the host end of the
+//! chardev does not accept the byte. On silicon the receive side overruns instead
+//! (STATE.RXOVERRUN) if a byte is not read within one character time: a board build
+//! would read it from the RX interrupt into a ring buffer.
+
+use crate::line_clock::ReloadRegister;
+use crate::link::ByteLink;
+
+/// mps2-an386 UART0 base address.
+pub const UART0_BASE: usize = 0x4000_4000;
+/// mps2-an386 TIMER0 base address.
+pub const TIMER0_BASE: usize = 0x4000_0000;
+/// The APB clock of UARTs and timers on the mps2-an386 (Hz).
+pub const PCLK_HZ: u32 = 25_000_000;
+
+mod uart_reg {
+    pub const DATA: usize = 0x00;
+    pub const STATE: usize = 0x04;
+    pub const CTRL: usize = 0x08;
+    pub const INTSTATUS: usize = 0x0C;
+    pub const BAUDDIV: usize = 0x10;
+    /// STATE: transmit buffer full.
+    pub const STATE_TX_FULL: u32 = 1 << 0;
+    /// STATE: receive buffer full.
+    pub const STATE_RX_FULL: u32 = 1 << 1;
+    /// CTRL: transmitter and receiver enable, receive interrupt enable.
+    pub const CTRL_TX_EN: u32 = 1 << 0;
+    pub const CTRL_RX_EN: u32 = 1 << 1;
+    pub const CTRL_RX_INTEN: u32 = 1 << 3;
+    /// INTSTATUS: receive interrupt (write 1 to clear).
+    pub const INT_RX: u32 = 1 << 1;
+}
+
+/// UART0's receive interrupt on the mps2-an386 (NVIC line 0; QEMU hw/arm/mps2.c).
+#[derive(Clone, Copy)]
+struct Uart0Rx;
+
+// SAFETY: 0 is the NVIC line QEMU's mps2-an386 wires UART0's RX interrupt to.
+unsafe impl cortex_m::interrupt::InterruptNumber for Uart0Rx {
+    fn number(self) -> u16 {
+        0
+    }
+}
+
+mod timer_reg {
+    pub const CTRL: usize = 0x0;
+    pub const RELOAD: usize = 0x8;
+    /// CTRL: counter enable.
+    pub const CTRL_EN: u32 = 1 << 0;
+}
+
+/// A 32-bit memory-mapped register block.
+struct Registers {
+    base: usize,
+}
+
+impl Registers {
+    fn read(&self, offset: usize) -> u32 {
+        // SAFETY: `base` is a peripheral this block owns (see the constructors), and
+        // `offset` one of its word-aligned registers: a volatile word read is the
+        // intended access.
+        unsafe { core::ptr::read_volatile((self.base + offset) as *const u32) }
+    }
+    fn write(&mut self, offset: usize, value: u32) {
+        // SAFETY: as in `read`.
+        unsafe { core::ptr::write_volatile((self.base + offset) as *mut u32, value) }
+    }
+}
+
+/// A CMSDK APB UART, polled.
+pub struct Uart {
+    regs: Registers,
+}
+
+impl Uart {
+    /// UART0 of the mps2-an386, enabled for transmit and receive at `baud` (8N1), its
+    /// receive interrupt enabled in the UART and the NVIC but masked in the core
+    /// (PRIMASK): it only wakes the core from [`ByteLink::wait`], no handler runs.
+    ///
+    /// # Safety
+    /// The caller must be the only owner of UART0 and the only user of interrupts
+    /// (this sets PRIMASK for good).
+    pub unsafe fn uart0(baud: u32) -> Uart {
+        let mut uart = Uart {
+            regs: Registers { base: UART0_BASE },
+        };
+        // The divider must be at least 16 (QEMU ignores smaller values).
+        let div = (PCLK_HZ / baud.max(1)).max(16);
+        uart.regs.write(uart_reg::BAUDDIV, div);
+        cortex_m::interrupt::disable();
+        uart.regs.write(
+            uart_reg::CTRL,
+            uart_reg::CTRL_TX_EN | uart_reg::CTRL_RX_EN | uart_reg::CTRL_RX_INTEN,
+        );
+        cortex_m::peripheral::NVIC::unpend(Uart0Rx);
+        // SAFETY: PRIMASK is set, so unmasking the line cannot run a handler or break
+        // a critical section.
+        unsafe { cortex_m::peripheral::NVIC::unmask(Uart0Rx) };
+        uart
+    }
+}
+
+impl ByteLink for Uart {
+    fn read_byte(&mut self) -> Option<u8> {
+        if self.regs.read(uart_reg::STATE) & uart_reg::STATE_RX_FULL == 0 {
+            return None;
+        }
+        Some(self.regs.read(uart_reg::DATA) as u8)
+    }
+
+    fn try_write_byte(&mut self, byte: u8) -> bool {
+        if !self.tx_idle() {
+            return false;
+        }
+        self.regs.write(uart_reg::DATA, u32::from(byte));
+        true
+    }
+
+    fn tx_idle(&mut self) -> bool {
+        self.regs.read(uart_reg::STATE) & uart_reg::STATE_TX_FULL == 0
+    }
+
+    /// Sleeps (WFI) until the receive interrupt is pending. The order makes a lost
+    /// wake-up impossible: the pending bit and the UART's interrupt line are cleared
+    /// first, then RXFULL is checked, so a byte that arrived before the check is seen
+    /// there and one that arrives after it raises the line again and ends the WFI.
+    /// (WFI wakes on a pending interrupt even with PRIMASK set.)
+    fn wait(&mut self) {
+        cortex_m::peripheral::NVIC::unpend(Uart0Rx);
+        self.regs.write(uart_reg::INTSTATUS, uart_reg::INT_RX);
+        if self.regs.read(uart_reg::STATE) & uart_reg::STATE_RX_FULL == 0 {
+            cortex_m::asm::wfi();
+        }
+    }
+}
+
+/// A CMSDK APB timer: a 32-bit down-counter on the APB clock that reloads from RELOAD
+/// when it reaches zero (one period = RELOAD + 1 clock cycles).
+pub struct Timer {
+    regs: Registers,
+}
+
+impl Timer {
+    /// TIMER0 of the mps2-an386, stopped until its first period is set.
+    ///
+    /// # Safety
+    /// The caller must be the only owner of TIMER0 (call this once).
+    pub unsafe fn timer0() -> Timer {
+        let mut timer = Timer {
+            regs: Registers { base: TIMER0_BASE },
+        };
+        timer.regs.write(timer_reg::CTRL, 0);
+        timer
+    }
+}
+
+impl ReloadRegister for Timer {
+    /// Sets the period; the first one also starts the counter (a running counter with
+    /// RELOAD 0 would have no period).
+    fn set_reload(&mut self, value: u32) {
+        self.regs.write(timer_reg::RELOAD, value);
+        if self.regs.read(timer_reg::CTRL) & timer_reg::CTRL_EN == 0 {
+            self.regs.write(timer_reg::CTRL, timer_reg::CTRL_EN);
+        }
+    }
+    fn reload(&self) -> u32 {
+        self.regs.read(timer_reg::RELOAD)
+    }
+}

@@ -1,0 +1,255 @@
+//! The on-target half of the xtask: the firmware under QEMU, the on-target tests, the
+//! instruction counts. See docs/target.md and docs/bench.md.
+//!
+//! - `cargo xtask run`: build the firmware (release) and play a pass through it under
+//!   QEMU (`pass`: telemetry on UART0 through a unix socket, the decoded defmt log on
+//!   stdout, table, plot, reference and fault checks); `--demo` runs the old
+//!   default-scene demo instead.
+//! - `cargo xtask qemu ELF`: the cargo runner for thumbv7em-none-eabihf (QEMU + defmt
+//!   decoding); `.cargo/config.toml` reaches it through `tools/qemu-runner`.
+//! - `cargo xtask bench`: guest instruction counts from a QEMU TCG plugin.
+//! - [`test_target`]: clippy for the target crates, the hil-tests under QEMU and the
+//!   end-to-end pass test ([`e2e_test`]).
+
+mod bench;
+mod pass;
+mod qemu;
+mod tools;
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::time::Instant;
+
+pub use bench::bench;
+pub use pass::e2e_test;
+pub use qemu::qemu;
+pub use tools::ensure_target_tools;
+
+/// The firmware's target: Cortex-M4F, hard-float ABI.
+pub const TARGET: &str = "thumbv7em-none-eabihf";
+
+/// `cargo xtask run [--demo] [--debug] [--short] [--telemetry FILE] [--plot PNG]
+/// [--every S] [--segments LIST|all] [--export-telemetry FILE]`: a pass through the firmware under QEMU (docs/telemetry.md),
+/// or the old default-scene demo.
+pub fn run(args: &[String]) -> Result<(), String> {
+    const USAGE: &str = "usage: run [--demo] [--debug] [--short] [--telemetry FILE.csv] [--plot FILE.png] [--every SECONDS] [--segments 0,5,9|all] [--export-telemetry FILE.csv]";
+    let mut release = true;
+    let mut demo = false;
+    let mut short = false;
+    let mut telemetry = None;
+    let mut plot = None;
+    let mut export = None;
+    let mut every_s = pass::TABLE_EVERY_S;
+    let mut segments = pass::TABLE_SEGMENTS.to_vec();
+    let mut it = args.iter();
+    while let Some(a) = it.next() {
+        let mut value = |name: &str| {
+            it.next()
+                .map(PathBuf::from)
+                .ok_or_else(|| format!("run: {name} needs a file name ({USAGE})"))
+        };
+        match a.as_str() {
+            "--debug" => release = false,
+            "--release" => release = true,
+            "--demo" => demo = true,
+            "--short" => short = true,
+            "--telemetry" => telemetry = Some(value("--telemetry")?),
+            "--plot" => plot = Some(value("--plot")?),
+            "--export-telemetry" => export = Some(value("--export-telemetry")?),
+            "--every" => {
+                every_s = it
+                    .next()
+                    .and_then(|v| v.parse().ok())
+                    .filter(|&v: &u64| v > 0)
+                    .ok_or_else(|| format!("run: --every needs whole seconds > 0 ({USAGE})"))?
+            }
+            "--segments" => {
+                let v = it
+                    .next()
+                    .ok_or_else(|| format!("run: --segments needs a list ({USAGE})"))?;
+                segments = if v == "all" {
+                    (0..16).collect()
+                } else {
+                    v.split(',')
+                        .map(|x| x.trim().parse::<u8>())
+                        .collect::<Result<_, _>>()
+                        .map_err(|_| format!("run: bad segment list `{v}` ({USAGE})"))?
+                };
+            }
+            other => return Err(format!("run: unknown argument `{other}` ({USAGE})")),
+        }
+    }
+    if let Some(path) = export {
+        return pass::export(&path);
+    }
+    if demo {
+        ensure_target_tools()?;
+        let elf = build_bin("firmware", "demo", release)?;
+        let outcome = qemu::run_elf(&elf, &qemu::Options::default())?;
+        return exit_like(outcome.status);
+    }
+    pass::run(&pass::RunOptions {
+        release,
+        short,
+        telemetry,
+        plot,
+        every_s,
+        segments,
+    })
+}
+
+/// Every check of the target crates, for `cargo xtask test`: toolchain and QEMU present,
+/// clippy with `-D warnings` on thumbv7em for core-math, controller, firmware and
+/// hil-tests, the hil-tests under QEMU in the test (dev) and release profiles, then the
+/// end-to-end pass test ([`e2e_test`]).
+pub fn test_target() -> Result<(), String> {
+    let started = Instant::now();
+    ensure_target_tools()?;
+    cargo(&[
+        "clippy",
+        "--package",
+        "core-math",
+        "--lib",
+        "--target",
+        TARGET,
+        "--",
+        "-D",
+        "warnings",
+    ])?;
+    cargo(&[
+        "clippy",
+        "--package",
+        "controller",
+        "--lib",
+        "--target",
+        TARGET,
+        "--",
+        "-D",
+        "warnings",
+    ])?;
+    cargo(&[
+        "clippy",
+        "--package",
+        "firmware",
+        "--package",
+        "hil-tests",
+        "--all-targets",
+        "--target",
+        TARGET,
+        "--",
+        "-D",
+        "warnings",
+    ])?;
+    let runner = runner_config()?;
+    for profile in [None, Some("--release")] {
+        let mut args = vec!["test", "--package", "hil-tests", "--target", TARGET];
+        args.extend(runner.iter().map(String::as_str));
+        args.extend(profile);
+        cargo(&args)?;
+    }
+    e2e_test()?;
+    eprintln!(
+        "xtask: target checks passed in {:.1} s",
+        started.elapsed().as_secs_f64()
+    );
+    Ok(())
+}
+
+/// The workspace root (the folder of the root Cargo.toml and `.cargo/config.toml`).
+fn workspace_root() -> PathBuf {
+    let here = Path::new(env!("CARGO_MANIFEST_DIR"));
+    here.parent().unwrap_or(here).to_path_buf()
+}
+
+/// `cargo` as the one that started us (falls back to the one on PATH).
+fn cargo_command() -> Command {
+    let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
+    let mut cmd = Command::new(cargo);
+    cmd.current_dir(workspace_root());
+    cmd
+}
+
+/// Runs cargo with `args` in the workspace root; an error if it fails.
+fn cargo(args: &[&str]) -> Result<(), String> {
+    eprintln!("xtask: cargo {}", args.join(" "));
+    let status = cargo_command()
+        .args(args)
+        .status()
+        .map_err(|e| format!("cannot start cargo: {e}"))?;
+    if status.success() {
+        Ok(())
+    } else {
+        Err(format!("`cargo {}` failed ({status})", args.join(" ")))
+    }
+}
+
+/// `--config` arguments that make this very xtask binary the thumbv7em runner, so that
+/// cargo runs QEMU without building anything else (no nested cargo). Cargo splits a
+/// runner string at spaces (and cannot merge an array into the config's string), so a
+/// binary whose path has whitespace keeps the configured `tools/qemu-runner` instead.
+fn runner_config() -> Result<Vec<String>, String> {
+    let exe =
+        std::env::current_exe().map_err(|e| format!("cannot locate the xtask binary: {e}"))?;
+    let exe = exe.to_str().ok_or("the xtask binary's path is not UTF-8")?;
+    if exe.chars().any(char::is_whitespace) {
+        return Ok(Vec::new());
+    }
+    let exe = exe.replace('\\', "\\\\").replace('"', "\\\"");
+    Ok(vec![
+        "--config".into(),
+        format!("target.{TARGET}.runner=\"{exe} qemu\""),
+    ])
+}
+
+/// Builds one binary of `package` for the target and returns its ELF's path (taken from
+/// cargo's JSON messages, so any target-dir setting is honoured).
+fn build_bin(package: &str, bin: &str, release: bool) -> Result<PathBuf, String> {
+    let mut cmd = cargo_command();
+    cmd.args([
+        "build",
+        "--package",
+        package,
+        "--bin",
+        bin,
+        "--target",
+        TARGET,
+    ])
+    .arg("--message-format=json-render-diagnostics");
+    if release {
+        cmd.arg("--release");
+    }
+    eprintln!(
+        "xtask: cargo build --package {package} --bin {bin} --target {TARGET}{}",
+        if release { " --release" } else { "" }
+    );
+    let out = cmd
+        .stderr(std::process::Stdio::inherit())
+        .output()
+        .map_err(|e| format!("cannot start cargo: {e}"))?;
+    if !out.status.success() {
+        return Err(format!("building `{bin}` failed ({})", out.status));
+    }
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let mut elf = None;
+    for line in stdout.lines() {
+        let Ok(msg) = serde_json::from_str::<serde_json::Value>(line) else {
+            continue;
+        };
+        if msg["reason"] == "compiler-artifact" && msg["target"]["name"] == bin {
+            if let Some(path) = msg["executable"].as_str() {
+                elf = Some(PathBuf::from(path));
+            }
+        }
+    }
+    elf.ok_or_else(|| format!("cargo reported no executable for `{bin}`"))
+}
+
+/// Ends the process with the firmware's exit status (0 returns normally).
+fn exit_like(status: i32) -> Result<(), String> {
+    if status == 0 {
+        Ok(())
+    } else {
+        eprintln!("xtask: firmware exited with status {status}");
+        std::process::exit(status)
+    }
+}

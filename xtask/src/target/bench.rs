@@ -1,0 +1,135 @@
+//! `cargo xtask bench`: guest instructions per evaluation on the Cortex-M4 under QEMU.
+//!
+//! Builds the firmware's `bench` binary (release profile) and the `stopwatch` TCG
+//! plugin (tools/qemu-stopwatch/stopwatch.c, with gcc), runs the binary under QEMU with
+//! the plugin watching the `bench_start` / `bench_stop` markers, and pairs the counts
+//! with the `BENCH <label>` lines the binary logs. Counts are exact and repeatable;
+//! they are instructions, not cycles (QEMU models no pipeline, no wait states).
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use object::{Object, ObjectSymbol};
+
+use super::{build_bin, ensure_target_tools, qemu, tools, workspace_root};
+
+const PLUGIN_SOURCE: &str = "tools/qemu-stopwatch/stopwatch.c";
+const LABEL_PREFIX: &str = "BENCH ";
+
+pub fn bench(args: &[String]) -> Result<(), String> {
+    if let Some(a) = args.first() {
+        return Err(format!("bench: unknown argument `{a}` (usage: bench)"));
+    }
+    ensure_target_tools()?;
+    if !tools::have("gcc") {
+        tools::apt_install(&["gcc", "libc6-dev"], "gcc (to build the QEMU plugin)")?;
+    }
+    let elf = build_bin("firmware", "bench", true)?;
+    let dir = elf.parent().ok_or("bench ELF has no folder")?.to_path_buf();
+    let plugin = build_plugin(&dir)?;
+    let (start, stop) = marker_addresses(&elf)?;
+    let counts_path = dir.join("bench-counts.txt");
+    let _ = std::fs::remove_file(&counts_path);
+
+    let options = qemu::Options {
+        extra_args: vec![
+            "-plugin".into(),
+            format!(
+                "{},start={start:#x},stop={stop:#x},out={}",
+                plugin.display(),
+                counts_path.display()
+            ),
+        ],
+        capture: true,
+        serial: None,
+    };
+    let outcome = qemu::run_elf(&elf, &options)?;
+    if outcome.status != 0 {
+        return Err(format!(
+            "the bench firmware exited with status {}",
+            outcome.status
+        ));
+    }
+    let counts = std::fs::read_to_string(&counts_path)
+        .map_err(|e| format!("no counts from the plugin ({}): {e}", counts_path.display()))?;
+    let counts: Vec<u64> = counts
+        .lines()
+        .map(|l| {
+            l.trim()
+                .parse::<u64>()
+                .map_err(|_| format!("bad plugin output line `{l}`"))
+        })
+        .collect::<Result<_, _>>()?;
+    let labels: Vec<&str> = outcome
+        .messages
+        .iter()
+        .filter_map(|m| m.strip_prefix(LABEL_PREFIX))
+        .collect();
+    if labels.len() != counts.len() || counts.is_empty() {
+        return Err(format!(
+            "{} regions logged but {} counts measured",
+            labels.len(),
+            counts.len()
+        ));
+    }
+    let overhead = counts.first().copied().unwrap_or(0);
+    println!();
+    println!("guest instructions per region (Cortex-M4 under QEMU {}, release: opt-level 3, fat LTO, codegen-units 1)", qemu_version());
+    println!("net = raw - {overhead} (the empty region: markers and black_box). Instructions, not cycles.");
+    println!();
+    println!("{:>8} {:>8}  region", "net", "raw");
+    for (label, raw) in labels.iter().zip(&counts) {
+        println!("{:>8} {:>8}  {label}", raw.saturating_sub(overhead), raw);
+    }
+    Ok(())
+}
+
+/// Compiles the plugin next to the bench ELF (a few hundred ms with gcc).
+fn build_plugin(dir: &Path) -> Result<PathBuf, String> {
+    let source = workspace_root().join(PLUGIN_SOURCE);
+    let out = dir.join("libstopwatch.so");
+    let status = Command::new("gcc")
+        .args([
+            "-shared", "-fPIC", "-O2", "-Wall", "-Wextra", "-Werror", "-o",
+        ])
+        .arg(&out)
+        .arg(&source)
+        .status()
+        .map_err(|e| format!("cannot run gcc: {e}"))?;
+    if status.success() {
+        Ok(out)
+    } else {
+        Err(format!(
+            "building the QEMU plugin {} failed ({status})",
+            source.display()
+        ))
+    }
+}
+
+/// Addresses of the first instructions of the two markers (Thumb bit cleared).
+fn marker_addresses(elf: &Path) -> Result<(u64, u64), String> {
+    let bytes = std::fs::read(elf).map_err(|e| format!("cannot read {}: {e}", elf.display()))?;
+    let file =
+        object::File::parse(&*bytes).map_err(|e| format!("cannot parse {}: {e}", elf.display()))?;
+    let find = |name: &str| {
+        file.symbols()
+            .find(|s| s.name() == Ok(name))
+            .map(|s| s.address() & !1)
+            .ok_or_else(|| format!("no symbol `{name}` in {}", elf.display()))
+    };
+    Ok((find("bench_start")?, find("bench_stop")?))
+}
+
+fn qemu_version() -> String {
+    Command::new(qemu::QEMU)
+        .arg("--version")
+        .output()
+        .ok()
+        .and_then(|o| {
+            String::from_utf8_lossy(&o.stdout)
+                .split_whitespace()
+                .nth(3)
+                .map(str::to_string)
+        })
+        .unwrap_or_else(|| "?".into())
+}

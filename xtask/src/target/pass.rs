@@ -1,0 +1,590 @@
+//! `cargo xtask run`: a pass played through the firmware under QEMU.
+//!
+//! The host builds the telemetry of a pass (NAV frames at 4 Hz from its f64 model,
+//! TIME frames at every tick of the controller's update period that has no NAV frame,
+//! injected faults, END), sends it to the firmware's UART0 through a unix socket (QEMU
+//! `-chardev socket` + `-serial chardev:`; stdout stays the defmt stream), collects
+//! the PERIODS and STATUS frames the firmware sends back, and checks them:
+//!
+//! - against the f64 reference (`core_math::Reference`) at the same instants: per
+//!   segment, |v| at the plan's sample points, period A (1/v_min + 1/v_max) / 2, in
+//!   ticks; the firmware's ticks must be within 1e-6 relative plus half a tick;
+//! - against a twin run: the same `controller::session::Session` on the host, fed the
+//!   stream without the injected faults: every update's PERIODS must be identical;
+//! - the final STATUS: every injected fault counted under its own counter, and the
+//!   whole STATUS identical to a host run of the faulty stream.
+//!
+//! Protocol and file format: docs/telemetry.md.
+
+mod check;
+mod scenario;
+mod stream;
+
+use std::collections::BTreeMap;
+use std::io::{Read, Write};
+use std::os::unix::net::UnixListener;
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use controller::report::{mode_from_u8, Periods, Status};
+use controller::{Config, Fault, Mode};
+
+use crate::plot::{Legend, Plot, Series};
+use check::{Downlink, ReferencePlan, F32_REL_TOLERANCE};
+use scenario::{Pass, Truth};
+
+use super::{build_bin, ensure_target_tools, qemu, workspace_root};
+
+/// Segments shown in the table by default (first, one of the two central ones, last).
+pub const TABLE_SEGMENTS: [u8; 3] = [0, 5, 9];
+/// Table row spacing by default (simulated seconds).
+pub const TABLE_EVERY_S: u64 = 10;
+
+/// What `run` was asked to do.
+pub struct RunOptions {
+    pub release: bool,
+    /// The end-to-end test's one-minute pass instead of the default one.
+    pub short: bool,
+    pub telemetry: Option<PathBuf>,
+    pub plot: Option<PathBuf>,
+    /// Table: seconds between rows, segments shown.
+    pub every_s: u64,
+    pub segments: Vec<u8>,
+}
+
+/// `cargo xtask run [--telemetry FILE]`: the default pass (or the file) through the
+/// firmware, table, plot, checks.
+pub fn run(options: &RunOptions) -> Result<(), String> {
+    let started = Instant::now();
+    let tick_us = Config::default().update_period_us;
+    let earth_radius_m = Config::default().earth_radius_m;
+    let pass = match &options.telemetry {
+        Some(path) => scenario::from_csv(path, tick_us)?,
+        None if options.short => scenario::short_pass(earth_radius_m, tick_us),
+        None => scenario::default_pass(earth_radius_m, tick_us),
+    };
+    ensure_target_tools()?;
+    let elf = build_bin("firmware", "firmware", options.release)?;
+    let result = play(&elf, &pass)?;
+    print_table(&pass, &result, options.every_s.max(1), &options.segments);
+    let plot = options
+        .plot
+        .clone()
+        .unwrap_or_else(|| workspace_root().join("target/pass/line-periods.png"));
+    plot_periods(&pass, &result, &plot)?;
+    println!("plot: {}", plot.display());
+    println!(
+        "wall time {:.1} s for {:.0} s of orbit",
+        started.elapsed().as_secs_f64(),
+        pass.end_us as f64 * 1e-6
+    );
+    result.finish()
+}
+
+/// `cargo xtask run --export-telemetry FILE`: the default pass's NAV samples as CSV.
+pub fn export(path: &Path) -> Result<(), String> {
+    let c = Config::default();
+    let pass = scenario::default_pass(c.earth_radius_m, c.update_period_us);
+    scenario::to_csv(&pass, path)?;
+    println!(
+        "wrote {} NAV samples of the {} to {} (faults are not part of the file)",
+        pass.samples.len(),
+        pass.name,
+        path.display()
+    );
+    Ok(())
+}
+
+/// The end-to-end test (`cargo xtask test`): a one-minute pass with every kind of
+/// fault through the firmware (release) under QEMU; every period against the
+/// reference, every fault counted, no output changed by a fault.
+pub fn e2e_test() -> Result<(), String> {
+    let started = Instant::now();
+    let c = Config::default();
+    let pass = scenario::short_pass(c.earth_radius_m, c.update_period_us);
+    let elf = build_bin("firmware", "firmware", true)?;
+    let result = play(&elf, &pass)?;
+    result.finish()?;
+    eprintln!(
+        "xtask: end-to-end pass test passed in {:.1} s",
+        started.elapsed().as_secs_f64()
+    );
+    Ok(())
+}
+
+/// Everything a played pass gave, and the verdicts.
+struct Played {
+    firmware: Downlink,
+    status: i32,
+    tx_bytes: usize,
+    rx_bytes: usize,
+    injected: Vec<(String, Option<Fault>)>,
+    noise_bytes: usize,
+    /// Reference check: max relative difference, largest difference in ticks,
+    /// periods compared, failures.
+    max_rel: f64,
+    max_ticks: f64,
+    compared: usize,
+    reference_failures: Vec<String>,
+    /// Updates whose PERIODS differ from the twin's (or exist in one run only).
+    changed: usize,
+    changed_examples: Vec<String>,
+    /// Final STATUS of the firmware.
+    final_status: Option<Status>,
+    count_failures: Vec<String>,
+}
+
+impl Played {
+    fn rejected(&self) -> u32 {
+        self.final_status.as_ref().map_or(0, Status::total)
+    }
+
+    /// Prints the verdict lines (the last two in the fixed format) and fails on any
+    /// broken check.
+    fn finish(&self) -> Result<(), String> {
+        let mut problems = Vec::new();
+        if self.status != 0 {
+            problems.push(format!("the firmware exited with status {}", self.status));
+        }
+        if self.firmware.bad_frames > 0 || self.firmware.skipped_bytes > 0 {
+            problems.push(format!(
+                "the downlink had {} bad frames and {} stray bytes",
+                self.firmware.bad_frames, self.firmware.skipped_bytes
+            ));
+        }
+        if self.compared == 0 {
+            problems.push("no period was compared with the reference".into());
+        }
+        problems.extend(self.reference_failures.iter().take(5).cloned());
+        problems.extend(self.changed_examples.iter().take(5).cloned());
+        problems.extend(self.count_failures.iter().cloned());
+        let counted = self.injected.iter().filter(|(_, f)| f.is_some()).count();
+        let noise = self.injected.len() - counted;
+        if noise > 0 {
+            let skipped = self.final_status.as_ref().map_or(0, |s| s.skipped_bytes);
+            println!(
+                "noise: {} bytes in {noise} burst(s) injected; the decoder skipped {skipped} bytes (the noise and the remains of the rejected frames)",
+                self.noise_bytes
+            );
+        }
+        println!(
+            "reference: largest |ticks - reference| {:.4} ticks (allowed: 0.5 for the rounding to whole ticks + 1e-6 x ticks for the f32 closed form)",
+            self.max_ticks
+        );
+        for p in &problems {
+            println!("FAILED: {p}");
+        }
+        println!(
+            "reference check: max relative difference {:.3e} over {} periods",
+            self.max_rel, self.compared
+        );
+        println!(
+            "faults: injected {counted}, rejected {}, outputs changed by faults {}",
+            self.rejected(),
+            self.changed
+        );
+        if problems.is_empty() {
+            Ok(())
+        } else {
+            Err(format!("{} check(s) failed (see above)", problems.len()))
+        }
+    }
+}
+
+/// Plays `pass` through the firmware `elf` and runs every check.
+fn play(elf: &Path, pass: &Pass) -> Result<Played, String> {
+    let stream = stream::build(pass)?;
+    let uplink = stream.faulty();
+    println!(
+        "{}: {} NAV samples, {} bytes up ({} injected faults), firmware {}",
+        pass.name,
+        pass.samples.len(),
+        uplink.len(),
+        stream.injected.len(),
+        elf.display()
+    );
+    let t_qemu = Instant::now();
+    let (status, downlink_bytes) = run_qemu(elf, &uplink)?;
+    let firmware = Downlink::decode(&downlink_bytes);
+    let t_twin = Instant::now();
+
+    // The twin: the stream without the injected faults, and a host run of the faulty
+    // stream (whose STATUS must equal the firmware's: same code, same bytes).
+    let (twin, navs) = check::twin(&stream.clean())?;
+    let (faulty_twin, _) = check::twin(&uplink)?;
+    let twin_s = t_twin.elapsed().as_secs_f64();
+
+    let (changed, changed_examples) = compare_with_twin(&firmware, &twin);
+    let controller = check::new_controller()?;
+    let t_check = Instant::now();
+    let (max_rel, max_ticks, compared, reference_failures) =
+        reference_check(pass, &firmware, &navs, &ReferencePlan::new(&controller)?)?;
+    println!(
+        "QEMU run {:.1} s; twin runs and reference check {:.1} s",
+        t_check.duration_since(t_qemu).as_secs_f64() - twin_s,
+        twin_s + t_check.elapsed().as_secs_f64()
+    );
+
+    let final_status = firmware.final_status().copied();
+    let faulty_twin_status = faulty_twin.final_status().copied();
+    let mut count_failures = Vec::new();
+    match (&final_status, &faulty_twin_status) {
+        (Some(fw), Some(host)) => {
+            for f in Fault::ALL {
+                let expected = stream
+                    .injected
+                    .iter()
+                    .filter(|(_, e)| *e == Some(f))
+                    .count() as u32;
+                if fw.count(f) != expected {
+                    count_failures.push(format!(
+                        "fault counter {}: {} in the firmware's STATUS, {expected} injected",
+                        f.name(),
+                        fw.count(f)
+                    ));
+                }
+            }
+            if fw != host {
+                count_failures.push(format!(
+                    "the firmware's final STATUS differs from the host run of the same bytes: {fw:?} vs {host:?}"
+                ));
+            }
+        }
+        _ => count_failures.push("no final STATUS frame".into()),
+    }
+    Ok(Played {
+        tx_bytes: uplink.len(),
+        rx_bytes: downlink_bytes.len(),
+        firmware,
+        status,
+        injected: stream.injected.clone(),
+        noise_bytes: stream.noise_bytes(),
+        max_rel,
+        max_ticks,
+        compared,
+        reference_failures,
+        changed,
+        changed_examples,
+        final_status,
+        count_failures,
+    })
+}
+
+/// Updates whose PERIODS payload differs between the firmware and the twin, matched by
+/// update instant.
+fn compare_with_twin(firmware: &Downlink, twin: &Downlink) -> (usize, Vec<String>) {
+    let fw: BTreeMap<u64, &Vec<u8>> = firmware.periods.iter().map(|(t, p)| (*t, p)).collect();
+    let tw: BTreeMap<u64, &Vec<u8>> = twin.periods.iter().map(|(t, p)| (*t, p)).collect();
+    let mut changed = 0;
+    let mut examples = Vec::new();
+    let instants: std::collections::BTreeSet<u64> = fw.keys().chain(tw.keys()).copied().collect();
+    for t in instants {
+        let (a, b) = (fw.get(&t), tw.get(&t));
+        if a != b {
+            changed += 1;
+            if examples.len() < 5 {
+                examples.push(format!(
+                    "update at {:.3} s: firmware {}, twin {}",
+                    t as f64 * 1e-6,
+                    describe(a.copied()),
+                    describe(b.copied())
+                ));
+            }
+        }
+    }
+    if fw.len() != firmware.periods.len() || tw.len() != twin.periods.len() {
+        changed += 1;
+        examples.push("two PERIODS frames with the same update instant".into());
+    }
+    (changed, examples)
+}
+
+fn describe(p: Option<&Vec<u8>>) -> String {
+    match p.and_then(|p| Periods::decode(p)) {
+        None => "no update".into(),
+        Some(p) => {
+            let ticks: Vec<String> = p
+                .records()
+                .iter()
+                .map(|r| format!("{}{}", r.ticks, if r.held { "h" } else { "" }))
+                .collect();
+            format!("mode {} ticks [{}]", p.mode, ticks.join(" "))
+        }
+    }
+}
+
+/// Every fresh (not held) period of the firmware against the reference at its update
+/// instant. Returns the largest relative difference, the count, the failures.
+fn reference_check(
+    pass: &Pass,
+    firmware: &Downlink,
+    navs: &BTreeMap<u64, controller::control::NavState>,
+    plan: &ReferencePlan,
+) -> Result<(f64, f64, usize, Vec<String>), String> {
+    let earth_radius_m = Config::default().earth_radius_m;
+    let mut max_rel = 0.0f64;
+    let mut max_ticks = 0.0f64;
+    let mut compared = 0;
+    let mut failures = Vec::new();
+    for (t_us, periods) in firmware.decoded() {
+        if !periods.records().iter().any(|r| !r.held) {
+            continue;
+        }
+        let geometry = match &pass.truth {
+            Truth::Circular { .. } => pass.truth.geometry(t_us as f64 * 1e-6),
+            Truth::Telemetry => navs
+                .get(&t_us)
+                .map(|nav| check::propagated(nav, t_us, earth_radius_m)),
+        };
+        let Some(g) = geometry else {
+            failures.push(format!(
+                "update at {:.3} s: no state to compare with",
+                t_us as f64 * 1e-6
+            ));
+            continue;
+        };
+        let reference = plan.ticks(&g)?;
+        for r in periods.records().iter().filter(|r| !r.held) {
+            let Some(&exact) = reference.get(&r.index) else {
+                failures.push(format!("segment {} is not in the plan", r.index));
+                continue;
+            };
+            let diff = (f64::from(r.ticks) - exact).abs();
+            let rel = diff / exact;
+            max_rel = max_rel.max(rel);
+            max_ticks = max_ticks.max(diff);
+            compared += 1;
+            if diff > F32_REL_TOLERANCE * exact + 0.5 {
+                failures.push(format!(
+                    "update at {:.3} s, segment {}: {} ticks, reference {exact:.3} (relative {rel:.2e})",
+                    t_us as f64 * 1e-6,
+                    r.index,
+                    r.ticks
+                ));
+            }
+        }
+    }
+    Ok((max_rel, max_ticks, compared, failures))
+}
+
+/// Starts QEMU with UART0 on a unix socket, sends `uplink`, returns the firmware's
+/// exit status and everything it sent.
+fn run_qemu(elf: &Path, uplink: &[u8]) -> Result<(i32, Vec<u8>), String> {
+    let socket = std::env::temp_dir().join(format!(
+        "tdi-pass-{}-{}.sock",
+        std::process::id(),
+        std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map_or(0, |d| d.subsec_nanos())
+    ));
+    let _ = std::fs::remove_file(&socket);
+    let listener = UnixListener::bind(&socket)
+        .map_err(|e| format!("cannot listen on {}: {e}", socket.display()))?;
+    let options = qemu::Options {
+        extra_args: vec![
+            "-chardev".into(),
+            format!("socket,id=telemetry,path={}", socket.display()),
+        ],
+        serial: Some("chardev:telemetry".into()),
+        capture: false,
+    };
+    let elf_owned = elf.to_path_buf();
+    let emulator = std::thread::spawn(move || qemu::run_elf(&elf_owned, &options));
+
+    // QEMU connects as soon as it starts; give up if it ends first or takes too long.
+    listener
+        .set_nonblocking(true)
+        .map_err(|e| format!("socket: {e}"))?;
+    let t0 = Instant::now();
+    let conn = loop {
+        match listener.accept() {
+            Ok((conn, _)) => break Ok(conn),
+            Err(e) if e.kind() == std::io::ErrorKind::WouldBlock => {
+                if emulator.is_finished() || t0.elapsed() > Duration::from_secs(30) {
+                    break Err("QEMU did not connect to the telemetry socket".to_string());
+                }
+                std::thread::sleep(Duration::from_millis(10));
+            }
+            Err(e) => break Err(format!("accepting QEMU's connection: {e}")),
+        }
+    };
+    let _ = std::fs::remove_file(&socket);
+    let conn = match conn {
+        Ok(c) => c,
+        Err(e) => {
+            let outcome = emulator.join();
+            return Err(match outcome {
+                Ok(Err(q)) => format!("{e}: {q}"),
+                _ => e,
+            });
+        }
+    };
+    conn.set_nonblocking(false)
+        .map_err(|e| format!("socket: {e}"))?;
+    let mut writer = conn.try_clone().map_err(|e| format!("socket: {e}"))?;
+    let data = uplink.to_vec();
+    // The firmware reads as fast as it computes; the writer blocks when QEMU's side is
+    // full, while this thread drains the downlink so that the firmware never waits.
+    let sender = std::thread::spawn(move || -> Result<(), String> {
+        for chunk in data.chunks(4096) {
+            writer
+                .write_all(chunk)
+                .map_err(|e| format!("sending telemetry: {e}"))?;
+        }
+        writer
+            .flush()
+            .map_err(|e| format!("sending telemetry: {e}"))
+    });
+    let mut downlink = Vec::new();
+    let mut reader = conn;
+    let read = reader.read_to_end(&mut downlink);
+    let outcome = emulator
+        .join()
+        .map_err(|_| "the QEMU thread panicked".to_string())??;
+    let sent = sender
+        .join()
+        .map_err(|_| "the sender thread panicked".to_string())?;
+    read.map_err(|e| format!("reading the downlink: {e}"))?;
+    if let Err(e) = sent {
+        return Err(format!(
+            "{e} (the firmware exited with status {})",
+            outcome.status
+        ));
+    }
+    Ok((outcome.status, downlink))
+}
+
+fn mode_name(m: u8) -> &'static str {
+    match mode_from_u8(m) {
+        Some(Mode::WaitingForNav) => "waiting",
+        Some(Mode::Nominal) => "nominal",
+        Some(Mode::Stale) => "STALE",
+        None => "?",
+    }
+}
+
+/// One row per `every_s` simulated seconds: the update at (or first after) that
+/// instant, the chosen segments' period (us), MTF and TDI stage limit, and the faults
+/// counted since the previous row.
+fn print_table(pass: &Pass, played: &Played, every_s: u64, segments: &[u8]) {
+    let decoded = played.firmware.decoded();
+    // Only segments the firmware reported.
+    let segments: Vec<u8> = segments
+        .iter()
+        .copied()
+        .filter(|s| {
+            decoded
+                .iter()
+                .any(|(_, p)| p.records().iter().any(|r| r.index == *s))
+        })
+        .collect();
+    println!(
+        "\nfirmware downlink: {} PERIODS and {} STATUS frames, {} bytes ({} bytes up)",
+        played.firmware.periods.len(),
+        played.firmware.status.len(),
+        played.rx_bytes,
+        played.tx_bytes
+    );
+    let mut header = format!("{:>6} {:>8} {:>6}", "t_s", "mode", "roll");
+    for &s in &segments {
+        header.push_str(&format!(
+            " | seg {s}: {:>9} {:>6} {:>3}",
+            "period_us", "MTF", "M"
+        ));
+    }
+    header.push_str(" | faults since last row");
+    println!("{header}");
+    let mut last_counts = [0u32; Fault::COUNT];
+    let mut next = 0u64;
+    let mut k = 0;
+    while next <= pass.end_us {
+        while k < decoded.len() && decoded[k].0 < next {
+            k += 1;
+        }
+        let Some((t_us, p)) = decoded.get(k) else {
+            break;
+        };
+        let t_s = *t_us as f64 * 1e-6;
+        let roll = pass
+            .truth
+            .roll_deg(t_s)
+            .or_else(|| telemetry_roll_deg(pass, *t_us))
+            .map_or("-".to_string(), |r| format!("{r:.2}"));
+        let mut line = format!("{t_s:>6.1} {:>8} {roll:>6}", mode_name(p.mode));
+        for &s in &segments {
+            match p.records().iter().find(|r| r.index == s) {
+                Some(r) => line.push_str(&format!(
+                    " | {:>16.1}{} {:>6.4} {:>3}",
+                    f64::from(r.ticks) * 0.1,
+                    if r.held { "h" } else { " " },
+                    r.mtf,
+                    r.max_stages
+                )),
+                None => line.push_str(&format!(" | {:>16} {:>6} {:>3}", "-", "-", "-")),
+            }
+        }
+        // Faults counted up to this row (the last STATUS not after it).
+        let counts = played
+            .firmware
+            .status
+            .iter()
+            .take_while(|(ts, _)| *ts <= *t_us)
+            .last()
+            .map_or([0; Fault::COUNT], |(_, s)| s.counts);
+        let new: Vec<String> = Fault::ALL
+            .iter()
+            .filter(|f| counts[**f as usize] > last_counts[**f as usize])
+            .map(|f| {
+                let n = counts[*f as usize] - last_counts[*f as usize];
+                if n > 1 {
+                    format!("{} x{n}", f.name())
+                } else {
+                    f.name().to_string()
+                }
+            })
+            .collect();
+        last_counts = counts;
+        line.push_str(" | ");
+        line.push_str(&new.join(", "));
+        println!("{}", line.trim_end());
+        next += every_s * 1_000_000;
+    }
+    println!("(period in us of the 10 MHz line clock; h: held over a fault; M: largest TDI stage count meeting MTF 0.95)");
+}
+
+/// The roll of the last NAV sample at or before `t_us`, propagated at its rate (deg).
+fn telemetry_roll_deg(pass: &Pass, t_us: u64) -> Option<f64> {
+    let s = pass.samples.iter().rev().find(|s| s.t_us <= t_us)?;
+    let a = s.nav.attitude;
+    let dt = (t_us - s.t_us) as f64 * 1e-6;
+    Some((f64::from(a.roll_rad) + f64::from(a.roll_rate_rad_s) * dt).to_degrees())
+}
+
+/// The line period of every segment over time, as programmed.
+fn plot_periods(pass: &Pass, played: &Played, path: &Path) -> Result<(), String> {
+    let decoded = played.firmware.decoded();
+    let mut series: BTreeMap<u8, Vec<(f64, f64)>> = BTreeMap::new();
+    for (t_us, p) in &decoded {
+        for r in p.records() {
+            series
+                .entry(r.index)
+                .or_default()
+                .push((*t_us as f64 * 1e-6, f64::from(r.ticks) * 1e-4));
+        }
+    }
+    let mut plot = Plot::new(
+        &format!("Line periods programmed by the firmware, {}", pass.name),
+        "time (s)",
+        "line period (ms)",
+    )
+    .legend(Legend::TopRight)
+    .x_range(0.0, (pass.end_us as f64 * 1e-6).max(1.0))
+    .size(1100, 650);
+    for (i, (index, points)) in series.into_iter().enumerate() {
+        plot = plot.series(Series::line(&format!("segment {index}"), points).palette(i));
+    }
+    if let Some(dir) = path.parent() {
+        std::fs::create_dir_all(dir).map_err(|e| format!("creating {}: {e}", dir.display()))?;
+    }
+    plot.save(path)
+}

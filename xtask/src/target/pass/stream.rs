@@ -1,0 +1,277 @@
+//! The byte stream a pass sends: NAV frames at the samples' time tags, TIME frames at
+//! every tick of the update period that has no NAV frame, the injected faults, END.
+//!
+//! Every item knows whether it is an injected fault: the firmware gets all of them, the
+//! host twin only the others ("the stream with the injected faulty frames removed").
+
+use controller::frame::{encode, kind, MAX_FRAME, SYNC};
+use controller::nav::Nav;
+use controller::Fault;
+
+use super::scenario::{us, FaultSpec, Pass, Sample, Truth};
+
+/// One piece of the stream.
+#[derive(Clone, Debug)]
+pub struct Item {
+    pub bytes: Vec<u8>,
+    /// The fault this item injects (None: good telemetry).
+    pub fault: Option<usize>,
+}
+
+/// The built stream and what the injection should produce.
+pub struct Stream {
+    pub items: Vec<Item>,
+    /// Per injected fault: its label and the fault counter it must increment (None:
+    /// noise, which the decoder skips and counts as skipped bytes, not as a fault).
+    pub injected: Vec<(String, Option<Fault>)>,
+}
+
+impl Stream {
+    /// What the firmware receives.
+    pub fn faulty(&self) -> Vec<u8> {
+        self.items
+            .iter()
+            .flat_map(|i| i.bytes.iter().copied())
+            .collect()
+    }
+    /// The same without the injected faults.
+    pub fn clean(&self) -> Vec<u8> {
+        self.items
+            .iter()
+            .filter(|i| i.fault.is_none())
+            .flat_map(|i| i.bytes.iter().copied())
+            .collect()
+    }
+    /// Noise bytes injected.
+    pub fn noise_bytes(&self) -> usize {
+        self.items
+            .iter()
+            .filter(|i| i.fault.is_some() && !i.bytes.starts_with(&SYNC))
+            .map(|i| i.bytes.len())
+            .sum()
+    }
+}
+
+struct Frames {
+    sequence: u16,
+}
+
+impl Frames {
+    fn frame(&mut self, kind: u8, time_us: u64, payload: &[u8]) -> Vec<u8> {
+        let mut buf = [0u8; MAX_FRAME];
+        let n = encode(kind, self.sequence, time_us, payload, &mut buf).unwrap_or(0);
+        self.sequence = self.sequence.wrapping_add(1);
+        buf[..n].to_vec()
+    }
+    fn nav(&mut self, time_us: u64, nav: &Nav) -> Vec<u8> {
+        let mut payload = [0u8; 128];
+        let n = nav.encode(&mut payload).unwrap_or(0);
+        self.frame(kind::NAV, time_us, &payload[..n])
+    }
+}
+
+/// Where a NAV or extra frame goes in time order.
+enum Slot {
+    Nav(Sample),
+    Time(u64),
+}
+
+/// Builds the stream of `pass`.
+pub fn build(pass: &Pass) -> Result<Stream, String> {
+    // NAV samples in their order; TIME ticks in between where no NAV has the instant.
+    let mut slots = Vec::new();
+    let mut next_tick = 0u64;
+    let tick = pass.tick_us.max(1);
+    let mut last_t = None;
+    for s in &pass.samples {
+        if last_t.is_none_or(|l| s.t_us > l) {
+            while next_tick < s.t_us {
+                slots.push(Slot::Time(next_tick));
+                next_tick += tick;
+            }
+            if next_tick == s.t_us {
+                next_tick += tick;
+            }
+            last_t = Some(s.t_us);
+        }
+        slots.push(Slot::Nav(*s));
+    }
+    while next_tick <= pass.end_us {
+        slots.push(Slot::Time(next_tick));
+        next_tick += tick;
+    }
+
+    let mut frames = Frames { sequence: 0 };
+    let mut items: Vec<Item> = Vec::with_capacity(slots.len() + 16);
+    // Index of the item carrying the NAV frame of each instant.
+    let mut nav_item = std::collections::HashMap::new();
+    for slot in &slots {
+        match slot {
+            Slot::Nav(s) => {
+                nav_item.insert(s.t_us, items.len());
+                items.push(Item {
+                    bytes: frames.nav(s.t_us, &s.nav),
+                    fault: None,
+                });
+            }
+            Slot::Time(t) => items.push(Item {
+                bytes: frames.frame(kind::TIME, *t, &[]),
+                fault: None,
+            }),
+        }
+    }
+
+    let mut injected = Vec::new();
+    // Extra items, inserted after building (index to insert before, item).
+    let mut extra: Vec<(usize, Item)> = Vec::new();
+    let item_at = |t_s: f64| -> Result<usize, String> {
+        nav_item
+            .get(&us(t_s))
+            .copied()
+            .ok_or_else(|| format!("no NAV frame at {t_s} s to inject a fault into"))
+    };
+    // The first item whose frame is time-tagged after `t_us` (extra frames go before it).
+    let times: Vec<u64> = slots
+        .iter()
+        .map(|s| match s {
+            Slot::Nav(n) => n.t_us,
+            Slot::Time(t) => *t,
+        })
+        .collect();
+    let after = |t_us: u64| times.iter().position(|&t| t > t_us).unwrap_or(times.len());
+    let truth_nav = |t_s: f64| -> Result<Nav, String> {
+        match &pass.truth {
+            Truth::Circular { orbit, roll } => Ok(super::scenario::true_nav(orbit, roll, t_s)),
+            Truth::Telemetry => Err("faults are injected into the built-in passes only".into()),
+        }
+    };
+    for (k, f) in pass.faults.iter().enumerate() {
+        let expect = match *f {
+            FaultSpec::BitFlip { t_s } => {
+                let i = item_at(t_s)?;
+                items[i].bytes = bit_flip(&items[i].bytes)?;
+                items[i].fault = Some(k);
+                Some(Fault::BadCrc)
+            }
+            FaultSpec::Truncate { t_s } => {
+                let i = item_at(t_s)?;
+                items[i].bytes = truncate(&items[i].bytes)?;
+                items[i].fault = Some(k);
+                Some(Fault::Truncated)
+            }
+            FaultSpec::Noise { t_s, bytes } => {
+                extra.push((
+                    after(us(t_s)),
+                    Item {
+                        bytes: noise(bytes, k as u64),
+                        fault: Some(k),
+                    },
+                ));
+                None
+            }
+            FaultSpec::Backwards { t_s, back_s } => {
+                let t_old = t_s - back_s;
+                let bytes = frames.nav(us(t_old), &truth_nav(t_old)?);
+                extra.push((
+                    after(us(t_s)),
+                    Item {
+                        bytes,
+                        fault: Some(k),
+                    },
+                ));
+                Some(Fault::TimeWentBackwards)
+            }
+            FaultSpec::NaN { t_s } => {
+                let mut nav = truth_nav(t_s)?;
+                nav.state.velocity_mps[0] = f64::NAN;
+                let bytes = frames.nav(us(t_s), &nav);
+                extra.push((
+                    after(us(t_s)),
+                    Item {
+                        bytes,
+                        fault: Some(k),
+                    },
+                ));
+                Some(Fault::NonFinite)
+            }
+            FaultSpec::Altitude { t_s, altitude_m } => {
+                let mut nav = truth_nav(t_s)?;
+                let r = nav.state.position_m;
+                let norm = (r[0] * r[0] + r[1] * r[1] + r[2] * r[2]).sqrt();
+                let Truth::Circular { orbit, .. } = &pass.truth else {
+                    return Err("faults are injected into the built-in passes only".into());
+                };
+                let scale = (orbit.earth_radius_m + altitude_m) / norm;
+                nav.state.position_m = r.map(|x| x * scale);
+                let bytes = frames.nav(us(t_s), &nav);
+                extra.push((
+                    after(us(t_s)),
+                    Item {
+                        bytes,
+                        fault: Some(k),
+                    },
+                ));
+                Some(Fault::OutOfRange)
+            }
+            // Cut out of the samples already: missing telemetry, in both runs.
+            FaultSpec::Gap { .. } => Some(Fault::Stale),
+        };
+        injected.push((f.label(), expect));
+    }
+    // Insert from the back so that earlier indices stay valid; equal indices keep
+    // their order.
+    extra.sort_by_key(|(i, _)| *i);
+    for (i, item) in extra.into_iter().rev() {
+        items.insert(i, item);
+    }
+    items.push(Item {
+        bytes: frames.frame(kind::END, pass.end_us + 1, &[]),
+        fault: None,
+    });
+    Ok(Stream { items, injected })
+}
+
+/// True when `bytes` holds the sync word anywhere.
+fn has_sync(bytes: &[u8]) -> bool {
+    bytes.windows(2).any(|w| w == SYNC)
+}
+
+/// The frame with one payload bit flipped: the first bit whose flip leaves no sync word
+/// inside the frame, so that the decoder sees exactly one bad CRC and then skips the
+/// frame's remains.
+fn bit_flip(frame: &[u8]) -> Result<Vec<u8>, String> {
+    let header = controller::frame::HEADER_LEN;
+    for bit in 0..(frame.len() - header - 2) * 8 {
+        let mut f = frame.to_vec();
+        f[header + bit / 8] ^= 1 << (bit % 8);
+        if !has_sync(&f[1..]) {
+            return Ok(f);
+        }
+    }
+    Err("no bit of the frame could be flipped cleanly".into())
+}
+
+/// The frame cut after its header and 20 payload bytes (no sync word in the remains).
+fn truncate(frame: &[u8]) -> Result<Vec<u8>, String> {
+    let f = frame[..controller::frame::HEADER_LEN + 20].to_vec();
+    if has_sync(&f[1..]) {
+        return Err("the truncated frame holds a sync word: pick another instant".into());
+    }
+    Ok(f)
+}
+
+/// Deterministic line noise without the sync word's first byte.
+fn noise(n: usize, seed: u64) -> Vec<u8> {
+    let mut x = 0x9E37_79B9_7F4A_7C15u64 ^ seed;
+    let mut out = Vec::with_capacity(n);
+    while out.len() < n {
+        x = x
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        let b = (x >> 56) as u8;
+        if b != SYNC[0] {
+            out.push(b);
+        }
+    }
+    out
+}

@@ -1,0 +1,227 @@
+//! QEMU as the cargo runner for thumbv7em-none-eabihf, with the defmt stream decoded on
+//! the host (the `defmt-decoder` crate, pinned to 1.2.x in xtask/Cargo.toml).
+//!
+//! The firmware logs defmt frames to semihosting stdout (`defmt-semihosting`); QEMU
+//! writes them to its stdout (`-semihosting-config target=native`), the UART goes
+//! nowhere (`-serial none`) or to a chardev of the caller's (`Options::serial`: the
+//! pass player's unix socket), never to stdout, so that no other byte mixes in; QEMU's
+//! exit status is the firmware's semihosting exit code.
+
+use std::collections::BTreeMap;
+use std::io::{Read, Write};
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+use defmt_decoder::{DecodeError, Frame, Location, Table};
+
+pub const QEMU: &str = "qemu-system-arm";
+pub const MACHINE: &str = "mps2-an386";
+/// Wall-clock limit of one QEMU run unless `TDI_QEMU_TIMEOUT_S` says otherwise: a hung
+/// firmware fails the command instead of blocking it.
+const DEFAULT_TIMEOUT_S: u64 = 300;
+
+/// How to run one ELF.
+#[derive(Default)]
+pub struct Options {
+    /// Extra QEMU arguments (e.g. `-plugin ...`).
+    pub extra_args: Vec<String>,
+    /// Keep the decoded messages (without level and location) for the caller.
+    pub capture: bool,
+    /// QEMU's `-serial` for UART0 (None: `none`, nothing connected), e.g.
+    /// `chardev:ID` with a `-chardev ...,id=ID` in `extra_args`.
+    pub serial: Option<String>,
+}
+
+/// What a run gave.
+pub struct Outcome {
+    /// The firmware's exit status.
+    pub status: i32,
+    /// The decoded messages, when captured.
+    pub messages: Vec<String>,
+}
+
+/// `cargo xtask qemu ELF [ARGS]`: the runner cargo calls for `cargo run` / `cargo test`
+/// on thumbv7em. Exits with the firmware's status.
+pub fn qemu(args: &[String]) -> Result<(), String> {
+    let Some((elf, rest)) = args.split_first() else {
+        return Err("qemu: usage: qemu ELF (the cargo runner for thumbv7em-none-eabihf)".into());
+    };
+    if !rest.is_empty() {
+        eprintln!("xtask qemu: ignoring arguments {rest:?} (the firmware takes none)");
+    }
+    let outcome = run_elf(Path::new(elf), &Options::default())?;
+    super::exit_like(outcome.status)
+}
+
+/// Runs `elf` under QEMU, prints its decoded defmt log on stdout and returns its exit
+/// status.
+pub fn run_elf(elf: &Path, options: &Options) -> Result<Outcome, String> {
+    let bytes = std::fs::read(elf).map_err(|e| format!("cannot read {}: {e}", elf.display()))?;
+    let table =
+        Table::parse(&bytes).map_err(|e| format!("bad defmt table in {}: {e}", elf.display()))?;
+    let locations = match &table {
+        Some(t) => t.get_locations(&bytes).unwrap_or_default(),
+        None => BTreeMap::new(),
+    };
+
+    let mut cmd = Command::new(QEMU);
+    cmd.args([
+        "-cpu",
+        "cortex-m4",
+        "-machine",
+        MACHINE,
+        "-nographic",
+        "-monitor",
+        "none",
+    ])
+    .arg("-serial")
+    .arg(options.serial.as_deref().unwrap_or("none"))
+    .args(["-semihosting-config", "enable=on,target=native"])
+    .args(&options.extra_args)
+    .arg("-kernel")
+    .arg(elf)
+    .stdin(Stdio::null())
+    .stdout(Stdio::piped())
+    .stderr(Stdio::inherit());
+    let mut child = cmd.spawn().map_err(|e| {
+        format!("cannot start {QEMU} (run `cargo xtask run` once to install it): {e}")
+    })?;
+    let stdout = child.stdout.take().ok_or("no stdout from QEMU")?;
+    let child = Arc::new(Mutex::new(child));
+    let watchdog = spawn_watchdog(Arc::clone(&child), timeout());
+
+    let mut printer = Printer {
+        locations: &locations,
+        root: super::workspace_root(),
+        capture: options.capture,
+        messages: Vec::new(),
+    };
+    let read = match &table {
+        Some(table) => decode_stream(table, stdout, &mut printer),
+        None => copy_raw(stdout),
+    };
+    let timed_out = watchdog.join().unwrap_or(false);
+    let status = lock(&child)
+        .wait()
+        .map_err(|e| format!("waiting for QEMU: {e}"))?;
+    read?;
+    if timed_out {
+        return Err(format!(
+            "QEMU timed out after {} s and was killed (set TDI_QEMU_TIMEOUT_S to change the limit)",
+            timeout().as_secs()
+        ));
+    }
+    let status = status
+        .code()
+        .ok_or_else(|| format!("QEMU ended without an exit code ({status})"))?;
+    Ok(Outcome {
+        status,
+        messages: printer.messages,
+    })
+}
+
+fn timeout() -> Duration {
+    let secs = std::env::var("TDI_QEMU_TIMEOUT_S")
+        .ok()
+        .and_then(|s| s.trim().parse().ok())
+        .unwrap_or(DEFAULT_TIMEOUT_S);
+    Duration::from_secs(secs)
+}
+
+fn lock(child: &Mutex<Child>) -> std::sync::MutexGuard<'_, Child> {
+    child
+        .lock()
+        .unwrap_or_else(|poisoned| poisoned.into_inner())
+}
+
+/// Kills QEMU after `limit`; returns whether it had to.
+fn spawn_watchdog(child: Arc<Mutex<Child>>, limit: Duration) -> std::thread::JoinHandle<bool> {
+    std::thread::spawn(move || {
+        let start = Instant::now();
+        loop {
+            {
+                let mut c = lock(&child);
+                if let Ok(Some(_)) = c.try_wait() {
+                    return false;
+                }
+                if start.elapsed() > limit {
+                    let _ = c.kill();
+                    return true;
+                }
+            }
+            std::thread::sleep(Duration::from_millis(20));
+        }
+    })
+}
+
+struct Printer<'a> {
+    locations: &'a BTreeMap<u64, Location>,
+    root: PathBuf,
+    capture: bool,
+    messages: Vec<String>,
+}
+
+impl Printer<'_> {
+    /// One plain line per frame: level, message, and for warnings and errors the
+    /// source location.
+    fn frame(&mut self, frame: &Frame<'_>) {
+        let message = frame.display_message().to_string();
+        let level = frame.level().map(|l| l.as_str().to_uppercase());
+        // `defmt::println!` frames have no level: printed as they are.
+        let mut line = match &level {
+            Some(level) => format!("{level:<5} {message}"),
+            None => message.clone(),
+        };
+        if matches!(level.as_deref(), Some("WARN" | "ERROR")) {
+            if let Some(loc) = self.locations.get(&frame.index()) {
+                let file = loc.file.strip_prefix(&self.root).unwrap_or(&loc.file);
+                line.push_str(&format!("\n      at {}:{}", file.display(), loc.line));
+            }
+        }
+        let mut out = std::io::stdout().lock();
+        let _ = writeln!(out, "{line}");
+        let _ = out.flush();
+        if self.capture {
+            self.messages.push(message);
+        }
+    }
+}
+
+fn decode_stream(
+    table: &Table,
+    mut input: impl Read,
+    printer: &mut Printer<'_>,
+) -> Result<(), String> {
+    let mut decoder = table.new_stream_decoder();
+    let mut buf = [0u8; 4096];
+    loop {
+        let n = match input.read(&mut buf) {
+            Ok(0) => return Ok(()),
+            Ok(n) => n,
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
+            Err(e) => return Err(format!("reading QEMU's output: {e}")),
+        };
+        decoder.received(buf.get(..n).unwrap_or(&[]));
+        loop {
+            match decoder.decode() {
+                Ok(frame) => printer.frame(&frame),
+                Err(DecodeError::UnexpectedEof) => break,
+                Err(DecodeError::Malformed) => {
+                    if table.encoding().can_recover() {
+                        eprintln!("xtask qemu: skipped a malformed defmt frame");
+                    } else {
+                        return Err("malformed defmt frame (raw encoding: cannot resync)".into());
+                    }
+                }
+            }
+        }
+    }
+}
+
+fn copy_raw(mut input: impl Read) -> Result<(), String> {
+    std::io::copy(&mut input, &mut std::io::stdout().lock())
+        .map(|_| ())
+        .map_err(|e| format!("reading QEMU's output: {e}"))
+}

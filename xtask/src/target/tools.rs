@@ -1,0 +1,122 @@
+//! Making sure the target toolchain and QEMU are there, installing them where we can.
+
+use std::process::{Command, Stdio};
+
+use super::TARGET;
+
+/// The Rust target (rustup) and qemu-system-arm with the mps2-an386 machine. Installs
+/// the target with rustup and QEMU with apt-get when running as root; otherwise an
+/// error that says what to install.
+pub fn ensure_target_tools() -> Result<(), String> {
+    ensure_rust_target()?;
+    ensure_qemu()
+}
+
+fn ensure_rust_target() -> Result<(), String> {
+    let installed = Command::new("rustup")
+        .args(["target", "list", "--installed"])
+        .output();
+    match installed {
+        Ok(out) if out.status.success() => {
+            if String::from_utf8_lossy(&out.stdout)
+                .lines()
+                .any(|l| l.trim() == TARGET)
+            {
+                return Ok(());
+            }
+            eprintln!("xtask: rustup target add {TARGET}");
+            let status = Command::new("rustup")
+                .args(["target", "add", TARGET])
+                .status()
+                .map_err(|e| format!("cannot run rustup: {e}"))?;
+            if status.success() {
+                Ok(())
+            } else {
+                Err(format!("`rustup target add {TARGET}` failed ({status})"))
+            }
+        }
+        _ => {
+            // No rustup: accept a toolchain that already has the target's core library.
+            let sysroot = Command::new("rustc").args(["--print", "sysroot"]).output();
+            let has_core = sysroot.ok().is_some_and(|o| {
+                let root = String::from_utf8_lossy(&o.stdout).trim().to_string();
+                std::path::Path::new(&root)
+                    .join("lib/rustlib")
+                    .join(TARGET)
+                    .is_dir()
+            });
+            if has_core {
+                Ok(())
+            } else {
+                Err(format!(
+                    "no rustup, and the toolchain lacks {TARGET}: install rustup and run `rustup target add {TARGET}`"
+                ))
+            }
+        }
+    }
+}
+
+/// True when `program --version` runs.
+pub(super) fn have(program: &str) -> bool {
+    Command::new(program)
+        .arg("--version")
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .status()
+        .is_ok_and(|s| s.success())
+}
+
+fn is_root() -> bool {
+    Command::new("id")
+        .arg("-u")
+        .output()
+        .is_ok_and(|o| String::from_utf8_lossy(&o.stdout).trim() == "0")
+}
+
+/// Installs Debian packages when root, else explains what to install.
+pub(super) fn apt_install(packages: &[&str], why: &str) -> Result<(), String> {
+    let list = packages.join(" ");
+    if !is_root() || !have("apt-get") {
+        return Err(format!(
+            "{why} is missing: install it (Debian/Ubuntu: `sudo apt-get install -y {list}`) and retry"
+        ));
+    }
+    eprintln!("xtask: {why} is missing; apt-get update && apt-get install -y {list}");
+    let update = Command::new("apt-get")
+        .args(["update"])
+        .status()
+        .map_err(|e| format!("cannot run apt-get: {e}"))?;
+    if !update.success() {
+        return Err(format!("`apt-get update` failed ({update})"));
+    }
+    let install = Command::new("apt-get")
+        .args(["install", "-y"])
+        .args(packages)
+        .env("DEBIAN_FRONTEND", "noninteractive")
+        .status()
+        .map_err(|e| format!("cannot run apt-get: {e}"))?;
+    if install.success() {
+        Ok(())
+    } else {
+        Err(format!("`apt-get install -y {list}` failed ({install})"))
+    }
+}
+
+fn ensure_qemu() -> Result<(), String> {
+    if !have(super::qemu::QEMU) {
+        apt_install(&["qemu-system-arm"], "qemu-system-arm")?;
+    }
+    let machines = Command::new(super::qemu::QEMU)
+        .args(["-machine", "help"])
+        .output()
+        .map_err(|e| format!("cannot run {}: {e}", super::qemu::QEMU))?;
+    if String::from_utf8_lossy(&machines.stdout).contains(super::qemu::MACHINE) {
+        Ok(())
+    } else {
+        Err(format!(
+            "{} has no `{}` machine: QEMU 6.0 or newer is needed",
+            super::qemu::QEMU,
+            super::qemu::MACHINE
+        ))
+    }
+}
