@@ -139,6 +139,26 @@ impl<T: Real> Backend for ClosedForm<T> {
 
     #[inline]
     fn motion(&self, u: &UpdateConst<T>, p: &PixelConst<T>) -> Result<ImageMotion<T>, ModelError> {
+        self.motion_terms::<true, true>(u, p)
+    }
+}
+
+impl<T: Real> ClosedForm<T> {
+    /// The closed form with terms a scene plan has proved it can do without:
+    /// - `LIMB = false` skips the limb-distance form and uses 1 - k|sin eta| directly,
+    ///   valid where every line of sight stays at least [`LIMB_BRANCH_RAD`] from the limb
+    ///   (there both forms agree to T's precision; the sign test still refuses a ray that
+    ///   misses the Earth);
+    /// - `DRIFT = false` returns v2 = 0 without computing it, valid where
+    ///   (v2/v1)^2 / 2, the relative change of |v_P|, is under the budget.
+    ///
+    /// `motion` is `motion_terms::<true, true>`.
+    #[inline(always)]
+    pub fn motion_terms<const LIMB: bool, const DRIFT: bool>(
+        &self,
+        u: &UpdateConst<T>,
+        p: &PixelConst<T>,
+    ) -> Result<ImageMotion<T>, ModelError> {
         let sin_eta = u.sin_roll * p.cos_field + u.cos_roll * p.sin_field;
         let cos_eta = u.cos_roll * p.cos_field - u.sin_roll * p.sin_field;
         // The near root of the ray/sphere quadratic lies in front of the camera only
@@ -149,24 +169,33 @@ impl<T: Real> Backend for ClosedForm<T> {
         // Angular distance delta = L - |eta| to the limb the ray looks toward. The hi
         // parts cancel exactly (Sterbenz) near the limb, so delta keeps T's relative
         // precision however small it is.
-        let delta = if sin_eta >= T::ZERO {
-            (u.limb_left_hi_rad - p.field_hi_rad) + (u.limb_left_lo_rad - p.field_lo_rad)
-        } else {
-            (u.limb_right_hi_rad + p.field_hi_rad) + (u.limb_right_lo_rad + p.field_lo_rad)
-        };
-        if !(delta > T::ZERO) {
-            return Err(ModelError::LineOfSightMissesEarth);
-        }
         let ks = u.k * sin_eta;
         let abs_ks = if ks < T::ZERO { -ks } else { ks };
-        // 1 - k|sin eta|: near the limb from delta, where 1 - k|sin eta| =
-        // 2 s (s + sqrt(k^2-1) c), s = sin(delta/2), c = cos(delta/2), all terms positive;
-        // elsewhere directly, where it is not small and a rounding of ks costs little.
-        let one_minus = if delta < T::from_f64(LIMB_BRANCH_RAD) {
-            let (s, c) = T::small_sin_cos(T::from_f64(0.5) * delta);
-            (s + s) * (s + u.sqrt_c0 * c)
+        let one_minus = if LIMB {
+            let delta = if sin_eta >= T::ZERO {
+                (u.limb_left_hi_rad - p.field_hi_rad) + (u.limb_left_lo_rad - p.field_lo_rad)
+            } else {
+                (u.limb_right_hi_rad + p.field_hi_rad) + (u.limb_right_lo_rad + p.field_lo_rad)
+            };
+            if !(delta > T::ZERO) {
+                return Err(ModelError::LineOfSightMissesEarth);
+            }
+            // 1 - k|sin eta|: near the limb from delta, where 1 - k|sin eta| =
+            // 2 s (s + sqrt(k^2-1) c), s = sin(delta/2), c = cos(delta/2), all terms
+            // positive; elsewhere directly, where it is not small and a rounding of ks
+            // costs little.
+            if delta < T::from_f64(LIMB_BRANCH_RAD) {
+                let (s, c) = T::small_sin_cos(T::from_f64(0.5) * delta);
+                (s + s) * (s + u.sqrt_c0 * c)
+            } else {
+                T::ONE - abs_ks
+            }
         } else {
-            T::ONE - abs_ks
+            let m = T::ONE - abs_ks;
+            if !(m > T::ZERO) {
+                return Err(ModelError::LineOfSightMissesEarth);
+            }
+            m
         };
         let q2 = one_minus * (T::ONE + T::ONE - one_minus);
         let q = q2.sqrt();
@@ -174,7 +203,11 @@ impl<T: Real> Backend for ClosedForm<T> {
         let cos_theta = q * cos_eta + ks * sin_eta;
         Ok(ImageMotion {
             v1_mps: p.w1_m * (u.b_rad_s * cos_theta * den - u.c_rad_s * sin_eta),
-            v2_mps: -(p.w2_m * u.a_rad_s * q * den),
+            v2_mps: if DRIFT {
+                -(p.w2_m * u.a_rad_s * q * den)
+            } else {
+                T::ZERO
+            },
         })
     }
 }
