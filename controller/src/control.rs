@@ -343,19 +343,20 @@ impl Controller {
         k: usize,
     ) -> Result<SegmentOutput, Fault> {
         let seg = &self.plan.segments[k];
-        let mut v_min = f32::INFINITY;
-        let mut v_max = 0.0f32;
-        let mut drift_rad = 0.0f32;
-        let centre = usize::from(seg.n_samples) / 2;
-        for (i, p) in seg.samples().iter().enumerate() {
-            let m = CLOSED_F32.motion(update, p)?;
-            let v = m.speed_mps();
-            v_min = v_min.min(v);
-            v_max = v_max.max(v);
-            if i == centre {
-                drift_rad = libm::atanf(m.v2_mps / m.v1_mps);
-            }
-        }
+        // One monomorphisation per plan: the terms are chosen once, not per sample.
+        let (v_min, v_max) = match (self.plan.terms.limb, self.plan.terms.drift) {
+            (true, true) => extremes::<true, true>(update, seg.samples())?,
+            (true, false) => extremes::<true, false>(update, seg.samples())?,
+            (false, true) => extremes::<false, true>(update, seg.samples())?,
+            (false, false) => extremes::<false, false>(update, seg.samples())?,
+        };
+        // The drift angle needs v2 at one point, whatever the plan left out.
+        let centre = seg
+            .samples()
+            .get(seg.samples().len() / 2)
+            .ok_or(Fault::InvalidScene)?;
+        let m = CLOSED_F32.motion(update, centre)?;
+        let drift_rad = libm::atanf(m.v2_mps / m.v1_mps);
         // The period minimising the worst relative mismatch over [v_min, v_max]: the
         // line speed equal to the harmonic mean of the extremes, i.e. the mean of the
         // extremes' periods.
@@ -387,6 +388,22 @@ impl Controller {
             held: false,
         })
     }
+}
+
+/// Smallest and largest |v_P| over a segment's samples, with the plan's terms.
+fn extremes<const LIMB: bool, const DRIFT: bool>(
+    update: &core_math::closed_form::UpdateConst<f32>,
+    samples: &[core_math::closed_form::PixelConst<f32>],
+) -> Result<(f32, f32), Fault> {
+    let mut v_min = f32::INFINITY;
+    let mut v_max = 0.0f32;
+    for p in samples {
+        let m = CLOSED_F32.motion_terms::<LIMB, DRIFT>(update, p)?;
+        let v = if DRIFT { m.speed_mps() } else { m.v1_mps.abs() };
+        v_min = v_min.min(v);
+        v_max = v_max.max(v);
+    }
+    Ok((v_min, v_max))
 }
 
 /// The physically possible line periods for `scene` over the configured altitudes, from

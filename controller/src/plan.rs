@@ -12,7 +12,7 @@
 //! smallest sample count meeting the budget. The controller's tests check the result
 //! against dense evaluations of the f64 reference.
 
-use core_math::closed_form::{PixelConst, UpdateConst};
+use core_math::closed_form::{PixelConst, UpdateConst, LIMB_BRANCH_RAD};
 use core_math::{Backend, Geometry, StageRule, CLOSED_F32, EARTH_RATE_RAD_S};
 
 use crate::fault::Fault;
@@ -60,9 +60,39 @@ impl SegmentPlan {
     }
 }
 
+/// Which optional terms of the closed form a plan evaluates.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Terms {
+    /// The limb-distance form (needed only within [`LIMB_BRANCH_RAD`] of the limb).
+    pub limb: bool,
+    /// v2 in |v_P| (its share of |v_P| is (v2/v1)^2 / 2).
+    pub drift: bool,
+}
+
+impl Terms {
+    pub const ALL: Terms = Terms {
+        limb: true,
+        drift: true,
+    };
+}
+
+/// Share of a segment's mismatch budget that left-out terms may use.
+pub const TERM_SHARE: f64 = 0.1;
+
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Plan {
     pub segments: [SegmentPlan; MAX_SEGMENTS],
+    /// The terms every update evaluates.
+    pub terms: Terms,
+    /// Smallest angular distance from any sample's line of sight to the limb over the
+    /// envelope (rad), computed from the lowest limb angle (highest altitude) and the
+    /// largest roll plus field angle. The limb form is left out when it is at least
+    /// [`LIMB_BRANCH_RAD`].
+    pub limb_margin_rad: f32,
+    /// Largest relative change of |v_P| from leaving v2 out, (v2/v1)^2 / 2 over the
+    /// probe grid at every sample, doubled. v2 is left out when it is under
+    /// [`TERM_SHARE`] of the smallest segment budget.
+    pub drift_bound: f32,
     /// Number of active segments (entries in `segments`).
     pub count: u8,
     pub pixel_m: f32,
@@ -144,8 +174,46 @@ fn curvature(
     Ok(c)
 }
 
+/// (limb margin, drift bound) of a plan's samples over the envelope; see [`Plan`].
+fn term_bounds(
+    scene: &Scene,
+    env: &Envelope,
+    segments: &[SegmentPlan],
+    updates: &[Option<UpdateConst<f32>>],
+) -> (f64, f64) {
+    let r = env.earth_radius_m;
+    let limb = libm::asin(r / (r + env.altitude_range_m.1));
+    let mut widest = 0.0f64;
+    let mut drift = 0.0f64;
+    for seg in segments {
+        for (&n, p) in seg.sample_px().iter().zip(seg.samples()) {
+            let tan = f64::from(n) * scene.camera.pixel_m / scene.camera.focal_m;
+            widest = widest.max(libm::fabs(libm::atan(tan)));
+            for u in updates.iter().flatten() {
+                if let Ok(m) = CLOSED_F32.motion(u, p) {
+                    let ratio = f64::from(m.v2_mps) / f64::from(m.v1_mps);
+                    drift = drift.max(ratio * ratio / 2.0);
+                }
+            }
+        }
+    }
+    (limb - f64::from(scene.max_roll_rad) - widest, 2.0 * drift)
+}
+
 impl Plan {
+    /// The plan of `scene`: active segments only, the fewest samples, the terms needed.
     pub fn new(scene: &Scene, env: &Envelope) -> Result<Plan, Fault> {
+        Plan::build(scene, env, false)
+    }
+
+    /// The evaluate-everything plan, the baseline the planner is measured against:
+    /// every segment of the table whether active or not, [`MAX_SAMPLES`] samples each,
+    /// every term.
+    pub fn exhaustive(scene: &Scene, env: &Envelope) -> Result<Plan, Fault> {
+        Plan::build(scene, env, true)
+    }
+
+    fn build(scene: &Scene, env: &Envelope, exhaustive: bool) -> Result<Plan, Fault> {
         scene.validate()?;
         let stage_rule =
             StageRule::<f32>::new(f64::from(scene.mtf_floor)).map_err(|_| Fault::InvalidScene)?;
@@ -164,14 +232,19 @@ impl Plan {
         };
         let mut segments = [blank; MAX_SEGMENTS];
         let mut count = 0usize;
-        for (index, spec) in scene.active() {
+        let table = scene
+            .segments
+            .iter()
+            .take(usize::from(scene.count))
+            .enumerate();
+        for (index, spec) in table.filter(|(_, s)| exhaustive || s.active) {
             let slot = segments.get_mut(count).ok_or(Fault::InvalidScene)?;
             let budget = SAMPLING_SHARE * f64::from(stage_rule.mismatch_budget())
                 / f64::from(spec.tdi_stages);
             let c = CURVATURE_SAFETY * curvature(scene, spec, &updates)?;
             let width = f64::from(spec.last_px) - f64::from(spec.first_px);
             // Smallest K >= 2 with c (width / (K - 1))^2 / 8 <= budget.
-            let mut k = 2usize;
+            let mut k = if exhaustive { MAX_SAMPLES } else { 2usize };
             while k < MAX_SAMPLES
                 && c * (width / (k - 1) as f64) * (width / (k - 1) as f64) / 8.0 > budget
             {
@@ -193,8 +266,24 @@ impl Plan {
             }
             count += 1;
         }
+        let (limb_margin_rad, drift_bound) = term_bounds(scene, env, &segments[..count], &updates);
+        let smallest_budget = segments[..count]
+            .iter()
+            .map(|s| f64::from(s.sampling_budget) / SAMPLING_SHARE)
+            .fold(f64::INFINITY, f64::min);
+        let terms = if exhaustive {
+            Terms::ALL
+        } else {
+            Terms {
+                limb: limb_margin_rad < LIMB_BRANCH_RAD,
+                drift: drift_bound > TERM_SHARE * smallest_budget,
+            }
+        };
         Ok(Plan {
             segments,
+            terms,
+            limb_margin_rad: limb_margin_rad as f32,
+            drift_bound: drift_bound as f32,
             count: count as u8,
             pixel_m: scene.camera.pixel_m as f32,
             line_clock_hz: scene.line_clock_hz as f32,

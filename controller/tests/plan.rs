@@ -129,3 +129,75 @@ proptest! {
         }
     }
 }
+
+/// The scene kinds of the issue, and what each plan leaves out.
+#[test]
+fn terms_left_out_per_scene_kind() {
+    let all = Scene::paper_default();
+    let p = Plan::new(&all, &ENV).unwrap();
+    // Roll up to 25 deg: the far point comes within 2.6 deg of the 800 km limb.
+    assert!(
+        p.terms.limb && p.terms.drift,
+        "{:?} margin {} drift {}",
+        p.terms,
+        p.limb_margin_rad,
+        p.drift_bound
+    );
+    let mut nadir = all;
+    nadir.max_roll_rad = 0.0;
+    let p = Plan::new(&nadir, &ENV).unwrap();
+    assert!(
+        !p.terms.limb,
+        "nadir only: at least {} rad from the limb",
+        p.limb_margin_rad
+    );
+    let mut few_stages = all;
+    for s in few_stages.segments.iter_mut() {
+        s.tdi_stages = 2;
+    }
+    let p = Plan::new(&few_stages, &ENV).unwrap();
+    assert!(
+        !p.terms.drift,
+        "2 stages: drift bound {} is within the budget",
+        p.drift_bound
+    );
+    let mut one = all;
+    for (k, s) in one.segments.iter_mut().enumerate() {
+        s.active = k == 4;
+    }
+    let p = Plan::new(&one, &ENV).unwrap();
+    assert_eq!(p.count, 1);
+    let e = Plan::exhaustive(&one, &ENV).unwrap();
+    assert_eq!(e.count, 10, "the baseline evaluates every segment");
+    assert!(e
+        .active()
+        .iter()
+        .all(|s| usize::from(s.n_samples) == controller::plan::MAX_SAMPLES));
+    assert_eq!(e.terms, controller::plan::Terms::ALL);
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 300, ..ProptestConfig::default() })]
+
+    /// The bounds behind leaving terms out hold against the reference: every sample's
+    /// line of sight is at least `limb_margin_rad` from the limb, and (|v| - |v1|) / |v|
+    /// is at most `drift_bound`, anywhere in the envelope.
+    #[test]
+    fn term_bounds_hold_against_the_reference(
+        scene in scene_strategy(), frac in -1f64..1.0, h in 500e3f64..800e3, i0 in 0f64..180.0, g0 in 0f64..360.0,
+    ) {
+        let plan = Plan::new(&scene, &ENV).unwrap();
+        let g = Geometry::circular(f64::from(scene.max_roll_rad) * frac, i0.to_radians(), g0.to_radians(), h, R);
+        let limb = libm::asin(R / (R + h));
+        for seg in plan.active() {
+            for &n in seg.sample_px() {
+                let alpha = libm::atan(f64::from(n) * scene.camera.pixel_m / scene.camera.focal_m);
+                prop_assert!(limb - (g.roll_rad + alpha).abs() >= f64::from(plan.limb_margin_rad) - 1e-9);
+                if let Ok(m) = Reference.evaluate(&scene.camera, &g, f64::from(n)) {
+                    let change = (m.speed_mps() - m.v1_mps.abs()) / m.speed_mps();
+                    prop_assert!(change <= f64::from(plan.drift_bound), "{change:e} > {:e}", plan.drift_bound);
+                }
+            }
+        }
+    }
+}
