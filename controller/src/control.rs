@@ -150,6 +150,15 @@ impl Controller {
         })
     }
 
+    /// A controller on the evaluate-everything plan ([`Plan::exhaustive`]): every
+    /// segment, the most samples, every term. The baseline the planner is measured
+    /// against (`cargo xtask bench`); not for flight.
+    pub fn evaluate_everything(config: Config, scene: Scene) -> Result<Controller, Fault> {
+        let mut c = Controller::new(config, scene)?;
+        c.plan = Plan::exhaustive(&c.scene, &c.config.envelope())?;
+        Ok(c)
+    }
+
     pub fn scene(&self) -> &Scene {
         &self.scene
     }

@@ -23,22 +23,27 @@
 // refuse NaN, which `x <= 0.0` would let through.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+#[cfg(feature = "reference")]
 pub mod accuracy;
 pub mod closed_form;
+#[cfg(feature = "reference")]
 pub mod dual;
 pub mod error;
+#[cfg(feature = "fixed-point")]
 pub mod fixed_point;
 pub mod line_period;
 pub mod model;
 pub mod mtf;
 pub mod orbit;
 pub mod real;
+#[cfg(feature = "reference")]
 pub mod reference;
 mod sqrt;
 pub mod trig;
 
 pub use closed_form::ClosedForm;
 pub use error::{ModelError, Param};
+#[cfg(feature = "fixed-point")]
 pub use fixed_point::{Fixed, FixedReal, FIXED};
 pub use line_period::{line_period_s, line_period_ticks, Ticks};
 pub use model::{
@@ -47,6 +52,7 @@ pub use model::{
 pub use mtf::{mtf_mismatch, sinc, StageRule};
 pub use orbit::{OrbitState, StateVector};
 pub use real::{Real, Scalar};
+#[cfg(feature = "reference")]
 pub use reference::Reference;
 
 /// The closed form in f64.

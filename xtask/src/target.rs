@@ -84,7 +84,7 @@ pub fn run(args: &[String]) -> Result<(), String> {
     }
     if demo {
         ensure_target_tools()?;
-        let elf = build_bin("firmware", "demo", release)?;
+        let elf = build_bin("firmware", "demo", release, &[])?;
         let outcome = qemu::run_elf(&elf, &qemu::Options::default())?;
         return exit_like(outcome.status);
     }
@@ -116,6 +116,19 @@ pub fn test_target() -> Result<(), String> {
         "-D",
         "warnings",
     ])?;
+    // The lean build a flight binary links: the f32 closed form only.
+    cargo(&[
+        "clippy",
+        "--package",
+        "core-math",
+        "--lib",
+        "--no-default-features",
+        "--target",
+        TARGET,
+        "--",
+        "-D",
+        "warnings",
+    ])?;
     cargo(&[
         "clippy",
         "--package",
@@ -134,6 +147,7 @@ pub fn test_target() -> Result<(), String> {
         "--package",
         "hil-tests",
         "--all-targets",
+        "--all-features",
         "--target",
         TARGET,
         "--",
@@ -203,7 +217,12 @@ fn runner_config() -> Result<Vec<String>, String> {
 
 /// Builds one binary of `package` for the target and returns its ELF's path (taken from
 /// cargo's JSON messages, so any target-dir setting is honoured).
-fn build_bin(package: &str, bin: &str, release: bool) -> Result<PathBuf, String> {
+fn build_bin(
+    package: &str,
+    bin: &str,
+    release: bool,
+    features: &[&str],
+) -> Result<PathBuf, String> {
     let mut cmd = cargo_command();
     cmd.args([
         "build",
@@ -215,6 +234,9 @@ fn build_bin(package: &str, bin: &str, release: bool) -> Result<PathBuf, String>
         TARGET,
     ])
     .arg("--message-format=json-render-diagnostics");
+    if !features.is_empty() {
+        cmd.arg("--features").arg(features.join(","));
+    }
     if release {
         cmd.arg("--release");
     }

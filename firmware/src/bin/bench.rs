@@ -20,6 +20,11 @@ use firmware::platform;
 use firmware::scene::{NoTelemetry, Scene, SceneSource};
 use firmware::FirmwareError;
 
+use controller::frame::{encode, kind, Decoder, Event, MAX_FRAME};
+use controller::nav::{Attitude, Nav};
+use controller::{Config, Controller, LinePeriodSink};
+use core_math::StateVector;
+
 /// Start of a measured region (the plugin watches its first instruction). The
 /// `black_box` of a constant of its own is a side effect the optimiser must keep, and
 /// makes the two markers differ, so that neither the calls nor the functions are merged
@@ -45,6 +50,120 @@ fn region<I, O>(label: &str, input: I, f: impl FnOnce(I) -> O) {
     let out = f(black_box(input));
     black_box(out);
     bench_stop();
+}
+
+/// Period registers that keep nothing (the bench measures the computation).
+struct NoRegisters;
+
+impl LinePeriodSink for NoRegisters {
+    type Error = ();
+    fn write_period(&mut self, _index: u8, ticks: u32) -> Result<(), ()> {
+        black_box(ticks);
+        Ok(())
+    }
+}
+
+/// A controller holding one accepted NAV frame: 645 km circular orbit, i0 97.98 deg,
+/// argument of latitude 0.5 rad, roll `roll_rad`.
+fn controller_with_nav(
+    scene: controller::Scene,
+    exhaustive: bool,
+    roll_rad: f32,
+) -> Result<Controller, FirmwareError> {
+    let config = Config::default();
+    let c = if exhaustive {
+        Controller::evaluate_everything(config, scene)
+    } else {
+        Controller::new(config, scene)
+    };
+    let mut c = c.map_err(|_| FirmwareError::Layout)?;
+    let (r_m, i0, u) = (6_371e3 + 645e3, 97.98f64.to_radians(), 0.5f64);
+    let speed = libm::sqrt(core_math::GM_M3_S2 / r_m);
+    let (si, ci, su, cu) = (libm::sin(i0), libm::cos(i0), libm::sin(u), libm::cos(u));
+    let state = StateVector {
+        position_m: [r_m * cu, r_m * su * ci, r_m * su * si],
+        velocity_mps: [-speed * su, speed * cu * ci, speed * cu * si],
+    };
+    let attitude = Attitude {
+        roll_rad,
+        ..Attitude::default()
+    };
+    let mut payload = [0u8; 96];
+    let n = Nav { state, attitude }
+        .encode(&mut payload)
+        .ok_or(FirmwareError::Layout)?;
+    let mut frame = [0u8; MAX_FRAME];
+    let len = encode(
+        kind::NAV,
+        1,
+        1_000_000,
+        payload.get(..n).ok_or(FirmwareError::Layout)?,
+        &mut frame,
+    )
+    .ok_or(FirmwareError::Layout)?;
+    let mut decoder = Decoder::new();
+    decoder.feed(frame.get(..len).ok_or(FirmwareError::Layout)?, |e| {
+        if let Event::Frame(f) = e {
+            c.on_frame(&f);
+        }
+    });
+    if c.nav().is_none() {
+        return Err(FirmwareError::Telemetry);
+    }
+    Ok(c)
+}
+
+/// One whole controller update (update constants, every planned segment, outputs).
+fn update_region(label: &str, c: &mut Controller, t_us: u64) -> Result<(), FirmwareError> {
+    let mut regs = NoRegisters;
+    defmt::info!("BENCH {=str}", label);
+    bench_start();
+    let ran = black_box(c).advance(black_box(t_us), &mut regs);
+    bench_stop();
+    if ran {
+        Ok(())
+    } else {
+        Err(FirmwareError::Telemetry)
+    }
+}
+
+/// Instructions per update for each scene kind, planned and evaluate-everything.
+fn scene_kinds() -> Result<(), FirmwareError> {
+    let all = controller::Scene::paper_default();
+    let mut nadir = all;
+    nadir.max_roll_rad = 0.0;
+    let mut one = all;
+    for (k, s) in one.segments.iter_mut().enumerate() {
+        s.active = k == 9;
+    }
+    let roll = 20f32.to_radians();
+    let kinds: [(&str, &str, controller::Scene, f32); 3] = [
+        (
+            "scene nadir only, all segments: planned",
+            "scene nadir only, all segments: evaluate everything",
+            nadir,
+            0.0,
+        ),
+        (
+            "scene roll up to 25 deg, all segments: planned",
+            "scene roll up to 25 deg, all segments: evaluate everything",
+            all,
+            roll,
+        ),
+        (
+            "scene roll up to 25 deg, one segment active: planned",
+            "scene roll up to 25 deg, one segment active: evaluate everything",
+            one,
+            roll,
+        ),
+    ];
+    for (planned, everything, scene, roll) in kinds {
+        let mut c = controller_with_nav(scene, false, roll)?;
+        update_region(planned, &mut c, 1_000_000)?;
+        let mut c = controller_with_nav(scene, true, roll)?;
+        update_region(everything, &mut c, 1_000_000)?;
+    }
+    Ok(())
 }
 
 fn run() -> Result<(), FirmwareError> {
@@ -145,7 +264,7 @@ fn run() -> Result<(), FirmwareError> {
         &gfx,
         |g| FIXED.update(g),
     );
-    Ok(())
+    scene_kinds()
 }
 
 #[entry]

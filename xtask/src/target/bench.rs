@@ -24,7 +24,7 @@ pub fn bench(args: &[String]) -> Result<(), String> {
     if !tools::have("gcc") {
         tools::apt_install(&["gcc", "libc6-dev"], "gcc (to build the QEMU plugin)")?;
     }
-    let elf = build_bin("firmware", "bench", true)?;
+    let elf = build_bin("firmware", "bench", true, &["bench"])?;
     let dir = elf.parent().ok_or("bench ELF has no folder")?.to_path_buf();
     let plugin = build_plugin(&dir)?;
     let (start, stop) = marker_addresses(&elf)?;

@@ -64,7 +64,7 @@ pub fn run(options: &RunOptions) -> Result<(), String> {
         None => scenario::default_pass(earth_radius_m, tick_us),
     };
     ensure_target_tools()?;
-    let elf = build_bin("firmware", "firmware", options.release)?;
+    let elf = build_bin("firmware", "firmware", options.release, &[])?;
     let result = play(&elf, &pass)?;
     print_table(&pass, &result, options.every_s.max(1), &options.segments);
     let plot = options
@@ -102,7 +102,7 @@ pub fn e2e_test() -> Result<(), String> {
     let started = Instant::now();
     let c = Config::default();
     let pass = scenario::short_pass(c.earth_radius_m, c.update_period_us);
-    let elf = build_bin("firmware", "firmware", true)?;
+    let elf = build_bin("firmware", "firmware", true, &[])?;
     let result = play(&elf, &pass)?;
     result.finish()?;
     eprintln!(
