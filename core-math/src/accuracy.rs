@@ -49,10 +49,7 @@ pub fn cos_incidence(
     geometry: &Geometry<f64>,
     n_px: f64,
 ) -> Result<f64, ModelError> {
-    let p = Reference.pixel(camera, n_px)?;
-    geometry.validate()?;
-    let eta = geometry.roll_rad + p.field_rad;
-    let k = 1.0 + geometry.altitude_m / geometry.earth_radius_m;
+    let (eta, k) = nadir_angle_and_k(camera, geometry, n_px)?;
     let s = k * libm::sin(eta);
     if libm::cos(eta) <= 0.0 || !(s.abs() < 1.0) {
         return Err(ModelError::LineOfSightMissesEarth);
@@ -67,8 +64,19 @@ pub fn limb_margin_rad(
     geometry: &Geometry<f64>,
     n_px: f64,
 ) -> Result<f64, ModelError> {
+    let (eta, k) = nadir_angle_and_k(camera, geometry, n_px)?;
+    Ok(libm::asin(1.0 / k) - libm::fabs(eta))
+}
+
+/// The line of sight's nadir angle roll + alpha (Eq. 2's field angle) and k = (R+H)/R,
+/// for a valid pixel and geometry.
+fn nadir_angle_and_k(
+    camera: &Camera,
+    geometry: &Geometry<f64>,
+    n_px: f64,
+) -> Result<(f64, f64), ModelError> {
     let p = Reference.pixel(camera, n_px)?;
     geometry.validate()?;
     let k = 1.0 + geometry.altitude_m / geometry.earth_radius_m;
-    Ok(libm::asin(1.0 / k) - libm::fabs(geometry.roll_rad + p.field_rad))
+    Ok((geometry.roll_rad + p.field_rad, k))
 }

@@ -105,55 +105,27 @@ pub fn run(args: &[String]) -> Result<(), String> {
 pub fn test_target() -> Result<(), String> {
     let started = Instant::now();
     ensure_target_tools()?;
-    cargo(&[
-        "clippy",
-        "--package",
-        "core-math",
-        "--lib",
-        "--target",
-        TARGET,
-        "--",
-        "-D",
-        "warnings",
-    ])?;
-    // The lean build a flight binary links: the f32 closed form only.
-    cargo(&[
-        "clippy",
-        "--package",
-        "core-math",
-        "--lib",
-        "--no-default-features",
-        "--target",
-        TARGET,
-        "--",
-        "-D",
-        "warnings",
-    ])?;
-    cargo(&[
-        "clippy",
-        "--package",
-        "controller",
-        "--lib",
-        "--target",
-        TARGET,
-        "--",
-        "-D",
-        "warnings",
-    ])?;
-    cargo(&[
-        "clippy",
-        "--package",
-        "firmware",
-        "--package",
-        "hil-tests",
-        "--all-targets",
-        "--all-features",
-        "--target",
-        TARGET,
-        "--",
-        "-D",
-        "warnings",
-    ])?;
+    // core-math with its default backends and as the lean flight build links it (the
+    // f32 closed form only), the controller, then the binaries with every feature.
+    let lints: [&[&str]; 4] = [
+        &["--package", "core-math", "--lib"],
+        &["--package", "core-math", "--lib", "--no-default-features"],
+        &["--package", "controller", "--lib"],
+        &[
+            "--package",
+            "firmware",
+            "--package",
+            "hil-tests",
+            "--all-targets",
+            "--all-features",
+        ],
+    ];
+    for which in lints {
+        let mut args = vec!["clippy"];
+        args.extend_from_slice(which);
+        args.extend_from_slice(&["--target", TARGET, "--", "-D", "warnings"]);
+        cargo(&args)?;
+    }
     let runner = runner_config()?;
     for profile in [None, Some("--release")] {
         let mut args = vec!["test", "--package", "hil-tests", "--target", TARGET];
@@ -184,7 +156,7 @@ fn cargo_command() -> Command {
 }
 
 /// Runs cargo with `args` in the workspace root; an error if it fails.
-fn cargo(args: &[&str]) -> Result<(), String> {
+pub(crate) fn cargo(args: &[&str]) -> Result<(), String> {
     eprintln!("xtask: cargo {}", args.join(" "));
     let status = cargo_command()
         .args(args)

@@ -2,6 +2,8 @@
 
 use std::process::Command;
 
+use crate::target::cargo;
+
 /// Runs a command with inherited output; an error names it and its status.
 pub fn run_step(program: &str, args: &[&str]) -> Result<(), String> {
     eprintln!("\n==> {program} {}", args.join(" "));
@@ -14,10 +16,6 @@ pub fn run_step(program: &str, args: &[&str]) -> Result<(), String> {
     } else {
         Err(format!("`{program} {}` failed ({status})", args.join(" ")))
     }
-}
-
-fn cargo(args: &[&str]) -> Result<(), String> {
-    run_step(env!("CARGO"), args)
 }
 
 pub fn run(args: &[String]) -> Result<(), String> {
