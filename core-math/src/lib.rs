@@ -9,7 +9,9 @@
 //! - [`Reference`]: the paper's transform chain (Eqs. 1-13) on dual numbers, f64;
 //! - [`ClosedForm<f64>`] and [`ClosedForm<f32>`]: the stable closed form;
 //! - [`Fixed`]: the same closed form in fixed point (I24F40 interface, integer-only
-//!   `update` and `motion`) for controllers without an FPU.
+//!   `update` and `motion`) for controllers without an FPU;
+//! - [`NaiveF32`] (feature `naive`, host tools and the bench only): the paper's route in
+//!   f32 with libm trig per pixel, the baseline the others are measured against.
 //!
 //! `no_std`, no allocation, no panics on any input: every refusal is a [`ModelError`].
 #![no_std]
@@ -34,6 +36,8 @@ pub mod fixed_point;
 pub mod line_period;
 pub mod model;
 pub mod mtf;
+#[cfg(feature = "naive")]
+pub mod naive;
 pub mod orbit;
 pub mod real;
 #[cfg(feature = "reference")]
@@ -50,6 +54,8 @@ pub use model::{
     domain, orbital_rate_rad_s, Backend, Camera, Geometry, ImageMotion, EARTH_RATE_RAD_S, GM_M3_S2,
 };
 pub use mtf::{mtf_mismatch, sinc, StageRule};
+#[cfg(feature = "naive")]
+pub use naive::NaiveF32;
 pub use orbit::{OrbitState, StateVector};
 pub use real::{Real, Scalar};
 #[cfg(feature = "reference")]

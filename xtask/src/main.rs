@@ -7,6 +7,7 @@ mod csv;
 mod eval;
 mod paper;
 mod plot;
+mod report;
 mod target;
 mod test_cmd;
 
@@ -23,6 +24,7 @@ commands:
       [--plot PNG] [--every S] [--segments 0,5,9|all]
       [--export-telemetry FILE.csv] [--demo]             (--demo: the default-scene demo)
   bench                                                  guest instructions per evaluation (QEMU plugin)
+  report [--csv] [--cases N] [--seed S] [--no-bench]     error against run time per backend (runs the bench)
   qemu ELF                                               cargo runner: ELF under QEMU, defmt decoded
 ";
 
@@ -40,6 +42,7 @@ fn main() -> ExitCode {
         "test" => test_cmd::run(rest),
         "run" => target::run(rest),
         "bench" => target::bench(rest),
+        "report" => report::run(rest),
         "qemu" => target::qemu(rest),
         "help" | "--help" | "-h" => {
             print!("{USAGE}");

@@ -20,7 +20,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
 
-pub use bench::bench;
+pub use bench::{bench, measure as bench_counts, BenchCounts};
 pub use pass::e2e_test;
 pub use qemu::qemu;
 pub use tools::ensure_target_tools;

@@ -13,7 +13,7 @@
 use core::hint::black_box;
 
 use core_math::fixed_point::geometry_from_f64;
-use core_math::{Backend, Camera, Geometry, Reference, CLOSED_F32, CLOSED_F64, FIXED};
+use core_math::{Backend, Camera, Geometry, NaiveF32, Reference, CLOSED_F32, CLOSED_F64, FIXED};
 use cortex_m_rt::entry;
 use firmware::pipeline::{Plan, SamplePoint};
 use firmware::platform;
@@ -189,6 +189,9 @@ fn run() -> Result<(), FirmwareError> {
     };
     let update_fx45 = FIXED.update(&geometry_from_f64(&g45)?)?;
     let near_fx = FIXED.pixel(&camera, 15_735.0)?;
+    let update_naive = NaiveF32.update(&g32)?;
+    let axis_naive = NaiveF32.pixel(&camera, 0.0)?;
+    let edge_naive = NaiveF32.pixel(&camera, 30_000.0)?;
     let axis_sample = SamplePoint {
         n_px: 0,
         pixel: axis,
@@ -264,7 +267,28 @@ fn run() -> Result<(), FirmwareError> {
         &gfx,
         |g| FIXED.update(g),
     );
-    scene_kinds()
+    scene_kinds()?;
+    region(
+        "NaiveF32 motion, 1 pixel (n = 0)",
+        (&update_naive, &axis_naive),
+        |(u, p)| NaiveF32.motion(u, p),
+    );
+    region(
+        "NaiveF32 motion, 1 pixel (n = +30000)",
+        (&update_naive, &edge_naive),
+        |(u, p)| NaiveF32.motion(u, p),
+    );
+    region(
+        "NaiveF32 update (checks and stores the geometry)",
+        &g32,
+        |g| NaiveF32.update(g),
+    );
+    region(
+        "Reference update (checks and stores the geometry)",
+        &g64,
+        |g| Reference.update(g),
+    );
+    Ok(())
 }
 
 #[entry]

@@ -16,10 +16,47 @@ use super::{build_bin, ensure_target_tools, qemu, tools, workspace_root};
 const PLUGIN_SOURCE: &str = "tools/qemu-stopwatch/stopwatch.c";
 const LABEL_PREFIX: &str = "BENCH ";
 
+/// The counts of one bench run: every region's label and raw count, in the order the
+/// firmware ran them, the first being the empty region (the markers' own overhead).
+pub struct BenchCounts {
+    pub qemu_version: String,
+    /// Raw count of the empty region, subtracted by [`BenchCounts::net`].
+    pub overhead: u64,
+    pub regions: Vec<(String, u64)>,
+}
+
+impl BenchCounts {
+    /// Net instructions (raw - overhead) of the region labelled exactly `label`.
+    pub fn net(&self, label: &str) -> Option<u64> {
+        self.regions
+            .iter()
+            .find(|(l, _)| l == label)
+            .map(|(_, raw)| raw.saturating_sub(self.overhead))
+    }
+}
+
+/// `cargo xtask bench`: measure, then print every region.
 pub fn bench(args: &[String]) -> Result<(), String> {
     if let Some(a) = args.first() {
         return Err(format!("bench: unknown argument `{a}` (usage: bench)"));
     }
+    let counts = measure(false)?;
+    let overhead = counts.overhead;
+    println!();
+    println!("guest instructions per region (Cortex-M4 under QEMU {}, release: opt-level 3, fat LTO, codegen-units 1)", counts.qemu_version);
+    println!("net = raw - {overhead} (the empty region: markers and black_box). Instructions, not cycles.");
+    println!();
+    println!("{:>8} {:>8}  region", "net", "raw");
+    for (label, raw) in &counts.regions {
+        println!("{:>8} {:>8}  {label}", raw.saturating_sub(overhead), raw);
+    }
+    Ok(())
+}
+
+/// Builds the bench firmware and the plugin, runs the firmware under QEMU and returns
+/// the parsed counts. The decoded defmt log is echoed as the firmware runs, to stdout or,
+/// with `log_to_stderr`, to stderr.
+pub fn measure(log_to_stderr: bool) -> Result<BenchCounts, String> {
     ensure_target_tools()?;
     if !tools::have("gcc") {
         tools::apt_install(&["gcc", "libc6-dev"], "gcc (to build the QEMU plugin)")?;
@@ -42,6 +79,7 @@ pub fn bench(args: &[String]) -> Result<(), String> {
         ],
         capture: true,
         serial: None,
+        log_to_stderr,
     };
     let outcome = qemu::run_elf(&elf, &options)?;
     if outcome.status != 0 {
@@ -72,16 +110,11 @@ pub fn bench(args: &[String]) -> Result<(), String> {
             counts.len()
         ));
     }
-    let overhead = counts.first().copied().unwrap_or(0);
-    println!();
-    println!("guest instructions per region (Cortex-M4 under QEMU {}, release: opt-level 3, fat LTO, codegen-units 1)", qemu_version());
-    println!("net = raw - {overhead} (the empty region: markers and black_box). Instructions, not cycles.");
-    println!();
-    println!("{:>8} {:>8}  region", "net", "raw");
-    for (label, raw) in labels.iter().zip(&counts) {
-        println!("{:>8} {:>8}  {label}", raw.saturating_sub(overhead), raw);
-    }
-    Ok(())
+    Ok(BenchCounts {
+        qemu_version: qemu_version(),
+        overhead: counts.first().copied().unwrap_or(0),
+        regions: labels.iter().map(|l| l.to_string()).zip(counts).collect(),
+    })
 }
 
 /// Compiles the plugin next to the bench ELF (a few hundred ms with gcc).

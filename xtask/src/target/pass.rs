@@ -387,6 +387,7 @@ fn run_qemu(elf: &Path, uplink: &[u8]) -> Result<(i32, Vec<u8>), String> {
         ],
         serial: Some("chardev:telemetry".into()),
         capture: false,
+        log_to_stderr: false,
     };
     let elf_owned = elf.to_path_buf();
     let emulator = std::thread::spawn(move || qemu::run_elf(&elf_owned, &options));

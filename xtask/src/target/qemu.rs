@@ -32,6 +32,9 @@ pub struct Options {
     /// QEMU's `-serial` for UART0 (None: `none`, nothing connected), e.g.
     /// `chardev:ID` with a `-chardev ...,id=ID` in `extra_args`.
     pub serial: Option<String>,
+    /// Echo the decoded log to stderr instead of stdout (for commands whose stdout is
+    /// data, e.g. `report --csv`).
+    pub log_to_stderr: bool,
 }
 
 /// What a run gave.
@@ -96,6 +99,7 @@ pub fn run_elf(elf: &Path, options: &Options) -> Result<Outcome, String> {
         locations: &locations,
         root: super::workspace_root(),
         capture: options.capture,
+        log_to_stderr: options.log_to_stderr,
         messages: Vec::new(),
     };
     let read = match &table {
@@ -160,6 +164,7 @@ struct Printer<'a> {
     locations: &'a BTreeMap<u64, Location>,
     root: PathBuf,
     capture: bool,
+    log_to_stderr: bool,
     messages: Vec<String>,
 }
 
@@ -180,9 +185,14 @@ impl Printer<'_> {
                 line.push_str(&format!("\n      at {}:{}", file.display(), loc.line));
             }
         }
-        let mut out = std::io::stdout().lock();
-        let _ = writeln!(out, "{line}");
-        let _ = out.flush();
+        if self.log_to_stderr {
+            let mut out = std::io::stderr().lock();
+            let _ = writeln!(out, "{line}");
+        } else {
+            let mut out = std::io::stdout().lock();
+            let _ = writeln!(out, "{line}");
+            let _ = out.flush();
+        }
         if self.capture {
             self.messages.push(message);
         }

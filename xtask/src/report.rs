@@ -1,0 +1,292 @@
+//! `cargo xtask report [--csv] [--cases N] [--seed S] [--no-bench]`: error against
+//! run time, one row per backend.
+//!
+//! Errors: |v_P| of each backend against the f64 reference chain over ONE shared, seeded
+//! random sample of the envelope (altitude 200-2000 km, R = 6371 km, roll up to 45 deg,
+//! field angle up to 40 deg, any inclination and argument of latitude; camera f = 0.555 m,
+//! A = 13 um). Three cases in four draw the field angle uniformly, one in four puts the
+//! line of sight log-uniformly 1e-5 to 1 deg short of a limb. The geometry is rounded to
+//! f32 once, so every backend and the reference see the same values (exact in f32 and,
+//! to 2^-40, in the fixed backend's I24F40). `max_rel_err` and `p99_rel_err` are over the
+//! cases at least 1 deg from the limb, `max_rel_err_near_limb` over those within 1 deg.
+//!
+//! Run time: guest instructions on the Cortex-M4 under QEMU from `cargo xtask bench`
+//! (the same build, the same plugin, [`crate::target::bench_counts`]): `motion` for one
+//! pixel at n = 0 and one `update`. Instructions, not cycles.
+//!
+//! `flash_bytes` is left empty: with fat LTO every backend is inlined into the bench's
+//! regions, so no symbol size measures one backend's code honestly.
+
+use core_math::fixed_point::{geometry_from_f64, motion_to_f64};
+use core_math::{Backend, Camera, Geometry, NaiveF32, Reference, CLOSED_F32, CLOSED_F64, FIXED};
+
+use crate::target::{bench_counts, BenchCounts};
+
+const USAGE: &str = "usage: report [--csv] [--cases N] [--seed S] [--no-bench]";
+const DEFAULT_CASES: usize = 200_000;
+const DEFAULT_SEED: u64 = 0x5EED_2013_0605_0750;
+const CAMERA: Camera = Camera {
+    focal_m: 0.555,
+    pixel_m: 13e-6,
+};
+/// "Near the limb": the line of sight within this angle (deg) of the limb.
+const NEAR_LIMB_DEG: f64 = 1.0;
+
+/// The backends, in report order, with their bench labels (motion at n = 0, update).
+const VARIANTS: [(&str, &str, &str); 5] = [
+    (
+        "naive-f32",
+        "NaiveF32 motion, 1 pixel (n = 0)",
+        "NaiveF32 update (checks and stores the geometry)",
+    ),
+    (
+        "reference",
+        "Reference motion (f64 chain), 1 pixel (n = 0)",
+        "Reference update (checks and stores the geometry)",
+    ),
+    (
+        "f64",
+        "CLOSED_F64 motion, 1 pixel (n = 0)",
+        "CLOSED_F64 update",
+    ),
+    (
+        "f32",
+        "CLOSED_F32 motion, 1 pixel (n = 0)",
+        "CLOSED_F32 update (once per telemetry update)",
+    ),
+    (
+        "fixed",
+        "FIXED motion, 1 pixel (n = 0; integer only)",
+        "FIXED update (once per telemetry update; integer only)",
+    ),
+];
+
+/// splitmix64: seeded and dependency-free, so the sample is reproducible anywhere.
+struct Rng(u64);
+
+impl Rng {
+    fn next_u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+
+    fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
+        lo + (hi - lo) * ((self.next_u64() >> 11) as f64 / (1u64 << 53) as f64)
+    }
+}
+
+#[derive(Default)]
+struct Errors {
+    far: Vec<f64>,
+    max_near: f64,
+    refused: u64,
+}
+
+struct Sample {
+    cases: usize,
+    near: usize,
+    errors: Vec<Errors>,
+}
+
+pub fn run(args: &[String]) -> Result<(), String> {
+    let mut csv = false;
+    let mut bench = true;
+    let mut cases = DEFAULT_CASES;
+    let mut seed = DEFAULT_SEED;
+    let mut it = args.iter();
+    while let Some(a) = it.next() {
+        match a.as_str() {
+            "--csv" => csv = true,
+            "--no-bench" => bench = false,
+            "--cases" => {
+                cases = it
+                    .next()
+                    .and_then(|v| v.parse().ok())
+                    .filter(|&n| n > 0)
+                    .ok_or_else(|| format!("report: --cases needs a positive count ({USAGE})"))?;
+            }
+            "--seed" => {
+                seed = it
+                    .next()
+                    .and_then(|v| parse_seed(v))
+                    .ok_or_else(|| format!("report: --seed needs an integer ({USAGE})"))?;
+            }
+            other => return Err(format!("report: unknown argument `{other}` ({USAGE})")),
+        }
+    }
+    let sample = sweep(seed, cases);
+    let counts = if bench {
+        Some(bench_counts(true)?)
+    } else {
+        None
+    };
+    print_table(&sample, counts.as_ref(), csv, seed)
+}
+
+fn parse_seed(v: &str) -> Option<u64> {
+    match v.strip_prefix("0x") {
+        Some(hex) => u64::from_str_radix(&hex.replace('_', ""), 16).ok(),
+        None => v.parse().ok(),
+    }
+}
+
+/// One case whose line of sight meets the Earth (per the reference), geometry rounded to
+/// f32, and its limb margin (deg).
+fn case(rng: &mut Rng) -> Option<(Geometry<f64>, f64, f64)> {
+    let g = Geometry::circular(
+        rng.uniform(-45.0, 45.0).to_radians(),
+        rng.uniform(0.0, 180.0).to_radians(),
+        rng.uniform(0.0, 360.0).to_radians(),
+        rng.uniform(200e3, 2000e3),
+        6_371e3,
+    )
+    .to::<f32>()
+    .to_f64();
+    let limb = libm::asin(g.earth_radius_m / (g.earth_radius_m + g.altitude_m));
+    let alpha = if rng.next_u64() & 3 == 0 {
+        let margin = libm::pow(10.0, rng.uniform(-5.0, 0.0)).to_radians();
+        let side = if rng.next_u64() & 1 == 0 { 1.0 } else { -1.0 };
+        side * (limb - margin) - g.roll_rad
+    } else {
+        rng.uniform(-40.0, 40.0).to_radians()
+    };
+    if alpha.abs() > 40f64.to_radians() {
+        return None;
+    }
+    let n_px = libm::tan(alpha) * CAMERA.focal_m / CAMERA.pixel_m;
+    let margin = core_math::accuracy::limb_margin_rad(&CAMERA, &g, n_px).ok()?;
+    (margin > 0.0).then_some((g, n_px, margin.to_degrees()))
+}
+
+fn sweep(seed: u64, cases: usize) -> Sample {
+    let mut rng = Rng(seed);
+    let mut errors: Vec<Errors> = VARIANTS.iter().map(|_| Errors::default()).collect();
+    let (mut done, mut near) = (0, 0);
+    while done < cases {
+        let Some((g, n_px, margin_deg)) = case(&mut rng) else {
+            continue;
+        };
+        let Ok(r) = Reference.evaluate(&CAMERA, &g, n_px) else {
+            continue;
+        };
+        done += 1;
+        let is_near = margin_deg < NEAR_LIMB_DEG;
+        near += usize::from(is_near);
+        let g32 = g.to::<f32>();
+        let speeds: [Option<f64>; 5] = [
+            NaiveF32
+                .evaluate(&CAMERA, &g32, n_px)
+                .ok()
+                .map(|m| f64::from(m.speed_mps())),
+            Some(r.speed_mps()),
+            CLOSED_F64
+                .evaluate(&CAMERA, &g, n_px)
+                .ok()
+                .map(|m| m.speed_mps()),
+            CLOSED_F32
+                .evaluate(&CAMERA, &g32, n_px)
+                .ok()
+                .map(|m| f64::from(m.speed_mps())),
+            geometry_from_f64(&g)
+                .and_then(|gq| FIXED.evaluate(&CAMERA, &gq, n_px))
+                .ok()
+                .map(|m| motion_to_f64(&m).speed_mps()),
+        ];
+        let sp = r.speed_mps();
+        for (e, s) in errors.iter_mut().zip(speeds) {
+            let Some(s) = s else {
+                e.refused += 1;
+                continue;
+            };
+            let rel = (s - sp).abs() / sp;
+            if is_near {
+                e.max_near = e.max_near.max(rel);
+            } else {
+                e.far.push(rel);
+            }
+        }
+    }
+    Sample {
+        cases,
+        near,
+        errors,
+    }
+}
+
+fn print_table(
+    sample: &Sample,
+    counts: Option<&BenchCounts>,
+    csv: bool,
+    seed: u64,
+) -> Result<(), String> {
+    let notes = format!(
+        "{} cases (seed {seed:#x}), {} within {NEAR_LIMB_DEG} deg of the limb; errors of |v_P| \
+         relative to the f64 reference chain (reference: 0 by definition); instructions: \
+         Cortex-M4 under QEMU {}, release, motion at n = 0 and one update, instructions \
+         not cycles; flash_bytes not measured (fat LTO inlines every backend)",
+        sample.cases,
+        sample.near,
+        counts.map_or("(not run: --no-bench)", |c| c.qemu_version.as_str()),
+    );
+    let mut rows = Vec::new();
+    for ((name, motion, update), e) in VARIANTS.iter().zip(&sample.errors) {
+        let mut far = e.far.clone();
+        far.sort_by(f64::total_cmp);
+        let max = far.last().copied().unwrap_or(0.0);
+        let p99 = far
+            .get(((far.len().max(1) - 1) as f64 * 0.99).round() as usize)
+            .copied()
+            .unwrap_or(0.0);
+        let count = |label: &str| -> Result<String, String> {
+            match counts {
+                None => Ok(String::new()),
+                Some(c) => c
+                    .net(label)
+                    .map(|n| n.to_string())
+                    .ok_or_else(|| format!("report: no bench region `{label}`")),
+            }
+        };
+        rows.push([
+            name.to_string(),
+            format!("{max:.2e}"),
+            format!("{p99:.2e}"),
+            format!("{:.2e}", e.max_near),
+            count(motion)?,
+            count(update)?,
+            String::new(),
+        ]);
+        if e.refused > 0 {
+            eprintln!(
+                "report: {name} refused {} case(s) the reference accepts (not in its errors)",
+                e.refused
+            );
+        }
+    }
+    const HEADER: [&str; 7] = [
+        "variant",
+        "max_rel_err",
+        "p99_rel_err",
+        "max_rel_err_near_limb",
+        "instr_per_pixel",
+        "instr_per_update",
+        "flash_bytes",
+    ];
+    if csv {
+        eprintln!("report: {notes}");
+        println!("{}", HEADER.join(","));
+        for r in &rows {
+            println!("{}", r.join(","));
+        }
+    } else {
+        println!("{notes}\n");
+        println!("| {} |", HEADER.join(" | "));
+        println!("|{}", "---|".repeat(HEADER.len()));
+        for r in &rows {
+            println!("| {} |", r.join(" | "));
+        }
+    }
+    Ok(())
+}
