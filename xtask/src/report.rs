@@ -123,7 +123,77 @@ pub fn run(args: &[String]) -> Result<(), String> {
     } else {
         None
     };
-    print_table(&sample, counts.as_ref(), csv, seed)
+    let rows = print_table(&sample, counts.as_ref(), csv, seed)?;
+    // The default (full sample, bench run, markdown) regenerates the doc's table and plot.
+    if !csv && counts.is_some() && cases == DEFAULT_CASES && seed == DEFAULT_SEED {
+        write_artefacts(&rows)?;
+    }
+    Ok(())
+}
+
+const DOC: &str = "docs/error-vs-runtime.md";
+const PNG: &str = "docs/error-vs-runtime.png";
+const BEGIN: &str = "<!-- report:begin (written by `cargo xtask report`) -->";
+const END: &str = "<!-- report:end -->";
+
+/// `doc` with the markdown table of `rows` between its markers.
+fn replace_table(doc: &str, rows: &[[String; 7]]) -> Option<String> {
+    let b = doc.find(BEGIN)?;
+    let e = doc[b..].find(END)? + b;
+    let mut table = format!(
+        "{BEGIN}\n\n| {} |\n|{}\n",
+        HEADER.join(" | "),
+        "---|".repeat(HEADER.len())
+    );
+    for r in rows {
+        table.push_str(&format!("| {} |\n", r.join(" | ")));
+    }
+    table.push('\n');
+    Some(format!("{}{table}{}", &doc[..b], &doc[e..]))
+}
+
+/// Replaces the table between the doc's markers and draws the plot: each variant's
+/// worst error at least 1 deg from the limb (a cross) and within 1 deg (a slash, dashed)
+/// against log10 of its instructions per pixel. The reference is the golden source
+/// (error 0 by definition) and has no point on a log axis.
+fn write_artefacts(rows: &[[String; 7]]) -> Result<(), String> {
+    let root = crate::target::workspace_root();
+    let doc_path = root.join(DOC);
+    let doc = std::fs::read_to_string(&doc_path).map_err(|e| format!("reading {DOC}: {e}"))?;
+    let new_doc = replace_table(&doc, rows).ok_or(format!("{DOC} lacks the report markers"))?;
+    std::fs::write(&doc_path, new_doc).map_err(|e| format!("writing {DOC}: {e}"))?;
+    let mut plot = crate::plot::Plot::new(
+        "Error against run time, per backend (Cortex-M4 under QEMU)",
+        "log10 instructions per pixel",
+        "max relative error of |v_P|",
+    )
+    .log_y(true)
+    .x_range(1.5, 5.5)
+    .y_range(1e-15, 1e-2);
+    for (i, r) in rows.iter().enumerate() {
+        let parse = |k: usize| r[k].parse::<f64>().ok().filter(|v| *v > 0.0);
+        let (Some(far), Some(near), Some(instr)) = (parse(1), parse(3), parse(4)) else {
+            continue;
+        };
+        let x = instr.log10();
+        let c = crate::plot::Series::line(&r[0], vec![(x - 0.06, far), (x + 0.06, far)]);
+        plot = plot
+            .series(c.palette(i).width(3.0))
+            .series(
+                crate::plot::Series::line("", vec![(x, far / 1.6), (x, far * 1.6)])
+                    .palette(i)
+                    .width(3.0),
+            )
+            .series(
+                crate::plot::Series::line("", vec![(x - 0.06, near / 1.6), (x + 0.06, near * 1.6)])
+                    .palette(i)
+                    .width(3.0)
+                    .dashed(),
+            );
+    }
+    plot.save(&root.join(PNG))?;
+    eprintln!("report: wrote {DOC} (table) and {PNG}");
+    Ok(())
 }
 
 fn parse_seed(v: &str) -> Option<u64> {
@@ -216,12 +286,22 @@ fn sweep(seed: u64, cases: usize) -> Sample {
     }
 }
 
+const HEADER: [&str; 7] = [
+    "variant",
+    "max_rel_err",
+    "p99_rel_err",
+    "max_rel_err_near_limb",
+    "instr_per_pixel",
+    "instr_per_update",
+    "flash_bytes",
+];
+
 fn print_table(
     sample: &Sample,
     counts: Option<&BenchCounts>,
     csv: bool,
     seed: u64,
-) -> Result<(), String> {
+) -> Result<Vec<[String; 7]>, String> {
     let notes = format!(
         "{} cases (seed {seed:#x}), {} within {NEAR_LIMB_DEG} deg of the limb; errors of |v_P| \
          relative to the f64 reference chain (reference: 0 by definition); instructions: \
@@ -265,15 +345,6 @@ fn print_table(
             );
         }
     }
-    const HEADER: [&str; 7] = [
-        "variant",
-        "max_rel_err",
-        "p99_rel_err",
-        "max_rel_err_near_limb",
-        "instr_per_pixel",
-        "instr_per_update",
-        "flash_bytes",
-    ];
     if csv {
         eprintln!("report: {notes}");
         println!("{}", HEADER.join(","));
@@ -288,5 +359,22 @@ fn print_table(
             println!("| {} |", r.join(" | "));
         }
     }
-    Ok(())
+    Ok(rows)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_table_between_the_markers_is_replaced_and_the_rest_kept() {
+        let doc = format!("intro\n{BEGIN}\nold table\n{END}\nreading\n");
+        let row = ["f32", "1e-7", "1e-7", "1e-7", "87", "5264", ""].map(String::from);
+        let new = replace_table(&doc, &[row]).unwrap();
+        assert!(new.starts_with("intro\n"));
+        assert!(new.ends_with(&format!("{END}\nreading\n")));
+        assert!(!new.contains("old table"));
+        assert!(new.contains("| f32 | 1e-7 | 1e-7 | 1e-7 | 87 | 5264 |  |"));
+        assert!(replace_table("no markers", &[]).is_none());
+    }
 }

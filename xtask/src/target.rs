@@ -142,7 +142,7 @@ pub fn test_target() -> Result<(), String> {
 }
 
 /// The workspace root (the folder of the root Cargo.toml and `.cargo/config.toml`).
-fn workspace_root() -> PathBuf {
+pub(crate) fn workspace_root() -> PathBuf {
     let here = Path::new(env!("CARGO_MANIFEST_DIR"));
     here.parent().unwrap_or(here).to_path_buf()
 }
