@@ -77,6 +77,17 @@ pub struct UpdateConst<T> {
 /// error, ~3u/q, stays under 5e-7 (see docs/accuracy.md).
 pub const LIMB_BRANCH_RAD: f64 = 0.3;
 
+/// x reduced to (-pi, pi].
+fn wrap_pi(x: f64) -> f64 {
+    let tau = core::f64::consts::TAU;
+    let r = x - tau * libm::round(x / tau);
+    if r <= -core::f64::consts::PI {
+        r + tau
+    } else {
+        r
+    }
+}
+
 /// x as hi + lo in T, hi = round(x), lo = round(x - hi).
 fn split<T: Real>(x: f64) -> (T, T) {
     let hi = T::from_f64(x);
@@ -119,7 +130,9 @@ impl<T: Real> Backend for ClosedForm<T> {
         // decides everything, and it must not inherit an absolute rounding of ~u.
         let h64 = g.altitude_m.to_f64() / g.earth_radius_m.to_f64();
         let limb = libm::asin(1.0 / (1.0 + h64));
-        let phi = g.roll_rad.to_f64();
+        // Reduced to (-pi, pi]: sin and cos of the roll wrap, so must the limb distance
+        // (an unreduced roll of 2 pi + x would put the limb 2 pi away).
+        let phi = wrap_pi(g.roll_rad.to_f64());
         let (limb_left_hi_rad, limb_left_lo_rad) = split::<T>(limb - phi);
         let (limb_right_hi_rad, limb_right_lo_rad) = split::<T>(limb + phi);
         Ok(UpdateConst {
@@ -191,12 +204,12 @@ impl<T: Real> ClosedForm<T> {
                 T::ONE - abs_ks
             }
         } else {
-            let m = T::ONE - abs_ks;
-            if !(m > T::ZERO) {
-                return Err(ModelError::LineOfSightMissesEarth);
-            }
-            m
+            T::ONE - abs_ks
         };
+        // One test for every path: no ground point, no square root of a negative.
+        if !(one_minus > T::ZERO) {
+            return Err(ModelError::LineOfSightMissesEarth);
+        }
         let q2 = one_minus * (T::ONE + T::ONE - one_minus);
         let q = q2.sqrt();
         let den = u.k * cos_eta + q;

@@ -19,6 +19,10 @@ pub fn line_period_s<T: Real>(pixel_m: T, speed_mps: T) -> Result<T, ModelError>
     if !t.is_finite() {
         return Err(ModelError::NoImageMotion);
     }
+    // An infinite speed, or one so large the quotient underflows: no period to clock.
+    if !(t > T::ZERO) {
+        return Err(ModelError::LinePeriodOutOfRange);
+    }
     Ok(t)
 }
 

@@ -29,6 +29,10 @@ const SINC_TAYLOR: [f64; 11] = [
 
 /// sin(x)/x, with sinc(0) = 1: a polynomial on |x| <= pi (no call, no 0/0), sin(x)/x beyond.
 pub fn sinc<T: Real>(x: T) -> T {
+    // |sinc x| <= 1/|x|: the limit at infinity is 0 (an overflowed argument, never NaN).
+    if !x.is_finite() {
+        return T::ZERO;
+    }
     let pi = T::from_f64(PI);
     if x <= pi && -x <= pi {
         let x2 = x * x;
@@ -53,6 +57,10 @@ pub fn mtf_mismatch<T: Real>(stages: u32, rel_mismatch: T) -> Result<T, ModelErr
     ))
 }
 
+/// Smallest and largest MTF floor a [`StageRule`] accepts.
+pub const MIN_MTF_FLOOR: f64 = 0.25;
+pub const MAX_MTF_FLOOR: f64 = 0.9999;
+
 /// The TDI stage limit for one MTF floor: computed once (per scene), used per update.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct StageRule<T> {
@@ -68,7 +76,9 @@ impl<T: Real> StageRule<T> {
         if !mtf_floor.is_finite() {
             return Err(ModelError::NonFinite(Param::MtfFloor));
         }
-        if !(mtf_floor > 0.0 && mtf_floor < 1.0) {
+        // Within the main lobe of sinc (its first side lobe peaks at 0.217), and far
+        // enough below 1 that the budget is a normal number in f32.
+        if !(MIN_MTF_FLOOR..=MAX_MTF_FLOOR).contains(&mtf_floor) {
             return Err(ModelError::OutOfDomain(Param::MtfFloor));
         }
         let (mut lo, mut hi) = (0.0_f64, PI);
@@ -105,11 +115,18 @@ impl<T: Real> StageRule<T> {
             (self.mismatch_budget / d).floor().to_u32().min(stage_limit)
         };
         let meets = |m: u32| sinc(T::from_f64(HALF_PI) * T::from_u32(m) * d) >= self.mtf_floor;
-        while m > 0 && !meets(m) {
-            m -= 1;
+        // The guess is off by at most one stage from rounding (the floor is kept away
+        // from 1 and inside the main lobe), so the correction is bounded: at most two
+        // steps each way, whatever the inputs.
+        for _ in 0..2 {
+            if m > 0 && !meets(m) {
+                m -= 1;
+            }
         }
-        while m < stage_limit && meets(m + 1) {
-            m += 1;
+        for _ in 0..2 {
+            if m < stage_limit && meets(m + 1) {
+                m += 1;
+            }
         }
         Ok(m)
     }
