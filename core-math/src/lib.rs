@@ -42,6 +42,8 @@ pub mod orbit;
 pub mod real;
 #[cfg(feature = "reference")]
 pub mod reference;
+#[cfg(feature = "reference")]
+pub mod sample;
 mod sqrt;
 pub mod trig;
 

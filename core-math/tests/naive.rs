@@ -8,6 +8,7 @@
 //! `cargo test --release -p core-math --test naive -- --nocapture`.
 
 use core_math::accuracy::limb_margin_rad;
+use core_math::sample::SplitMix64 as Rng;
 use core_math::{Backend, Camera, Geometry, NaiveF32, Reference};
 
 const CAMERA: Camera = Camera {
@@ -25,23 +26,6 @@ const BUCKETS_DEG: [f64; 6] = [1.0, 0.1, 0.01, 1e-3, 1e-4, 0.0];
 /// some rays the reference accepts ((R+H) sin(eta)/R rounds to 1 in f32).
 const MEASURED: [f64; 6] = [7.41e-6, 1.16e-5, 2.68e-5, 1.02e-4, 3.47e-4, 9.17e-4];
 const BOUND: [f64; 6] = [2.0e-5, 3.0e-5, 7.0e-5, 2.5e-4, 1.0e-3, 2.5e-3];
-
-/// splitmix64: a seeded, dependency-free generator (the sample must be reproducible).
-struct Rng(u64);
-
-impl Rng {
-    fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-    /// Uniform in [lo, hi).
-    fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
-        lo + (hi - lo) * ((self.next_u64() >> 11) as f64 / (1u64 << 53) as f64)
-    }
-}
 
 /// A random case of the envelope whose line of sight meets the Earth; one in four is
 /// drawn log-uniformly within 1 deg of a limb so that the limb buckets are populated.

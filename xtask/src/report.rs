@@ -21,6 +21,7 @@ use core_math::fixed_point::{geometry_from_f64, motion_to_f64};
 use core_math::{Backend, Camera, Geometry, NaiveF32, Reference, CLOSED_F32, CLOSED_F64, FIXED};
 
 use crate::target::{bench_counts, BenchCounts};
+use core_math::sample::SplitMix64 as Rng;
 
 const USAGE: &str = "usage: report [--csv] [--cases N] [--seed S] [--no-bench]";
 const DEFAULT_CASES: usize = 200_000;
@@ -60,23 +61,6 @@ const VARIANTS: [(&str, &str, &str); 5] = [
         "FIXED update (once per telemetry update; integer only)",
     ),
 ];
-
-/// splitmix64: seeded and dependency-free, so the sample is reproducible anywhere.
-struct Rng(u64);
-
-impl Rng {
-    fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-
-    fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
-        lo + (hi - lo) * ((self.next_u64() >> 11) as f64 / (1u64 << 53) as f64)
-    }
-}
 
 #[derive(Default)]
 struct Errors {
