@@ -60,6 +60,10 @@ pub struct UpdateConst<T> {
     pub limb_right_lo_rad: T,
     /// sqrt(k^2 - 1) = k cos L.
     pub sqrt_c0: T,
+    /// 1 - k|sin eta| of a ray [`LIMB_BRANCH_RAD`] from the limb at this altitude: a ray
+    /// with 1 - k|sin eta| at or below it takes the near-limb form. The test costs one
+    /// comparison where a test on the limb distance itself would first have to form it.
+    pub near_limb_below: T,
     pub sin_roll: T,
     pub cos_roll: T,
     /// (R + H) / R.
@@ -135,12 +139,18 @@ impl<T: Real> Backend for ClosedForm<T> {
         let phi = wrap_pi(g.roll_rad.to_f64());
         let (limb_left_hi_rad, limb_left_lo_rad) = split::<T>(limb - phi);
         let (limb_right_hi_rad, limb_right_lo_rad) = split::<T>(limb + phi);
+        let sqrt_c0 = c0.sqrt();
+        // 1 - k sin(L - d) = (1 - cos d) + sqrt(k^2 - 1) sin d, increasing in d on
+        // [0, pi/2]: at or below this value a ray is within LIMB_BRANCH_RAD of the limb.
+        let (sin_branch, cos_branch) = T::from_f64(LIMB_BRANCH_RAD).sin_cos();
+        let near_limb_below = (T::ONE - cos_branch) + sqrt_c0 * sin_branch;
         Ok(UpdateConst {
             limb_left_hi_rad,
             limb_left_lo_rad,
             limb_right_hi_rad,
             limb_right_lo_rad,
-            sqrt_c0: c0.sqrt(),
+            sqrt_c0,
+            near_limb_below,
             sin_roll,
             cos_roll,
             k: T::ONE + h,
@@ -179,32 +189,30 @@ impl<T: Real> ClosedForm<T> {
         if !(cos_eta > T::ZERO) {
             return Err(ModelError::LineOfSightMissesEarth);
         }
-        // Angular distance delta = L - |eta| to the limb the ray looks toward. The hi
-        // parts cancel exactly (Sterbenz) near the limb, so delta keeps T's relative
-        // precision however small it is.
         let ks = u.k * sin_eta;
-        let abs_ks = if ks < T::ZERO { -ks } else { ks };
-        let one_minus = if LIMB {
+        let direct = T::ONE - ks.abs();
+        // 1 - k|sin eta| is small near the limb, where a rounding of k sin(eta) would
+        // cost all its digits: there it comes from the limb distance instead.
+        let one_minus = if LIMB && !(direct > u.near_limb_below) {
+            // Angular distance delta = L - |eta| to the limb the ray looks toward. The
+            // hi parts cancel exactly (Sterbenz) near the limb, so delta keeps T's
+            // relative precision however small it is.
             let delta = if sin_eta >= T::ZERO {
                 (u.limb_left_hi_rad - p.field_hi_rad) + (u.limb_left_lo_rad - p.field_lo_rad)
             } else {
                 (u.limb_right_hi_rad + p.field_hi_rad) + (u.limb_right_lo_rad + p.field_lo_rad)
             };
+            // Beyond the limb, or (rounding at the branch point) a hair above
+            // LIMB_BRANCH_RAD, where the series is still far inside its range.
             if !(delta > T::ZERO) {
                 return Err(ModelError::LineOfSightMissesEarth);
             }
-            // 1 - k|sin eta|: near the limb from delta, where 1 - k|sin eta| =
-            // 2 s (s + sqrt(k^2-1) c), s = sin(delta/2), c = cos(delta/2), all terms
-            // positive; elsewhere directly, where it is not small and a rounding of ks
-            // costs little.
-            if delta < T::from_f64(LIMB_BRANCH_RAD) {
-                let (s, c) = T::small_sin_cos(T::from_f64(0.5) * delta);
-                (s + s) * (s + u.sqrt_c0 * c)
-            } else {
-                T::ONE - abs_ks
-            }
+            // 1 - k|sin eta| = 2 s (s + sqrt(k^2-1) c), s = sin(delta/2),
+            // c = cos(delta/2): all terms positive, no cancellation.
+            let (s, c) = T::small_sin_cos(T::from_f64(0.5) * delta);
+            (s + s) * (s + u.sqrt_c0 * c)
         } else {
-            T::ONE - abs_ks
+            direct
         };
         // One test for every path: no ground point, no square root of a negative.
         if !(one_minus > T::ZERO) {

@@ -10,6 +10,8 @@
 //! - [`ClosedForm<f64>`] and [`ClosedForm<f32>`]: the stable closed form;
 //! - [`Fixed`]: the same closed form in fixed point (I24F40 interface, integer-only
 //!   `update` and `motion`) for controllers without an FPU;
+//! - [`ClosedForm<MicroF32>`] (feature `micromath`, the report only): the f32 closed
+//!   form with micromath's sine and cosine;
 //! - [`NaiveF32`] (feature `naive`, host tools and the bench only): the paper's route in
 //!   f32 with libm trig per pixel, the baseline the others are measured against.
 //!
@@ -34,6 +36,8 @@ pub mod error;
 #[cfg(feature = "fixed-point")]
 pub mod fixed_point;
 pub mod line_period;
+#[cfg(feature = "micromath")]
+pub mod micromath_f32;
 pub mod model;
 pub mod mtf;
 #[cfg(feature = "naive")]
@@ -52,6 +56,8 @@ pub use error::{ModelError, Param};
 #[cfg(feature = "fixed-point")]
 pub use fixed_point::{Fixed, FixedReal, FIXED};
 pub use line_period::{line_period_s, line_period_ticks, Ticks};
+#[cfg(feature = "micromath")]
+pub use micromath_f32::MicroF32;
 pub use model::{
     domain, orbital_rate_rad_s, Backend, Camera, Geometry, ImageMotion, EARTH_RATE_RAD_S, GM_M3_S2,
 };
@@ -67,3 +73,6 @@ pub use reference::Reference;
 pub const CLOSED_F64: ClosedForm<f64> = ClosedForm::new();
 /// The closed form in f32, the shipped path.
 pub const CLOSED_F32: ClosedForm<f32> = ClosedForm::new();
+/// The closed form in f32 with micromath's sine and cosine (a report variant).
+#[cfg(feature = "micromath")]
+pub const CLOSED_MICROMATH: ClosedForm<MicroF32> = ClosedForm::new();

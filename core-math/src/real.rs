@@ -33,6 +33,8 @@ pub trait Real:
     /// (sin x, cos x), each within 2 ulp (f32: `trig::sin_cos_f32`, 1.54 ulp measured).
     fn sin_cos(self) -> (Self, Self);
     fn is_finite(self) -> bool;
+    /// |x| (one `vabs.f32` on the target).
+    fn abs(self) -> Self;
     /// Largest integer not above `self`.
     fn floor(self) -> Self;
     /// Conversion to u32, saturating at 0 and `u32::MAX` (NaN gives 0), as Rust's `as`.
@@ -77,6 +79,10 @@ impl Real for f64 {
         f64::is_finite(self)
     }
     #[inline(always)]
+    fn abs(self) -> Self {
+        f64::abs(self)
+    }
+    #[inline(always)]
     fn floor(self) -> Self {
         libm::floor(self)
     }
@@ -118,6 +124,10 @@ impl Real for f32 {
     #[inline(always)]
     fn is_finite(self) -> bool {
         f32::is_finite(self)
+    }
+    #[inline(always)]
+    fn abs(self) -> Self {
+        f32::abs(self)
     }
     #[inline(always)]
     fn floor(self) -> Self {
