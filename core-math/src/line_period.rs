@@ -47,9 +47,18 @@ pub fn line_period_ticks<T: Real>(period_s: T, clock_hz: T) -> Result<Ticks<T>, 
         return Err(ModelError::LinePeriodOutOfRange);
     }
     let exact = period_s * clock_hz;
-    let nearest = (exact + T::from_f64(0.5)).floor();
-    // Compared as reals before converting, since `as u32` would saturate silently.
-    if !(nearest >= T::ONE && nearest <= T::from_f64(u32::MAX as f64)) {
+    // Half up, from the exact fraction: `floor(exact + 0.5)` would round the sum first
+    // (0.5 - 1 ulp + 0.5 gives 1.0; in f32 an odd integer above 2^23 plus 0.5 ties to
+    // the even one above).
+    let whole = exact.floor();
+    let nearest = if exact - whole >= T::from_f64(0.5) {
+        whole + T::ONE
+    } else {
+        whole
+    };
+    // Compared as reals before converting, since `as u32` would saturate silently; 2^32
+    // is exact in f32 and f64, where u32::MAX rounds to 2^32 in f32.
+    if !(nearest >= T::ONE && nearest < T::from_f64(4_294_967_296.0)) {
         return Err(ModelError::LinePeriodOutOfRange);
     }
     let ticks = nearest.to_u32();

@@ -60,6 +60,10 @@ pub fn mtf_mismatch<T: Real>(stages: u32, rel_mismatch: T) -> Result<T, ModelErr
 /// Smallest and largest MTF floor a [`StageRule`] accepts.
 pub const MIN_MTF_FLOOR: f64 = 0.25;
 pub const MAX_MTF_FLOOR: f64 = 0.9999;
+/// Stage limits above this (2^23) are taken as this by [`StageRule::max_stages`]: f32
+/// holds every count up to it exactly, and its search is proven there
+/// (`core-math/tests/fuzz_regressions.rs`, F5). TDI sensors have at most a few hundred.
+pub const MAX_STAGE_LIMIT: u32 = 1 << 23;
 
 /// The TDI stage limit for one MTF floor: computed once (per scene), used per update.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -96,10 +100,16 @@ impl<T: Real> StageRule<T> {
         })
     }
 
-    /// The largest M in 0..=`stage_limit` with MTF_mismatch(M, dv/v) >= floor.
-    /// The closed-form guess is checked against [`mtf_mismatch`] itself and moved by
-    /// one stage where rounding put it on the wrong side of the floor.
+    /// The largest M in 0..=min(`stage_limit`, [`MAX_STAGE_LIMIT`]) with
+    /// MTF_mismatch(M, dv/v) >= floor. The closed-form guess is checked against
+    /// [`mtf_mismatch`] itself and moved by one stage where rounding put it on the wrong
+    /// side of the floor. The returned M always meets the floor.
     pub fn max_stages(&self, rel_mismatch: T, stage_limit: u32) -> Result<u32, ModelError> {
+        // Finding F5 (docs/fuzzing.md): beyond 2^23 an f32 guess is off by more than the
+        // correction's two steps, and past 2^24 neighbouring counts round to one f32.
+        // Capping keeps the answer meeting the floor; only its maximality is given up,
+        // for counts no TDI sensor has.
+        let stage_limit = stage_limit.min(MAX_STAGE_LIMIT);
         if !rel_mismatch.is_finite() {
             return Err(ModelError::NonFinite(Param::RelativeMismatch));
         }

@@ -9,6 +9,8 @@
 //! that could wrap panics there instead, and the narrowing casts are bounded by
 //! `debug_assert!`s. The corner test runs every corner in that build too.
 
+mod common;
+
 use core_math::accuracy::limb_margin_rad;
 use core_math::fixed_point::{geometry_from_f64, motion_to_f64};
 use core_math::{
@@ -19,7 +21,7 @@ use proptest::prelude::*;
 /// Relative error of |v_P| and v1, and error of v2 over |v_P|, accepted anywhere in the
 /// envelope, the limb included (measured maximum: 1.1e-7, docs/fixed-point.md; the
 /// requirement is 2e-6).
-const REL_TOL: f64 = 5.0e-7;
+const REL_TOL: f64 = common::FIXED_REL_TOLERANCE;
 /// The far-from-the-limb property test keeps this margin (rad); the other goes to 1e-6.
 const FAR_MARGIN_RAD: f64 = 1.0e-3;
 

@@ -1,4 +1,4 @@
-//! The findings of the fuzzers (docs/fuzzing.md, F1-F4), each kept as a test.
+//! The findings of the fuzzers (docs/fuzzing.md, F1-F5), each kept as a test.
 
 use core_math::{
     line_period_s, mtf_mismatch, Backend, Camera, Geometry, ModelError, Reference, StageRule,
@@ -103,6 +103,9 @@ fn f4_stage_search_is_bounded_and_floors_are_in_the_main_lobe() {
         for d in [1e-15, 1e-9, 1e-6, 1e-3, 0.1, 1.0, 131_072.000_000_059_6] {
             let m = rule.max_stages(d, u32::MAX).unwrap();
             let mtf = |m: u32| mtf_mismatch(m, d).unwrap();
+            // The limit is capped (F5): M is the largest up to MAX_STAGE_LIMIT.
+            let cap = core_math::mtf::MAX_STAGE_LIMIT;
+            assert!(m <= cap);
             if m > 0 {
                 assert!(
                     mtf(m) >= floor - 1e-12,
@@ -110,7 +113,7 @@ fn f4_stage_search_is_bounded_and_floors_are_in_the_main_lobe() {
                     mtf(m)
                 );
             }
-            if m < u32::MAX {
+            if m < cap {
                 assert!(
                     mtf(m + 1) < floor + 1e-12,
                     "floor {floor} d {d}: M + 1 = {} still meets",
@@ -118,5 +121,55 @@ fn f4_stage_search_is_bounded_and_floors_are_in_the_main_lobe() {
                 );
             }
         }
+    }
+}
+
+/// F5: in f32, `max_stages` with a stage limit beyond ~2^23 returned an M that missed
+/// the floor. Its guess floor(budget / dv/v) was then off by more than the two
+/// correction steps F4 allows (and above 2^24, M +/- 1 may round to the same f32, so a
+/// step changes nothing). Fixed by capping the limit at `MAX_STAGE_LIMIT` (2^23), where
+/// the next test proves the search. The fuzzer's input (docs/fuzzing.md, run of
+/// 2026-11-21) and the smallest case found by a sweep.
+#[test]
+fn f5_f32_stage_search_meets_the_floor_for_huge_limits() {
+    let cases: [(f64, f32, u32); 2] = [
+        (
+            2_425_393_296.0 / u32::MAX as f64,
+            7.041_529e-9,
+            2_425_393_296,
+        ),
+        (0.5, 7.074_536_5e-8, u32::MAX),
+    ];
+    for (floor, d, limit) in cases {
+        let rule = StageRule::<f32>::new(floor).unwrap();
+        let m = rule.max_stages(d, limit).unwrap();
+        assert!(m <= core_math::mtf::MAX_STAGE_LIMIT);
+        let mtf = mtf_mismatch(m, d).unwrap();
+        assert!(
+            m == 0 || mtf >= rule.mtf_floor(),
+            "floor {floor} d {d:e}: M {m} gives {mtf} < {}",
+            rule.mtf_floor()
+        );
+    }
+}
+
+/// F5's boundary: up to 2^23 stages the f32 search meets the floor (a sweep of floors
+/// and mismatches, each checked against `mtf_mismatch` itself).
+#[test]
+fn f5_f32_stage_search_meets_the_floor_up_to_2_pow_23() {
+    let mut d = 1e-9f64;
+    while d < 1e-2 {
+        for floor in [0.25, 0.5, 0.8, 0.95, 0.9999] {
+            let rule = StageRule::<f32>::new(floor).unwrap();
+            let m = rule.max_stages(d as f32, 1 << 23).unwrap();
+            if m > 0 {
+                let mtf = mtf_mismatch(m, d as f32).unwrap();
+                assert!(
+                    mtf >= rule.mtf_floor(),
+                    "floor {floor} d {d:e}: M {m}, {mtf}"
+                );
+            }
+        }
+        d *= 1.0137;
     }
 }

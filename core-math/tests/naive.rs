@@ -7,6 +7,9 @@
 //! The survey behind the bounds below prints with
 //! `cargo test --release -p core-math --test naive -- --nocapture`.
 
+mod common;
+
+use common::{NAIVE_BOUND as BOUND, NAIVE_BUCKETS_DEG as BUCKETS_DEG};
 use core_math::accuracy::limb_margin_rad;
 use core_math::sample::SplitMix64 as Rng;
 use core_math::{Backend, Camera, Geometry, NaiveF32, Reference};
@@ -16,16 +19,15 @@ const CAMERA: Camera = Camera {
     pixel_m: 13e-6,
 };
 
-/// Limb-margin buckets (deg), lower bounds; the last is everything closer.
-const BUCKETS_DEG: [f64; 6] = [1.0, 0.1, 0.01, 1e-3, 1e-4, 0.0];
 /// Measured maximum relative error of |v_P| per bucket over the 200 000 cases of the seed
-/// below (f32 geometry, reference at the same inputs), and the bound asserted (about 2.5x
-/// the measurement). Far from the limb the naive route is good to ~1e-5, some 10x worse
-/// than `CLOSED_F32` (6.6e-7); toward the limb its asin and the difference of Eq. 3 lose
+/// below (f32 geometry, reference at the same inputs); the bound asserted, about 2.5x
+/// the measurement, is `common::NAIVE_BOUND` (limb-margin buckets `NAIVE_BUCKETS_DEG`,
+/// lower bounds in deg, the last everything closer), shared with tests/stiff.rs. Far
+/// from the limb the naive route is good to ~1e-5, some 10x worse than `CLOSED_F32`
+/// (6.6e-7); toward the limb its asin and the difference of Eq. 3 lose
 /// digits like u/q^2 and the error reaches ~1e-3 within 1e-4 deg, where it also refuses
 /// some rays the reference accepts ((R+H) sin(eta)/R rounds to 1 in f32).
 const MEASURED: [f64; 6] = [7.41e-6, 1.16e-5, 2.68e-5, 1.02e-4, 3.47e-4, 9.17e-4];
-const BOUND: [f64; 6] = [2.0e-5, 3.0e-5, 7.0e-5, 2.5e-4, 1.0e-3, 2.5e-3];
 
 /// A random case of the envelope whose line of sight meets the Earth; one in four is
 /// drawn log-uniformly within 1 deg of a limb so that the limb buckets are populated.

@@ -3,7 +3,7 @@
 //!
 //! Oracles: no panic (the crate promises "no panics on any input"), every `Ok` value
 //! finite, `line_period_ticks` within half a tick (plus rounding) of period x clock,
-//! `max_stages` at most the limit and meeting the floor.
+//! `max_stages` at most the limit and meeting the floor (in f64 also the largest such).
 //!
 //! Each input value is either a raw f64 (any bit pattern: NaN, inf, subnormal, huge)
 //! or a fraction mapped into a range around the model's domain, so that the fuzzer
@@ -73,14 +73,12 @@ fn check_motion<T: Real>(m: &ImageMotion<T>, what: &str, input: &Input) {
     assert!(s.is_finite(), "{what}: non-finite speed for {input:?}");
 }
 
-fn stage_rule<T: Real + core::fmt::Debug>(floor: f64, rel: T, limit: u32) {
+/// `largest`: also check that M + 1 misses the floor (the doc's "largest M"); asked of
+/// f64 only, where every u32 stage count and the guess are exact to well under a stage.
+fn stage_rule<T: Real + core::fmt::Debug>(floor: f64, rel: T, limit: u32, largest: bool) {
     if let Ok(rule) = StageRule::<T>::new(floor) {
-        // Finding F4 (docs/fuzzing.md): `max_stages` corrects its closed-form guess one
-        // stage at a time, and the guess can be off by up to the whole limit (floor that
-        // rounds to 1 in T; a tiny floor with sinc's side lobes): up to 4e9 sinc
-        // evaluations, seconds to minutes. Known and reported; the limit is capped at
-        // u16::MAX (the controller's range) so that the run can look for anything else.
-        let limit = limit.min(65_535);
+        // F4 (docs/fuzzing.md, fixed): the correction of the guess is bounded, so any
+        // limit up to u32::MAX is checked (the run's -timeout catches a slow search).
         assert!(rule.mismatch_budget().is_finite() && rule.mtf_floor().is_finite());
         if let Ok(m) = rule.max_stages(rel, limit) {
             assert!(m <= limit, "max_stages {m} > limit {limit}");
@@ -89,6 +87,15 @@ fn stage_rule<T: Real + core::fmt::Debug>(floor: f64, rel: T, limit: u32) {
                 assert!(
                     mtf >= rule.mtf_floor(),
                     "max_stages {m} misses the floor: mtf {mtf:?} < {:?} (rel {rel:?})",
+                    rule.mtf_floor()
+                );
+            }
+            // Limits are capped at MAX_STAGE_LIMIT (finding F5): the largest M below it.
+            if largest && m < limit.min(core_math::mtf::MAX_STAGE_LIMIT) {
+                let next = mtf_mismatch(m + 1, rel).expect("finite rel");
+                assert!(
+                    !(next >= rule.mtf_floor()),
+                    "max_stages {m} is not the largest: mtf(M + 1) {next:?} >= {:?} (rel {rel:?})",
                     rule.mtf_floor()
                 );
             }
@@ -141,20 +148,12 @@ fuzz_target!(|input: Input| {
         if let Ok(m) = core_math::Reference.evaluate(&camera, &g, n_px) {
             check_motion(&m, "Reference", &input);
         }
-        // Finding F3 (docs/fuzzing.md): with |roll| > pi the closed form's limb distance
-        // (built from the unreduced roll) is wrong, and a ray that misses the Earth gives
-        // Ok(NaN) instead of LineOfSightMissesEarth. Known and reported: a NaN with
-        // |roll| > pi is not asserted again; any other non-finite Ok still is.
-        let f3 = !(g.roll_rad.abs() <= core::f64::consts::PI);
+        // F3 (docs/fuzzing.md, fixed): rolls beyond pi are checked like any other.
         if let Ok(m) = CLOSED_F64.evaluate(&camera, &g, n_px) {
-            if !f3 {
-                check_motion(&m, "CLOSED_F64", &input);
-            }
+            check_motion(&m, "CLOSED_F64", &input);
         }
         if let Ok(m) = CLOSED_F32.evaluate(&camera, &g.to::<f32>(), n_px) {
-            if !f3 {
-                check_motion(&m, "CLOSED_F32", &input);
-            }
+            check_motion(&m, "CLOSED_F32", &input);
         }
         if let Ok(gf) = geometry_from_f64(&g) {
             if let Ok(m) = FIXED.evaluate(&camera, &gf, n_px) {
@@ -164,42 +163,34 @@ fuzz_target!(|input: Input| {
     }
 
     let rel = input.rel_mismatch.get(-0.1, 0.1);
-    // Finding F1 (docs/fuzzing.md): when (pi/2) x stages x rel overflows to infinity,
-    // `mtf_mismatch` answers Ok(NaN) (sinc(inf) = sin(inf)/inf). Known and reported; not
-    // asserted again here so that the run can look for anything else.
-    let arg64 = core::f64::consts::FRAC_PI_2 * f64::from(input.stages) * rel;
+    // F1 (docs/fuzzing.md, fixed): an overflowing sinc argument must give a finite
+    // value too (its limit, 0), so every Ok is asserted finite.
     if let Ok(x) = mtf_mismatch(input.stages, rel) {
-        assert!(
-            x.is_finite() || !arg64.is_finite(),
-            "mtf_mismatch f64 {x} for {input:?}"
-        );
+        assert!(x.is_finite(), "mtf_mismatch f64 {x} for {input:?}");
     }
-    let arg32 = core::f32::consts::FRAC_PI_2 * input.stages as f32 * rel as f32;
     if let Ok(x) = mtf_mismatch(input.stages, rel as f32) {
-        assert!(
-            x.is_finite() || !arg32.is_finite(),
-            "mtf_mismatch f32 {x} for {input:?}"
-        );
+        assert!(x.is_finite(), "mtf_mismatch f32 {x} for {input:?}");
     }
     let floor = input.mtf_floor.get(0.0, 1.0);
-    stage_rule::<f64>(floor, rel, input.stage_limit);
-    stage_rule::<f32>(floor, rel as f32, input.stage_limit);
+    stage_rule::<f64>(floor, rel, input.stage_limit, true);
+    // Finding F5 (docs/fuzzing.md, fixed): f32 gets any u32 limit again.
+    stage_rule::<f32>(floor, rel as f32, input.stage_limit, false);
 
     let period = input.period_s.get(0.0, 1.0e-2);
     let clock = input.clock_hz.get(0.0, 1.0e9);
     ticks::<f64>(period, clock, f64::EPSILON);
     ticks::<f32>(period as f32, clock as f32, f64::from(f32::EPSILON));
-    // Finding F2 (docs/fuzzing.md): an infinite speed, or a quotient that underflows,
-    // gives Ok(0.0). Known and reported; only finiteness and sign are asserted here.
+    // F2 (docs/fuzzing.md, fixed): no zero period any more, so every Ok is finite and
+    // strictly positive.
     if let Ok(p) = line_period_s(camera.pixel_m, period) {
         assert!(
-            p.is_finite() && p >= 0.0,
+            p.is_finite() && p > 0.0,
             "line_period_s f64 {p} for {input:?}"
         );
     }
     if let Ok(p) = line_period_s(camera.pixel_m as f32, period as f32) {
         assert!(
-            p.is_finite() && p >= 0.0,
+            p.is_finite() && p > 0.0,
             "line_period_s f32 {p} for {input:?}"
         );
     }
