@@ -4,7 +4,10 @@
 //! of the limb on either side, several optics.
 
 use core_math::accuracy::{f64_rel_tolerance, F32_REL_TOLERANCE, F32_V2_TOLERANCE};
-use core_math::{Backend, Camera, Geometry, Reference, CLOSED_F32, CLOSED_F64};
+use core_math::{
+    Backend, Camera, Geometry, MicroF32, NaiveF32, Reference, CLOSED_F32, CLOSED_F64,
+    CLOSED_MICROMATH,
+};
 use proptest::prelude::*;
 
 #[derive(Clone, Copy, Debug)]
@@ -132,6 +135,13 @@ proptest! {
         }
         if let Ok(m) = CLOSED_F32.evaluate(&camera, &g.to::<f32>(), n) {
             prop_assert!(m.v1_mps.is_finite() && m.v2_mps.is_finite() && m.speed_mps().is_finite(), "{:?}", m);
+        }
+        // The report's variants too (FIXED has its own in tests/fixed_point.rs).
+        if let Ok(m) = NaiveF32.evaluate(&camera, &g.to::<f32>(), n) {
+            prop_assert!(m.v1_mps.is_finite() && m.v2_mps.is_finite() && m.speed_mps().is_finite(), "{:?}", m);
+        }
+        if let Ok(m) = CLOSED_MICROMATH.evaluate(&camera, &g.to::<MicroF32>(), n) {
+            prop_assert!(m.v1_mps.0.is_finite() && m.v2_mps.0.is_finite() && m.speed_mps().0.is_finite(), "{:?}", m);
         }
     }
 }
