@@ -18,6 +18,8 @@
 
 use std::path::Path;
 
+pub mod heatmap;
+
 /// An RGB colour.
 pub type Rgb = [u8; 3];
 

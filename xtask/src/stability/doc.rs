@@ -1,0 +1,392 @@
+//! The figures: PNG maps, the tables, and the values the document's template quotes.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use crate::plot::heatmap::Heatmap;
+
+use super::maps::{Cell, Map};
+use super::point::{Outcome, Point, INPUTS};
+use super::{C_F32, C_FIXED};
+
+/// log10 with a floor, so that an exact 0 lands at the bottom of the colour scale.
+fn lg(x: f64) -> f64 {
+    x.max(1e-30).log10()
+}
+
+pub fn e2(x: f64) -> String {
+    format!("{x:.2e}")
+}
+
+fn f2(x: f64) -> String {
+    format!("{x:.2}")
+}
+
+/// A short description of where a point is.
+pub fn describe(pt: &Point, o: &Outcome) -> String {
+    let g = &pt.g;
+    format!(
+        "H {:.0} km, roll {:.2} deg, field {:.2} deg, i0 {:.1} deg, g0 {:.1} deg; limb margin {} deg",
+        g.altitude_m / 1e3,
+        g.roll_rad.to_degrees(),
+        pt.field_rad.to_degrees(),
+        g.inclination_rad.to_degrees(),
+        g.arg_latitude_rad.to_degrees(),
+        sig(o.margin_rad.to_degrees()),
+    )
+}
+
+/// Three significant digits, plain or scientific.
+pub fn sig(x: f64) -> String {
+    if x != 0.0 && (x.abs() < 0.01 || x.abs() >= 1e4) {
+        format!("{x:.2e}")
+    } else if x.abs() >= 100.0 {
+        format!("{x:.0}")
+    } else if x.abs() >= 10.0 {
+        format!("{x:.1}")
+    } else {
+        format!("{x:.3}")
+    }
+}
+
+/// One panel of a map: file suffix, title, colour-bar label, z range (log10 unless
+/// `linear`), the value, and which sample's location to mark.
+struct Panel {
+    suffix: &'static str,
+    title: &'static str,
+    z_label: &'static str,
+    z_range: (f64, f64),
+    linear: bool,
+    value: fn(&Cell) -> f64,
+    /// A line across the colour bar (the stated bound), in plotted units.
+    bound: Option<f64>,
+}
+
+const ERR_RANGE: (f64, f64) = (-10.0, -3.0);
+const RATIO_RANGE: (f64, f64) = (-3.0, 1.0);
+
+const PANELS: [Panel; 6] = [
+    Panel {
+        suffix: "kappa",
+        title: "condition number kappa",
+        z_label: "kappa",
+        z_range: (0.0, 4.0),
+        linear: false,
+        value: |c| lg(c.kappa),
+        bound: None,
+    },
+    Panel {
+        suffix: "err-f32",
+        title: "f32 error (same inputs)",
+        z_label: "rel. error |v_P|",
+        z_range: ERR_RANGE,
+        linear: false,
+        value: |c| lg(c.e_f32),
+        bound: None,
+    },
+    Panel {
+        suffix: "err-f32-inputs",
+        title: "f32 error (unrounded inputs)",
+        z_label: "rel. error |v_P|",
+        z_range: ERR_RANGE,
+        linear: false,
+        value: |c| lg(c.e_f32_in),
+        bound: None,
+    },
+    Panel {
+        suffix: "err-fixed",
+        title: "fixed-point error",
+        z_label: "rel. error |v_P|",
+        z_range: ERR_RANGE,
+        linear: false,
+        value: |c| lg(c.e_fixed.max(c.e_fixed_in)),
+        bound: None,
+    },
+    Panel {
+        suffix: "ratio-f32",
+        title: "f32: err / (kappa u)",
+        z_label: "err / (kappa u)",
+        z_range: RATIO_RANGE,
+        linear: false,
+        value: |c| lg(c.ratio_f32.max(c.ratio_f32_in)),
+        bound: Some(C_F32),
+    },
+    Panel {
+        suffix: "ratio-fixed",
+        title: "fixed: err / (kappa u_fx)",
+        z_label: "err / (kappa u_fx)",
+        z_range: RATIO_RANGE,
+        linear: false,
+        value: |c| lg(c.ratio_fixed),
+        bound: Some(C_FIXED),
+    },
+];
+
+/// The extra panel of the inclination map: the ratio of v1's two terms.
+const V1_TERMS: Panel = Panel {
+    suffix: "v1-terms",
+    title: "v1: cancellation of its two terms",
+    z_label: "t (second / first)",
+    z_range: (0.0, 0.1),
+    linear: true,
+    value: |c| c.v1_term_ratio,
+    bound: None,
+};
+
+fn heatmap(map: &Map, panel: &Panel, map_letter: &str) -> Heatmap {
+    let s = map.spec;
+    let values = map.values(panel.value);
+    let mut h = Heatmap::new(
+        &format!("{map_letter}: {}", panel.title),
+        s.x_label,
+        s.y_label,
+        panel.z_label,
+        (map.nx, map.ny),
+        values,
+    )
+    .x_range(s.x_range.0, s.x_range.1)
+    .y_range(s.y_range.0, s.y_range.1)
+    .y_decades(s.y_decades)
+    .z_range(panel.z_range.0, panel.z_range.1)
+    .z_decades(!panel.linear)
+    .missing_label(s.missing);
+    if let Some(c) = panel.bound {
+        h = h.z_mark(c.log10());
+    }
+    if let Some((ix, iy)) = map.argmax(panel.value) {
+        let (x, y) = map.centre(ix, iy);
+        h = h.mark(x, y);
+    }
+    h
+}
+
+/// The kappa panel (each cell's largest kappa) with its colour scale fitted to the map:
+/// decades when it spans one or more, linear (whole numbers) otherwise, where a log
+/// scale would show one colour.
+fn kappa_panel(map: &Map) -> Panel {
+    let (lo, hi) = map
+        .cells
+        .iter()
+        .filter(|c| c.n > 0)
+        .fold((f64::INFINITY, 0.0f64), |(l, h), c| {
+            (l.min(c.kappa), h.max(c.kappa))
+        });
+    // Also when the map is empty (lo = inf) or flat.
+    if lo.partial_cmp(&hi) != Some(std::cmp::Ordering::Less) || hi / lo >= 10.0 {
+        return Panel {
+            z_range: (lg(lo).floor().min(0.0), lg(hi).ceil().max(1.0)),
+            ..PANELS[0]
+        };
+    }
+    Panel {
+        z_range: (lo.floor(), hi.ceil()),
+        linear: true,
+        value: |c| c.kappa,
+        ..PANELS[0]
+    }
+}
+
+/// Writes the PNGs of `map` into `dir`; returns the file names in panel order.
+pub fn write_pngs(map: &Map, letter: &str, dir: &Path) -> Result<Vec<String>, String> {
+    let mut names = Vec::new();
+    let extra = if map.spec.key == "inclination-latitude" {
+        Some(&V1_TERMS)
+    } else {
+        None
+    };
+    for panel in PANELS.iter().chain(extra) {
+        let name = format!("{}-{}.png", map.spec.key, panel.suffix);
+        let panel = if panel.suffix == "kappa" {
+            &kappa_panel(map)
+        } else {
+            panel
+        };
+        heatmap(map, panel, letter).save(&dir.join(&name))?;
+        names.push(name);
+    }
+    Ok(names)
+}
+
+/// Maxima over the cells of `map` that pass `keep`.
+#[derive(Clone, Default)]
+pub struct Agg {
+    pub n: u64,
+    pub refused: u64,
+    pub refused_by: Option<&'static str>,
+    pub e_f32: f64,
+    pub e_f32_v1: f64,
+    pub e_f32_in: f64,
+    pub e_fixed: f64,
+    pub e_fixed_v1: f64,
+    pub kappa_min: f64,
+    pub kappa_max: f64,
+    pub ratio_f32: f64,
+    pub ratio_f32_in: f64,
+    pub ratio_fixed: f64,
+    /// min and max of kappa q over the max-kappa sample of each cell.
+    pub kq: (f64, f64),
+    pub worst_f32: Option<(Point, Outcome)>,
+    pub worst_f32_in: Option<(Point, Outcome)>,
+    pub worst_fixed: Option<(Point, Outcome)>,
+    pub max_kappa: Option<(Point, Outcome)>,
+    pub max_v1_terms: f64,
+}
+
+pub fn aggregate(map: &Map, keep: impl Fn(usize, usize, &Cell) -> bool) -> Agg {
+    let mut a = Agg {
+        kappa_min: f64::INFINITY,
+        kq: (f64::INFINITY, 0.0),
+        max_v1_terms: f64::NEG_INFINITY,
+        ..Agg::default()
+    };
+    for iy in 0..map.ny {
+        for ix in 0..map.nx {
+            let c = &map.cells[iy * map.nx + ix];
+            if c.n == 0 || !keep(ix, iy, c) {
+                continue;
+            }
+            a.n += c.n as u64;
+            a.refused += c.refused as u64;
+            a.refused_by = a.refused_by.or(c.refused_by);
+            a.e_f32 = a.e_f32.max(c.e_f32);
+            a.e_f32_v1 = a.e_f32_v1.max(c.e_f32_v1);
+            a.e_f32_in = a.e_f32_in.max(c.e_f32_in);
+            a.e_fixed = a.e_fixed.max(c.e_fixed.max(c.e_fixed_in));
+            a.e_fixed_v1 = a.e_fixed_v1.max(c.e_fixed_v1);
+            a.kappa_min = a.kappa_min.min(c.min_kappa);
+            a.max_v1_terms = a.max_v1_terms.max(c.v1_term_ratio);
+            let take = |best: &mut f64, slot: &mut Option<(Point, Outcome)>, v: f64, w| {
+                if v > *best || slot.is_none() {
+                    *best = v;
+                    *slot = w;
+                }
+            };
+            take(&mut a.ratio_f32, &mut a.worst_f32, c.ratio_f32, c.worst_f32);
+            take(
+                &mut a.ratio_f32_in,
+                &mut a.worst_f32_in,
+                c.ratio_f32_in,
+                c.worst_f32_in,
+            );
+            take(
+                &mut a.ratio_fixed,
+                &mut a.worst_fixed,
+                c.ratio_fixed,
+                c.worst_fixed,
+            );
+            take(&mut a.kappa_max, &mut a.max_kappa, c.kappa, c.max_kappa);
+            if let Some((_, o)) = c.max_kappa {
+                let kq = o.kappa * o.q;
+                a.kq = (a.kq.0.min(kq), a.kq.1.max(kq));
+            }
+        }
+    }
+    a
+}
+
+/// A markdown table.
+pub fn table(header: &[&str], rows: &[Vec<String>]) -> String {
+    let mut s = format!(
+        "| {} |\n|{}\n",
+        header.join(" | "),
+        "---|".repeat(header.len())
+    );
+    for r in rows {
+        s.push_str(&format!("| {} |\n", r.join(" | ")));
+    }
+    s
+}
+
+const AGG_HEADER: [&str; 12] = [
+    "cases",
+    "kappa min - max",
+    "f32 err \\|v\\|",
+    "f32 err v1",
+    "f32 err, unrounded inputs",
+    "fixed err \\|v\\|",
+    "fixed err v1",
+    "f32 err/(kappa u)",
+    "f32 unrounded err/(kappa u)",
+    "fixed err/(kappa u_fx)",
+    "kappa q",
+    "refused",
+];
+
+fn agg_row(first: String, a: &Agg) -> Vec<String> {
+    vec![
+        first,
+        a.n.to_string(),
+        format!("{} - {}", sig(a.kappa_min), sig(a.kappa_max)),
+        e2(a.e_f32),
+        e2(a.e_f32_v1),
+        e2(a.e_f32_in),
+        e2(a.e_fixed),
+        e2(a.e_fixed_v1),
+        f2(a.ratio_f32),
+        f2(a.ratio_f32_in),
+        f2(a.ratio_fixed),
+        format!("{} - {}", sig(a.kq.0), sig(a.kq.1)),
+        a.refused.to_string(),
+    ]
+}
+
+pub fn agg_table(first: &str, rows: &[(String, Agg)]) -> String {
+    let mut header = vec![first];
+    header.extend(AGG_HEADER);
+    let rows: Vec<Vec<String>> = rows.iter().map(|(n, a)| agg_row(n.clone(), a)).collect();
+    table(&header, &rows)
+}
+
+/// kappa's parts at a point, largest first, as "roll 6.2, altitude 3.0, ...".
+pub fn parts(o: &Outcome) -> String {
+    let mut idx: Vec<usize> = (0..INPUTS.len()).collect();
+    idx.sort_by(|&a, &b| o.kappa_parts[b].total_cmp(&o.kappa_parts[a]));
+    idx.iter()
+        .filter(|&&i| o.kappa_parts[i] >= 0.01)
+        .map(|&i| format!("{} {}", INPUTS[i], sig(o.kappa_parts[i])))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// Least-squares slope of log10(kappa) against log10(q) over the max-kappa samples of
+/// the cells of `map` whose line of sight is within `margin_deg` of the limb.
+pub fn limb_slope(map: &Map, margin_deg: f64) -> Option<(f64, usize)> {
+    let pts: Vec<(f64, f64)> = map
+        .cells
+        .iter()
+        .filter_map(|c| c.max_kappa)
+        .filter(|(_, o)| o.margin_rad.to_degrees() < margin_deg)
+        .map(|(_, o)| (o.q.log10(), o.kappa.log10()))
+        .collect();
+    let n = pts.len() as f64;
+    if pts.len() < 3 {
+        return None;
+    }
+    let (sx, sy) = pts.iter().fold((0.0, 0.0), |(a, b), (x, y)| (a + x, b + y));
+    let (mx, my) = (sx / n, sy / n);
+    let (sxy, sxx) = pts.iter().fold((0.0, 0.0), |(a, b), (x, y)| {
+        (a + (x - mx) * (y - my), b + (x - mx) * (x - mx))
+    });
+    Some((sxy / sxx, pts.len()))
+}
+
+/// Fills `{{key}}` placeholders; an unknown key is an error.
+pub fn fill(template: &str, values: &BTreeMap<String, String>) -> Result<String, String> {
+    let mut out = String::with_capacity(template.len() * 2);
+    let mut rest = template;
+    while let Some(b) = rest.find("{{") {
+        out.push_str(&rest[..b]);
+        let e = rest[b..]
+            .find("}}")
+            .ok_or("stability template: unclosed {{")?
+            + b;
+        let key = rest[b + 2..e].trim();
+        let v = values
+            .get(key)
+            .ok_or(format!("stability template: no value for `{key}`"))?;
+        out.push_str(v);
+        rest = &rest[e + 2..];
+    }
+    out.push_str(rest);
+    Ok(out)
+}

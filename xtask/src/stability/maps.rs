@@ -1,0 +1,304 @@
+//! The three maps: which variables span each, where the others sit, and the sweep.
+
+use super::point::{evaluate, Outcome, Point, Skip, EARTH_RADIUS_M};
+
+/// Sun-synchronous inclination of the paper's orbit (deg).
+pub const I0_SSO_DEG: f64 = 97.98;
+
+/// One 2-D map of the envelope.
+pub struct MapSpec {
+    /// File stem under docs/stability/ and key in the document.
+    pub key: &'static str,
+    pub title: &'static str,
+    pub x_label: &'static str,
+    pub y_label: &'static str,
+    pub x_range: (f64, f64),
+    pub y_range: (f64, f64),
+    /// The y coordinate is log10 of the quantity (decade ticks).
+    pub y_decades: bool,
+    /// Cells (full run).
+    pub nx: usize,
+    pub ny: usize,
+    /// Sub-samples per cell (full run).
+    pub sub: usize,
+    /// The point of sub-sample `s` at (x, y); None where the map has no line of sight.
+    pub point: fn(x: f64, y: f64, s: usize) -> Option<Point>,
+    /// What the other variables are, for the document.
+    pub others: &'static str,
+    /// Label of the grey cells (no line of sight there), empty if there are none.
+    pub missing: &'static str,
+}
+
+/// Inclination and argument of latitude (deg) the sub-samples of map A cycle through.
+const OTHERS_A: [(f64, f64); 6] = [
+    (I0_SSO_DEG, 0.0),
+    (I0_SSO_DEG, 135.0),
+    (50.0, 270.0),
+    (0.0, 0.0),
+    (150.0, 45.0),
+    (85.0, 90.0),
+];
+
+/// Map A: altitude x distance from the line of sight to the limb (log).
+fn point_a(h_km: f64, log_margin_deg: f64, s: usize) -> Option<Point> {
+    let h = h_km * 1e3;
+    let limb_deg = libm::asin(EARTH_RADIUS_M / (EARTH_RADIUS_M + h)).to_degrees();
+    let margin = 10f64.powf(log_margin_deg);
+    if margin >= limb_deg {
+        return None; // past the nadir: the other side's margin
+    }
+    // Both limbs, and three ways to share eta between roll and field angle.
+    let side = [1.0, -1.0][s % 2];
+    let eta = side * (limb_deg - margin);
+    let a = eta.abs();
+    let (roll, field) = match (s / 6 + s / 2) % 3 {
+        0 => (0.5 * a, 0.5 * a),
+        1 => (a.min(45.0), a - a.min(45.0)),
+        _ => (a - a.min(40.0), a.min(40.0)),
+    };
+    let (i0, g0) = OTHERS_A[s % OTHERS_A.len()];
+    Some(Point::circular(side * roll, side * field, i0, g0, h_km))
+}
+
+/// Map B: roll x field angle at 645 km, sun-synchronous, g0 over the sub-samples.
+fn point_b(roll_deg: f64, field_deg: f64, s: usize) -> Option<Point> {
+    let g0 = 60.0 * (s % 6) as f64;
+    Some(Point::circular(roll_deg, field_deg, I0_SSO_DEG, g0, 645.0))
+}
+
+/// The lines of sight map C takes the maximum over: 1 deg from the left limb (roll
+/// +45 deg), 1 deg from the right limb (roll -45 deg), nadir, a mid-swath point.
+fn los_c(s: usize, h_km: f64) -> (f64, f64) {
+    let limb_deg = libm::asin(EARTH_RADIUS_M / (EARTH_RADIUS_M + h_km * 1e3)).to_degrees();
+    match s % 4 {
+        0 => (45.0, limb_deg - 1.0 - 45.0),
+        1 => (-45.0, -(limb_deg - 1.0 - 45.0)),
+        2 => (0.0, 0.0),
+        _ => (20.0, -30.0),
+    }
+}
+
+/// Map C: inclination x argument of latitude at 2 000 km (where the Earth-rotation
+/// terms are largest against the orbital rate).
+fn point_c(i0_deg: f64, g0_deg: f64, s: usize) -> Option<Point> {
+    let h_km = 2000.0;
+    let (roll, field) = los_c(s, h_km);
+    Some(Point::circular(roll, field, i0_deg, g0_deg, h_km))
+}
+
+pub const MAPS: [MapSpec; 3] = [
+    MapSpec {
+        key: "altitude-limb",
+        title: "altitude x distance to the limb",
+        x_label: "altitude (km)",
+        y_label: "limb margin (deg)",
+        x_range: (200.0, 2000.0),
+        y_range: (-5.0, 2.0),
+        y_decades: true,
+        nx: 120,
+        ny: 112,
+        sub: 12,
+        point: point_a,
+        others: "both limbs alternately; eta shared between roll and field angle three ways \
+                 (half each, roll up to 45 deg, field up to 40 deg); (i0, g0) cycling through \
+                 (97.98, 0), (97.98, 135), (50, 270), (0, 0), (150, 45), (85, 90) deg",
+        missing: "past nadir",
+    },
+    MapSpec {
+        key: "roll-field",
+        title: "roll x field angle, 645 km",
+        x_label: "roll (deg)",
+        y_label: "field angle (deg)",
+        x_range: (-45.0, 45.0),
+        y_range: (-40.0, 40.0),
+        y_decades: false,
+        nx: 180,
+        ny: 160,
+        sub: 6,
+        point: point_b,
+        others: "altitude 645 km, i0 97.98 deg; g0 = 0, 60, ..., 300 deg over the sub-samples",
+        missing: "beyond the limb",
+    },
+    MapSpec {
+        key: "inclination-latitude",
+        title: "inclination x arg. of latitude, 2000 km",
+        x_label: "inclination (deg)",
+        y_label: "argument of latitude (deg)",
+        x_range: (0.0, 180.0),
+        y_range: (0.0, 360.0),
+        y_decades: false,
+        nx: 144,
+        ny: 144,
+        sub: 8,
+        point: point_c,
+        others: "altitude 2 000 km; lines of sight 1 deg from the left limb (roll +45 deg), \
+                 1 deg from the right limb (roll -45 deg), nadir, and roll 20 / field -30 deg",
+        missing: "",
+    },
+];
+
+/// What a cell keeps of its sub-samples: maxima, and the sample behind each ratio's max.
+#[derive(Clone, Debug, Default)]
+pub struct Cell {
+    pub n: u32,
+    pub refused: u32,
+    pub refused_by: Option<&'static str>,
+    pub e_f32: f64,
+    pub e_f32_v1: f64,
+    pub e_f32_in: f64,
+    pub e_fixed: f64,
+    pub e_fixed_v1: f64,
+    pub e_fixed_in: f64,
+    pub kappa: f64,
+    pub min_kappa: f64,
+    pub ratio_f32: f64,
+    pub ratio_f32_in: f64,
+    pub ratio_fixed: f64,
+    pub v1_term_ratio: f64,
+    pub min_margin_rad: f64,
+    pub worst_f32: Option<(Point, Outcome)>,
+    pub worst_f32_in: Option<(Point, Outcome)>,
+    pub worst_fixed: Option<(Point, Outcome)>,
+    pub max_kappa: Option<(Point, Outcome)>,
+}
+
+impl Cell {
+    fn add(&mut self, pt: &Point, o: &Outcome) {
+        if self.n == 0 {
+            self.min_kappa = f64::INFINITY;
+            self.min_margin_rad = f64::INFINITY;
+            self.v1_term_ratio = f64::NEG_INFINITY;
+        }
+        self.n += 1;
+        self.e_f32 = self.e_f32.max(o.e_f32);
+        self.e_f32_v1 = self.e_f32_v1.max(o.e_f32_v1);
+        self.e_f32_in = self.e_f32_in.max(o.e_f32_in);
+        self.e_fixed = self.e_fixed.max(o.e_fixed);
+        self.e_fixed_v1 = self.e_fixed_v1.max(o.e_fixed_v1);
+        self.e_fixed_in = self.e_fixed_in.max(o.e_fixed_in);
+        self.min_kappa = self.min_kappa.min(o.kappa);
+        self.min_margin_rad = self.min_margin_rad.min(o.margin_rad);
+        self.v1_term_ratio = self.v1_term_ratio.max(o.v1_term_ratio);
+        let keep = |best: &mut f64, slot: &mut Option<(Point, Outcome)>, v: f64| {
+            if slot.is_none() || v > *best {
+                *best = v;
+                *slot = Some((*pt, *o));
+            }
+        };
+        keep(&mut self.ratio_f32, &mut self.worst_f32, o.ratio_f32());
+        keep(
+            &mut self.ratio_f32_in,
+            &mut self.worst_f32_in,
+            o.ratio_f32_in(),
+        );
+        keep(
+            &mut self.ratio_fixed,
+            &mut self.worst_fixed,
+            o.ratio_fixed(),
+        );
+        keep(&mut self.kappa, &mut self.max_kappa, o.kappa);
+    }
+}
+
+/// A swept map: the cells, row-major from the bottom row (index iy * nx + ix).
+pub struct Map {
+    pub spec: &'static MapSpec,
+    pub nx: usize,
+    pub ny: usize,
+    /// Sub-samples per cell.
+    pub sub: usize,
+    pub cells: Vec<Cell>,
+}
+
+impl Map {
+    /// Cell centre in map coordinates.
+    pub fn centre(&self, ix: usize, iy: usize) -> (f64, f64) {
+        let (x0, x1) = self.spec.x_range;
+        let (y0, y1) = self.spec.y_range;
+        (
+            x0 + (ix as f64 + 0.5) * (x1 - x0) / self.nx as f64,
+            y0 + (iy as f64 + 0.5) * (y1 - y0) / self.ny as f64,
+        )
+    }
+
+    /// One value per cell (None where the cell has no sample), for a heatmap.
+    pub fn values(&self, f: impl Fn(&Cell) -> f64) -> Vec<Option<f64>> {
+        self.cells
+            .iter()
+            .map(|c| if c.n > 0 { Some(f(c)) } else { None })
+            .collect()
+    }
+
+    /// The cell (ix, iy) maximising `f` over the cells with samples.
+    pub fn argmax(&self, f: impl Fn(&Cell) -> f64) -> Option<(usize, usize)> {
+        (0..self.cells.len())
+            .filter(|&i| self.cells[i].n > 0)
+            .max_by(|&a, &b| f(&self.cells[a]).total_cmp(&f(&self.cells[b])))
+            .map(|i| (i % self.nx, i / self.nx))
+    }
+
+    pub fn samples(&self) -> u64 {
+        self.cells.iter().map(|c| c.n as u64).sum()
+    }
+}
+
+/// Sub-sample `s` of `sub`: offsets in (0, 1) within the cell, stratified in x and
+/// spread by the golden ratio in y (deterministic).
+fn jitter(s: usize, sub: usize) -> (f64, f64) {
+    let fx = (s as f64 + 0.5) / sub as f64;
+    let fy = (0.5 + s as f64 * 0.618_033_988_749_894_9).fract();
+    (fx, fy)
+}
+
+/// Sweeps `spec` with `nx` x `ny` cells and `sub` sub-samples per cell, on every core.
+pub fn sweep(spec: &'static MapSpec, nx: usize, ny: usize, sub: usize) -> Map {
+    let (x0, x1) = spec.x_range;
+    let (y0, y1) = spec.y_range;
+    let (dx, dy) = ((x1 - x0) / nx as f64, (y1 - y0) / ny as f64);
+    let cell = |ix: usize, iy: usize| {
+        let mut c = Cell::default();
+        for s in 0..sub {
+            let (fx, fy) = jitter(s, sub);
+            let (x, y) = (x0 + (ix as f64 + fx) * dx, y0 + (iy as f64 + fy) * dy);
+            let Some(pt) = (spec.point)(x, y, s) else {
+                continue;
+            };
+            match evaluate(&pt) {
+                Ok(o) => c.add(&pt, &o),
+                Err(Skip::Outside) => {}
+                Err(Skip::Refused(by)) => {
+                    c.refused += 1;
+                    c.refused_by = Some(by);
+                }
+            }
+        }
+        c
+    };
+    let workers = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let mut rows: Vec<Vec<Cell>> = vec![Vec::new(); ny];
+    std::thread::scope(|scope| {
+        let handles: Vec<_> = (0..workers)
+            .map(|w| {
+                let cell = &cell;
+                scope.spawn(move || {
+                    (w..ny)
+                        .step_by(workers)
+                        .map(|iy| (iy, (0..nx).map(|ix| cell(ix, iy)).collect::<Vec<_>>()))
+                        .collect::<Vec<_>>()
+                })
+            })
+            .collect();
+        for h in handles {
+            for (iy, row) in h.join().expect("sweep worker panicked") {
+                rows[iy] = row;
+            }
+        }
+    });
+    Map {
+        spec,
+        nx,
+        ny,
+        sub,
+        cells: rows.into_iter().flatten().collect(),
+    }
+}
