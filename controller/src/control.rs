@@ -13,7 +13,7 @@ use core_math::{
 use crate::fault::{Counters, Fault};
 use crate::frame::{kind, Frame};
 use crate::nav::{Attitude, Nav};
-use crate::plan::{Envelope, Plan};
+use crate::plan::{Envelope, Plan, SegmentPlan};
 use crate::scene::{Scene, MAX_SEGMENTS};
 
 /// Where line periods go: the period registers of the camera's line clock (one per
@@ -321,20 +321,31 @@ impl Controller {
                 return;
             }
         };
+        // Indices by `get` (`count` <= MAX_SEGMENTS and `index` < MAX_SEGMENTS by
+        // construction of the plan): no panic path (docs/no-panic.md).
         for k in 0..usize::from(self.plan.count) {
-            let seg = self.plan.segments[k];
-            let slot = usize::from(seg.index);
-            match self.segment(&update, k) {
+            let Some(seg) = self.plan.segments.get(k) else {
+                break;
+            };
+            let (index, result) = (seg.index, self.segment(&update, seg));
+            let slot = usize::from(index);
+            match result {
                 Ok(out) => {
                     // Only a period inside the physical range reaches a register.
-                    if sink.write_period(seg.index, out.ticks).is_ok() {
-                        self.outputs[slot] = out;
-                        self.has_output[slot] = true;
+                    if sink.write_period(index, out.ticks).is_ok() {
+                        if let (Some(o), Some(h)) =
+                            (self.outputs.get_mut(slot), self.has_output.get_mut(slot))
+                        {
+                            *o = out;
+                            *h = true;
+                        }
                     }
                 }
                 Err(f) => {
                     self.reject(f);
-                    self.outputs[slot].held = true;
+                    if let Some(o) = self.outputs.get_mut(slot) {
+                        o.held = true;
+                    }
                 }
             }
         }
@@ -349,9 +360,8 @@ impl Controller {
     fn segment(
         &self,
         update: &core_math::closed_form::UpdateConst<f32>,
-        k: usize,
+        seg: &SegmentPlan,
     ) -> Result<SegmentOutput, Fault> {
-        let seg = &self.plan.segments[k];
         // One monomorphisation per plan: the terms are chosen once, not per sample.
         let (v_min, v_max) = match (self.plan.terms.limb, self.plan.terms.drift) {
             (true, true) => extremes::<true, true>(update, seg.samples())?,

@@ -138,7 +138,9 @@ impl Decoder {
     }
 
     fn step(&self) -> Step {
-        let b = &self.buf[..self.len];
+        // `len` <= MAX_FRAME always (`feed`); the `min` proves it to the optimiser (no
+        // panic path, docs/no-panic.md).
+        let b = &self.buf[..self.len.min(MAX_FRAME)];
         if b.is_empty() {
             return Step::Wait;
         }
@@ -184,9 +186,10 @@ impl Decoder {
     }
 
     fn consume(&mut self, n: usize) {
-        let n = n.min(self.len);
-        self.buf.copy_within(n..self.len, 0);
-        self.len -= n;
+        let len = self.len.min(MAX_FRAME);
+        let n = n.min(len);
+        self.buf.copy_within(n..len, 0);
+        self.len = len - n;
     }
 }
 

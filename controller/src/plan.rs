@@ -52,11 +52,13 @@ pub struct SegmentPlan {
 }
 
 impl SegmentPlan {
+    // `n_samples` <= MAX_SAMPLES in every plan `Plan::build` makes; the `min` proves it
+    // to the optimiser (no panic path, docs/no-panic.md).
     pub fn samples(&self) -> &[PixelConst<f32>] {
-        &self.samples[..usize::from(self.n_samples)]
+        &self.samples[..usize::from(self.n_samples).min(MAX_SAMPLES)]
     }
     pub fn sample_px(&self) -> &[i32] {
-        &self.sample_px[..usize::from(self.n_samples)]
+        &self.sample_px[..usize::from(self.n_samples).min(MAX_SAMPLES)]
     }
 }
 
@@ -266,8 +268,10 @@ impl Plan {
             }
             count += 1;
         }
-        let (limb_margin_rad, drift_bound) = term_bounds(scene, env, &segments[..count], &updates);
-        let smallest_budget = segments[..count]
+        // count <= MAX_SEGMENTS (each slot came from `get_mut`); the `min` says so.
+        let active = &segments[..count.min(MAX_SEGMENTS)];
+        let (limb_margin_rad, drift_bound) = term_bounds(scene, env, active, &updates);
+        let smallest_budget = active
             .iter()
             .map(|s| f64::from(s.sampling_budget) / SAMPLING_SHARE)
             .fold(f64::INFINITY, f64::min);
@@ -294,6 +298,6 @@ impl Plan {
     }
 
     pub fn active(&self) -> &[SegmentPlan] {
-        &self.segments[..usize::from(self.count)]
+        &self.segments[..usize::from(self.count).min(MAX_SEGMENTS)]
     }
 }

@@ -11,7 +11,8 @@
 //!   period into a timer's reload register, the others into a table) and the PERIODS
 //!   frames the session sends;
 //! - the hardware behind those traits: [`cmsdk`] (the mps2-an386's UART0 and TIMER0);
-//! - [`platform`]: defmt logger, panic/fault handlers, exit by semihosting;
+//! - [`platform`]: panic/fault handlers, exit by semihosting; [`logger`]: the global
+//!   defmt logger (semihosting, never panics);
 //!   [`stack`]: the stack's high-water mark (the firmware's RAM use).
 //!
 //! The default-scene demo (`src/bin/demo.rs`, `cargo xtask run --demo`) and the
@@ -29,6 +30,7 @@
 pub mod cmsdk;
 pub mod line_clock;
 pub mod link;
+pub mod logger;
 pub mod output;
 pub mod pipeline;
 pub mod platform;

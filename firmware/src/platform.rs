@@ -1,13 +1,13 @@
 //! What ties the application to the chip and the debugger: the defmt logger, the panic
 //! and fault handlers, and the way out.
 //!
-//! Logging goes through semihosting (`defmt-semihosting`): under QEMU the host runner
-//! (`cargo xtask qemu`) decodes the frames; on a board, probe-rs does. The exit status
-//! reaches QEMU's (and so the runner's) exit status by semihosting as well.
+//! Logging goes through semihosting (the global defmt logger in [`crate::logger`]):
+//! under QEMU the host runner (`cargo xtask qemu`) decodes the frames; on a board,
+//! probe-rs does. The exit status reaches QEMU's (and so the runner's) exit status by
+//! semihosting as well.
 
-use cortex_m as _; // critical-section implementation for defmt-semihosting
+use cortex_m as _; // critical-section implementation for the logger
 use cortex_m_rt::{exception, ExceptionFrame};
-use defmt_semihosting as _; // the global defmt logger
 
 /// Exit status of a panic (never expected: the firmware's own paths return `Result`).
 pub const EXIT_PANIC: i32 = 101;
@@ -19,15 +19,50 @@ pub fn exit(code: i32) -> ! {
     semihosting::process::exit(code)
 }
 
+#[cfg(not(feature = "no-panic-check"))]
 #[panic_handler]
 fn panic(info: &core::panic::PanicInfo<'_>) -> ! {
     defmt::error!("panic: {}", defmt::Display2Format(info));
     exit(EXIT_PANIC)
 }
 
+#[cfg(not(feature = "no-panic-check"))]
 #[defmt::panic_handler]
 fn defmt_panic() -> ! {
     exit(EXIT_PANIC)
+}
+
+// The no-panic proof (docs/no-panic.md): built with `--features no-panic-check`, both
+// panic handlers call a function that no object defines. After fat LTO and the linker's
+// garbage collection, a handler that no reachable code calls is gone with its call, and
+// the link succeeds; a single surviving panic path keeps it, and the link fails with
+// "undefined symbol: NO_PANIC_CHECK__...". Such a binary must never run, so the feature
+// is only for that one link (`cargo xtask test`, xtask/src/no_panic.rs).
+#[cfg(feature = "no-panic-check")]
+extern "C" {
+    fn NO_PANIC_CHECK__a_panic_path_is_reachable__see_docs_no_panic_md(
+        location: *const core::ffi::c_void,
+    ) -> !;
+}
+
+#[cfg(feature = "no-panic-check")]
+#[panic_handler]
+fn panic(info: &core::panic::PanicInfo<'_>) -> ! {
+    // The location is passed on only so that the panic sites' `Location` records stay in
+    // the ELF, where `cargo xtask test` finds them when the link has failed (it then links
+    // once more with the symbol left unresolved, never to run).
+    let location = info.location().map_or(core::ptr::null(), |l| {
+        core::ptr::from_ref(l).cast::<core::ffi::c_void>()
+    });
+    // SAFETY: never runs: the symbol is undefined, so a binary that calls it cannot link.
+    unsafe { NO_PANIC_CHECK__a_panic_path_is_reachable__see_docs_no_panic_md(location) }
+}
+
+#[cfg(feature = "no-panic-check")]
+#[defmt::panic_handler]
+fn defmt_panic() -> ! {
+    // SAFETY: as in `panic`.
+    unsafe { NO_PANIC_CHECK__a_panic_path_is_reachable__see_docs_no_panic_md(core::ptr::null()) }
 }
 
 #[exception]

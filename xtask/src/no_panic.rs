@@ -1,0 +1,521 @@
+//! The no-panic proof of the flight binary (docs/no-panic.md), part of `cargo xtask test`.
+//!
+//! [`check`] builds `firmware` (the flight binary) for the target in release with the
+//! firmware's `no-panic-check` feature, under which both panic handlers call a function
+//! that is defined nowhere. After fat LTO and the linker's garbage collection a handler
+//! survives only if some reachable code can call it, so: the link succeeds if and only
+//! if no panic path is left. When it fails, [`check`] links the same build once more
+//! with the symbol left unresolved (never to run) and names the panic sites from that
+//! ELF: the `core::panic::Location` records still in it (file:line:col of each panic
+//! that survived optimisation) and the functions that branch into the panic machinery.
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::PathBuf;
+use std::process::{Command, Stdio};
+use std::time::Instant;
+
+use object::{Object, ObjectSection, ObjectSymbol, SectionKind, SymbolKind};
+
+use crate::target::{workspace_root, TARGET};
+
+/// The undefined function the check build's panic handlers call (firmware/src/platform.rs).
+const SYMBOL: &str = "NO_PANIC_CHECK__a_panic_path_is_reachable__see_docs_no_panic_md";
+/// The cargo arguments of the check build.
+const BUILD: [&str; 10] = [
+    "--package",
+    "firmware",
+    "--bin",
+    "firmware",
+    "--target",
+    TARGET,
+    "--release",
+    "--features",
+    "no-panic-check",
+    "--color=never",
+];
+
+/// `cargo` as the one that started us, in the workspace root.
+fn cargo() -> Command {
+    let mut cmd = Command::new(std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into()));
+    cmd.current_dir(workspace_root());
+    cmd
+}
+
+/// The proof: an error (naming the panic sites when it can) if the release flight binary
+/// still has a path to the panic handler.
+pub fn check() -> Result<(), String> {
+    let t0 = Instant::now();
+    eprintln!("\n==> no-panic proof: cargo build {}", BUILD.join(" "));
+    let out = cargo()
+        .arg("build")
+        .args(BUILD)
+        .stdout(Stdio::null())
+        .output()
+        .map_err(|e| format!("cannot start cargo: {e}"))?;
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    if out.status.success() {
+        restore_flight_binary();
+        eprintln!(
+            "xtask: no-panic proof passed: the release flight binary links with no path to a panic handler ({:.1} s)",
+            t0.elapsed().as_secs_f64()
+        );
+        return Ok(());
+    }
+    if !stderr.contains(SYMBOL) {
+        eprint!("{stderr}");
+        return Err(format!("the no-panic check build failed ({})", out.status));
+    }
+    let report = match diagnose() {
+        Ok(report) => report,
+        Err(e) => format!("(could not name the panic sites: {e})\n"),
+    };
+    Err(format!(
+        "no-panic proof failed: the release flight binary can reach the panic handler \
+         (link error: undefined symbol {SYMBOL}).\n{report}\
+         Remove each path (docs/no-panic.md) and rerun `cargo xtask test`."
+    ))
+}
+
+/// Links the check build with the symbol unresolved, lists its panic sites, and puts the
+/// normal flight binary back in its place.
+fn diagnose() -> Result<String, String> {
+    let out = cargo()
+        .arg("rustc")
+        .args(BUILD)
+        .arg("--message-format=json-render-diagnostics")
+        .args(["--", "-C", "link-arg=--unresolved-symbols=ignore-all"])
+        .stderr(Stdio::null())
+        .output()
+        .map_err(|e| format!("cannot start cargo: {e}"))?;
+    let mut elf = None;
+    for line in String::from_utf8_lossy(&out.stdout).lines() {
+        let Ok(msg) = serde_json::from_str::<serde_json::Value>(line) else {
+            continue;
+        };
+        if msg["reason"] == "compiler-artifact" && msg["target"]["name"] == "firmware" {
+            if let Some(path) = msg["executable"].as_str() {
+                elf = Some(PathBuf::from(path));
+            }
+        }
+    }
+    let report = match (out.status.success(), elf) {
+        (true, Some(elf)) => std::fs::read(&elf)
+            .map_err(|e| format!("cannot read {}: {e}", elf.display()))
+            .and_then(|bytes| report(&bytes)),
+        _ => Err(format!("the diagnostic link failed ({})", out.status)),
+    };
+    restore_flight_binary();
+    report
+}
+
+/// Cargo copies the last ELF it linked for a binary to `<target>/<triple>/release/
+/// firmware`: after the check builds, put the normal flight binary back there (cargo
+/// finds it up to date, so this only copies).
+fn restore_flight_binary() {
+    let restored = cargo()
+        .args(["build", "--package", "firmware", "--bin", "firmware"])
+        .args(["--target", TARGET, "--release", "--quiet"])
+        .status();
+    if !restored.is_ok_and(|s| s.success()) {
+        eprintln!("xtask: warning: could not rebuild the normal release flight binary");
+    }
+}
+
+/// What the diagnostic ELF says about its panic paths.
+fn report(elf: &[u8]) -> Result<String, String> {
+    let file = object::File::parse(elf).map_err(|e| format!("cannot parse the ELF: {e}"))?;
+    let mut text = String::new();
+    let locations = panic_locations(&file);
+    if !locations.is_empty() {
+        text.push_str("panic sites left in the binary (core::panic::Location records):\n");
+        for l in &locations {
+            text.push_str(&format!("  {l}\n"));
+        }
+    }
+    let edges = panic_calls(&file);
+    if !edges.is_empty() {
+        text.push_str("calls on a path to the panic handler (caller -> callee):\n");
+        for (caller, callees) in &edges {
+            for callee in callees {
+                text.push_str(&format!("  {caller} -> {callee}\n"));
+            }
+        }
+    }
+    if text.is_empty() {
+        return Err("found neither Location records nor branches to the handler".into());
+    }
+    Ok(text)
+}
+
+/// `file:line:col` of every `core::panic::Location` in the read-only data: four words
+/// (file name pointer and length, line, column) whose pointer and length name UTF-8 text
+/// ending in `.rs` in the same data. The check build's panic handler hands the location
+/// on, so exactly the locations of surviving panic sites stay in the binary.
+fn panic_locations(file: &object::File<'_>) -> BTreeSet<String> {
+    let mut found = BTreeSet::new();
+    let sections: Vec<(u64, &[u8])> = file
+        .sections()
+        .filter(|s| {
+            matches!(
+                s.kind(),
+                SectionKind::ReadOnlyData | SectionKind::ReadOnlyString
+            )
+        })
+        .filter_map(|s| Some((s.address(), s.data().ok()?)))
+        .collect();
+    let text_at = |addr: u64, len: u64| {
+        sections.iter().find_map(|&(start, data)| {
+            let from = usize::try_from(addr.checked_sub(start)?).ok()?;
+            let to = from.checked_add(usize::try_from(len).ok()?)?;
+            std::str::from_utf8(data.get(from..to)?).ok()
+        })
+    };
+    for &(_, data) in &sections {
+        let word = |at: usize| {
+            data.get(at..at.checked_add(4)?)
+                .and_then(|b| b.try_into().ok())
+                .map(u32::from_le_bytes)
+        };
+        // Records are 4-aligned.
+        for at in (0..data.len()).step_by(4) {
+            let (Some(ptr), Some(len), Some(line), Some(col)) =
+                (word(at), word(at + 4), word(at + 8), word(at + 12))
+            else {
+                break;
+            };
+            if !(1..=1024).contains(&len)
+                || !(1..1 << 20).contains(&line)
+                || !(1..1 << 16).contains(&col)
+            {
+                continue;
+            }
+            if let Some(name) = text_at(u64::from(ptr), u64::from(len)) {
+                if name.ends_with(".rs") {
+                    found.insert(format!("{}:{line}:{col}", short_path(name)));
+                }
+            }
+        }
+    }
+    found
+}
+
+/// A source path without the cargo registry's or the toolchain's prefix.
+fn short_path(path: &str) -> &str {
+    if let Some((_, rest)) = path.split_once("/registry/src/") {
+        return rest.split_once('/').map_or(rest, |(_, p)| p);
+    }
+    if let Some((_, rest)) = path.split_once("/library/") {
+        return rest;
+    }
+    path
+}
+
+/// The call graph's edges that lead to a panic handler (`rust_begin_unwind`, defmt's
+/// `_defmt_panic`), from every caller outside `core` and the handlers themselves: the
+/// code to change. Branch targets come from decoding each function's Thumb-2 branches
+/// (BL, B, B.W, B<c>, B<c>.W, CB(N)Z), skipping literal pools (`$d` mapping symbols).
+fn panic_calls(file: &object::File<'_>) -> BTreeMap<String, BTreeSet<String>> {
+    struct Func<'a> {
+        start: u64,
+        end: u64,
+        name: String,
+        code: &'a [u8],
+    }
+    let mut data_marks: Vec<(u64, bool)> = file
+        .symbols()
+        .filter_map(|s| {
+            let name = s.name().ok()?;
+            let is_data = name == "$d" || name.starts_with("$d.");
+            let is_code = name == "$t" || name.starts_with("$t.");
+            (is_data || is_code).then_some((s.address(), is_data))
+        })
+        .collect();
+    data_marks.sort_unstable();
+    let mut funcs: Vec<Func<'_>> = file
+        .symbols()
+        .filter(|s| s.kind() == SymbolKind::Text && s.size() > 0)
+        .filter_map(|s| {
+            let start = s.address() & !1;
+            let section = file.section_by_index(s.section_index()?).ok()?;
+            let data = section.data().ok()?;
+            let from = usize::try_from(start.checked_sub(section.address())?).ok()?;
+            let to = from.checked_add(usize::try_from(s.size()).ok()?)?;
+            Some(Func {
+                start,
+                end: start + s.size(),
+                name: demangle(s.name().ok()?),
+                code: data.get(from..to)?,
+            })
+        })
+        .collect();
+    funcs.sort_by_key(|f| f.start);
+    funcs.dedup_by_key(|f| f.start);
+    let func_at = |addr: u64| {
+        let i = funcs.partition_point(|f| f.start <= addr).checked_sub(1)?;
+        (addr < funcs.get(i)?.end).then_some(i)
+    };
+    // Is `addr` inside a literal pool (after a `$d` mark, before the next `$t`)?
+    let in_data = |addr: u64| {
+        let i = data_marks.partition_point(|&(a, _)| a <= addr);
+        i.checked_sub(1)
+            .and_then(|i| data_marks.get(i))
+            .is_some_and(|&(_, d)| d)
+    };
+    let mut callers: Vec<BTreeSet<usize>> = vec![BTreeSet::new(); funcs.len()];
+    for (i, f) in funcs.iter().enumerate() {
+        let mut at = 0usize;
+        while let Some(hw1) = halfword(f.code, at) {
+            let addr = f.start + at as u64;
+            let (size, target) = decode_branch(hw1, halfword(f.code, at + 2), addr);
+            if let Some(j) = target.filter(|_| !in_data(addr)).and_then(func_at) {
+                if let Some(set) = callers.get_mut(j).filter(|_| j != i) {
+                    set.insert(i);
+                }
+            }
+            at += size;
+        }
+    }
+    // Every function from which a handler can be reached.
+    let is_handler = |name: &str| name.ends_with("rust_begin_unwind") || name == "_defmt_panic";
+    let mut reach: BTreeSet<usize> = (0..funcs.len())
+        .filter(|&i| funcs.get(i).is_some_and(|f| is_handler(&f.name)))
+        .collect();
+    let mut todo: Vec<usize> = reach.iter().copied().collect();
+    while let Some(j) = todo.pop() {
+        for &i in callers.get(j).into_iter().flatten() {
+            if reach.insert(i) {
+                todo.push(i);
+            }
+        }
+    }
+    let mut edges: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
+    for &j in &reach {
+        for &i in callers.get(j).into_iter().flatten() {
+            let (Some(caller), Some(callee)) = (funcs.get(i), funcs.get(j)) else {
+                continue;
+            };
+            let machinery = caller.name.starts_with("core::") || is_handler(&caller.name);
+            if !machinery {
+                edges
+                    .entry(caller.name.clone())
+                    .or_default()
+                    .insert(callee.name.clone());
+            }
+        }
+    }
+    edges
+}
+
+fn halfword(code: &[u8], at: usize) -> Option<u16> {
+    let b = code.get(at..at.checked_add(2)?)?;
+    Some(u16::from_le_bytes([*b.first()?, *b.get(1)?]))
+}
+
+/// Decodes the Thumb-2 instruction starting with `hw1` (and `hw2`, its second half if it
+/// is a 32-bit one) at `addr`: its size in bytes and, for a direct branch or call, the
+/// target address.
+fn decode_branch(hw1: u16, hw2: Option<u16>, addr: u64) -> (usize, Option<u64>) {
+    let sext = |value: u32, bits: u32| -> i64 {
+        let shift = 32 - bits;
+        i64::from(((value << shift) as i32) >> shift)
+    };
+    let pc = addr as i64 + 4;
+    let target = |offset: i64| u64::try_from(pc + offset).ok();
+    let hw1 = u32::from(hw1);
+    if matches!(hw1 >> 11, 0b11101..=0b11111) {
+        let Some(hw2) = hw2.map(u32::from) else {
+            return (4, None);
+        };
+        if hw1 >> 11 != 0b11110 || hw2 & 0x8000 == 0 {
+            return (4, None);
+        }
+        let s = (hw1 >> 10) & 1;
+        let (j1, j2) = ((hw2 >> 13) & 1, (hw2 >> 11) & 1);
+        let imm11 = hw2 & 0x7FF;
+        return match hw2 & 0xD000 {
+            // BL (T1) and B.W (T4).
+            0xD000 | 0x9000 => {
+                let (i1, i2) = (!(j1 ^ s) & 1, !(j2 ^ s) & 1);
+                let imm =
+                    (s << 24) | (i1 << 23) | (i2 << 22) | ((hw1 & 0x3FF) << 12) | (imm11 << 1);
+                (4, target(sext(imm, 25)))
+            }
+            // B<c>.W (T3); condition 111x is not a branch.
+            0x8000 if (hw1 >> 6) & 0xE != 0xE => {
+                let imm = (s << 20) | (j2 << 19) | (j1 << 18) | ((hw1 & 0x3F) << 12) | (imm11 << 1);
+                (4, target(sext(imm, 21)))
+            }
+            _ => (4, None),
+        };
+    }
+    if hw1 >> 11 == 0b11100 {
+        // B (T2).
+        return (2, target(sext((hw1 & 0x7FF) << 1, 12)));
+    }
+    if hw1 >> 12 == 0b1101 && (hw1 >> 8) & 0xE != 0xE {
+        // B<c> (T1).
+        return (2, target(sext((hw1 & 0xFF) << 1, 9)));
+    }
+    if hw1 & 0xF500 == 0xB100 {
+        // CBZ, CBNZ.
+        let imm = (((hw1 >> 9) & 1) << 6) | (((hw1 >> 3) & 0x1F) << 1);
+        return (2, target(i64::from(imm)));
+    }
+    (2, None)
+}
+
+/// A readable name for a Rust symbol: legacy (`_ZN..E`) and the plain-path cases of v0
+/// (`_R...`) mangling, enough for the functions of this report; anything else as is.
+fn demangle(name: &str) -> String {
+    demangle_legacy(name)
+        .or_else(|| demangle_v0(name))
+        .unwrap_or_else(|| name.to_string())
+}
+
+fn demangle_legacy(name: &str) -> Option<String> {
+    let mut rest = name.strip_prefix("_ZN")?.strip_suffix('E')?;
+    let mut parts = Vec::new();
+    while !rest.is_empty() {
+        let digits = rest.bytes().take_while(u8::is_ascii_digit).count();
+        let len: usize = rest.get(..digits)?.parse().ok()?;
+        let part = rest.get(digits..digits.checked_add(len)?)?;
+        rest = rest.get(digits + len..)?;
+        parts.push(part);
+    }
+    // Drop the trailing hash (`h` and 16 hex digits).
+    if parts
+        .last()
+        .is_some_and(|p| p.len() == 17 && p.starts_with('h'))
+    {
+        parts.pop();
+    }
+    // A part that starts with an escape has a `_` in front of it.
+    let parts: Vec<&str> = parts
+        .iter()
+        .map(|p| p.strip_prefix("_$").map_or(*p, |_| &p[1..]))
+        .collect();
+    let mut out = parts.join("::");
+    for (from, to) in [
+        ("$LT$", "<"),
+        ("$GT$", ">"),
+        ("$RF$", "&"),
+        ("$BP$", "*"),
+        ("$SP$", "@"),
+        ("$C$", ","),
+        ("$u20$", " "),
+        ("$u27$", "'"),
+        ("$u3b$", ";"),
+        ("$u5b$", "["),
+        ("$u5d$", "]"),
+        ("$u7b$", "{"),
+        ("$u7d$", "}"),
+        ("$u7e$", "~"),
+        ("..", "::"),
+    ] {
+        out = out.replace(from, to);
+    }
+    Some(out)
+}
+
+fn demangle_v0(name: &str) -> Option<String> {
+    let mut parts = Vec::new();
+    let mut rest = name.strip_prefix("_R")?;
+    // Nested paths: N <namespace> <path> <identifier>, down to a crate root C.
+    let mut depth = 0;
+    while let Some(r) = rest.strip_prefix('N') {
+        rest = r.get(1..)?;
+        depth += 1;
+    }
+    let r = rest.strip_prefix('C')?;
+    let (krate, mut r) = v0_ident(v0_disambiguator(r)?)?;
+    parts.push(krate);
+    for _ in 0..depth {
+        let (ident, next) = v0_ident(v0_disambiguator(r)?)?;
+        parts.push(ident);
+        r = next;
+    }
+    Some(parts.join("::"))
+}
+
+/// Skips an optional `s<base-62>_` disambiguator.
+fn v0_disambiguator(s: &str) -> Option<&str> {
+    match s.strip_prefix('s') {
+        Some(r) => Some(r.split_once('_')?.1),
+        None => Some(s),
+    }
+}
+
+/// `<decimal length> [_] <bytes>`; punycode (`u` prefix) is not handled.
+fn v0_ident(s: &str) -> Option<(&str, &str)> {
+    let digits = s.bytes().take_while(u8::is_ascii_digit).count();
+    let len: usize = s.get(..digits)?.parse().ok()?;
+    let mut r = s.get(digits..)?;
+    if let Some(stripped) = r.strip_prefix('_') {
+        r = stripped;
+    }
+    Some((r.get(..len)?, r.get(len..)?))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn hw(bytes: [u8; 4]) -> (u16, Option<u16>) {
+        (
+            u16::from_le_bytes([bytes[0], bytes[1]]),
+            Some(u16::from_le_bytes([bytes[2], bytes[3]])),
+        )
+    }
+
+    // Encodings and targets from `llvm-objdump -d` of the firmware.
+    #[test]
+    fn decodes_thumb2_branches() {
+        let (a, b) = hw([0x05, 0xf0, 0x15, 0xfc]); // bl 0x71dc
+        assert_eq!(decode_branch(a, b, 0x19ae), (4, Some(0x71dc)));
+        let (a, b) = hw([0xfe, 0xf7, 0xf2, 0xbd]); // b.w 0x58e
+        assert_eq!(decode_branch(a, b, 0x19a6), (4, Some(0x58e)));
+        let (a, b) = hw([0x41, 0xf0, 0x0b, 0x80]); // bne.w 0x1494
+        assert_eq!(decode_branch(a, b, 0x47a), (4, Some(0x1494)));
+        let (a, b) = hw([0x40, 0xf0, 0xac, 0x80]); // bne.w 0x656
+        assert_eq!(decode_branch(a, b, 0x4fa), (4, Some(0x656)));
+        assert_eq!(decode_branch(0xd121, None, 0x48c), (2, Some(0x4d2))); // bne
+        assert_eq!(decode_branch(0xb3d1, None, 0x490), (2, Some(0x508))); // cbz
+        assert_eq!(decode_branch(0xe7fb, None, 0x410), (2, Some(0x40a))); // b
+        assert_eq!(decode_branch(0x200e, None, 0x19aa), (2, None)); // movs r0, #14
+    }
+
+    #[test]
+    fn demangles_both_schemes() {
+        assert_eq!(
+            demangle("_ZN10controller7control10Controller7segment17h3056d19f2e759753E"),
+            "controller::control::Controller::segment"
+        );
+        assert_eq!(
+            demangle("_RNvNtCs7ldSeZOOJos_4core9panicking18panic_bounds_check"),
+            "core::panicking::panic_bounds_check"
+        );
+        assert_eq!(
+            demangle("_RNvCsfLfy6EI15iL_7___rustc17rust_begin_unwind"),
+            "__rustc::rust_begin_unwind"
+        );
+        assert_eq!(demangle("_defmt_acquire"), "_defmt_acquire");
+    }
+
+    #[test]
+    fn shortens_source_paths() {
+        assert_eq!(
+            short_path("/root/.cargo/registry/src/index.crates.io-1949cf8c6b5b557f/semihosting-0.1.25/src/fd.rs"),
+            "semihosting-0.1.25/src/fd.rs"
+        );
+        assert_eq!(
+            short_path(
+                "/rustc/59807616e1fa2540724bfbac14d7976d7e4a3860/library/core/src/slice/index.rs"
+            ),
+            "core/src/slice/index.rs"
+        );
+        assert_eq!(
+            short_path("controller/src/plan.rs"),
+            "controller/src/plan.rs"
+        );
+    }
+}
