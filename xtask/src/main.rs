@@ -4,10 +4,14 @@
 
 mod accuracy;
 mod csv;
+mod ellipsoid;
 mod eval;
+mod footprint;
+mod no_panic;
 mod paper;
 mod plot;
 mod report;
+mod stability;
 mod target;
 mod test_cmd;
 
@@ -25,6 +29,8 @@ commands:
       [--export-telemetry FILE.csv] [--demo]             (--demo: the default-scene demo)
   bench                                                  guest instructions per evaluation (QEMU plugin)
   report [--csv] [--cases N] [--seed S] [--no-bench]     error against run time per backend (runs the bench)
+  stability [--quick]                                    regenerate docs/stability.md and its maps
+  ellipsoid [--print]                                    round-Earth model error against WGS 84 (default scene)
   qemu ELF                                               cargo runner: ELF under QEMU, defmt decoded
 ";
 
@@ -44,6 +50,8 @@ fn main() -> ExitCode {
         "bench" => target::bench(rest),
         "report" => report::run(rest),
         "qemu" => target::qemu(rest),
+        "stability" => stability::run(rest),
+        "ellipsoid" => ellipsoid::run(rest),
         "help" | "--help" | "-h" => {
             print!("{USAGE}");
             Ok(())

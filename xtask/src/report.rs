@@ -11,14 +11,19 @@
 //! cases at least 1 deg from the limb, `max_rel_err_near_limb` over those within 1 deg.
 //!
 //! Run time: guest instructions on the Cortex-M4 under QEMU from `cargo xtask bench`
-//! (the same build, the same plugin, [`crate::target::bench_counts`]): `motion` for one
-//! pixel at n = 0 and one `update`. Instructions, not cycles.
+//! (the same build, the same plugin, [`crate::target::bench_counts`]): per pixel, the
+//! count of `motion` over 32 pixels across the swath in a loop, divided by 32 (the
+//! marginal cost inside the loop the controller runs, without a one-pixel region's call
+//! and return); per update, `update` then `motion` at each of the default scene's
+//! planned sample points. Instructions, not cycles.
 //!
-//! `flash_bytes` is left empty: with fat LTO every backend is inlined into the bench's
-//! regions, so no symbol size measures one backend's code honestly.
+//! `flash_bytes`: [`crate::footprint`], one link per backend.
 
 use core_math::fixed_point::{geometry_from_f64, motion_to_f64};
-use core_math::{Backend, Camera, Geometry, NaiveF32, Reference, CLOSED_F32, CLOSED_F64, FIXED};
+use core_math::{
+    Backend, Camera, Geometry, MicroF32, NaiveF32, Reference, CLOSED_F32, CLOSED_F64,
+    CLOSED_MICROMATH, FIXED,
+};
 
 use crate::target::{bench_counts, BenchCounts};
 use core_math::sample::SplitMix64 as Rng;
@@ -33,33 +38,49 @@ const CAMERA: Camera = Camera {
 /// "Near the limb": the line of sight within this angle (deg) of the limb.
 const NEAR_LIMB_DEG: f64 = 1.0;
 
-/// The backends, in report order, with their bench labels (motion at n = 0, update).
-const VARIANTS: [(&str, &str, &str); 5] = [
-    (
-        "naive-f32",
-        "NaiveF32 motion, 1 pixel (n = 0)",
-        "NaiveF32 update (checks and stores the geometry)",
-    ),
-    (
-        "reference",
-        "Reference motion (f64 chain), 1 pixel (n = 0)",
-        "Reference update (checks and stores the geometry)",
-    ),
-    (
-        "f64",
-        "CLOSED_F64 motion, 1 pixel (n = 0)",
-        "CLOSED_F64 update",
-    ),
-    (
-        "f32",
-        "CLOSED_F32 motion, 1 pixel (n = 0)",
-        "CLOSED_F32 update (once per telemetry update)",
-    ),
-    (
-        "fixed",
-        "FIXED motion, 1 pixel (n = 0; integer only)",
-        "FIXED update (once per telemetry update; integer only)",
-    ),
+/// Pixels in the bench's loop regions (firmware/src/bin/bench.rs, `LOOP_PX`).
+const LOOP_PX: u64 = 32;
+
+/// One backend of the report: its name (also its `--cfg footprint` value) and its bench
+/// regions: `motion` over `LOOP_PX` pixels in a loop, and one full update of the default
+/// scene (`update`, then `motion` at each of its planned sample points).
+struct Variant {
+    name: &'static str,
+    loop_label: &'static str,
+    full_update_label: &'static str,
+}
+
+const VARIANTS: [Variant; 6] = [
+    Variant {
+        name: "naive-f32",
+        loop_label: "NaiveF32 motion, 32 pixels in a loop",
+        full_update_label: "NaiveF32 full update",
+    },
+    Variant {
+        name: "reference",
+        loop_label: "Reference motion, 32 pixels in a loop",
+        full_update_label: "Reference full update",
+    },
+    Variant {
+        name: "f64",
+        loop_label: "CLOSED_F64 motion, 32 pixels in a loop",
+        full_update_label: "CLOSED_F64 full update",
+    },
+    Variant {
+        name: "f32",
+        loop_label: "CLOSED_F32 motion, 32 pixels in a loop",
+        full_update_label: "CLOSED_F32 full update",
+    },
+    Variant {
+        name: "f32-micromath",
+        loop_label: "CLOSED_MICROMATH motion, 32 pixels in a loop",
+        full_update_label: "CLOSED_MICROMATH full update",
+    },
+    Variant {
+        name: "fixed",
+        loop_label: "FIXED motion, 32 pixels in a loop",
+        full_update_label: "FIXED full update",
+    },
 ];
 
 #[derive(Default)]
@@ -102,15 +123,29 @@ pub fn run(args: &[String]) -> Result<(), String> {
         }
     }
     let sample = sweep(seed, cases);
-    let counts = if bench {
-        Some(bench_counts(true)?)
+    let (counts, flash) = if bench {
+        let names: Vec<&str> = VARIANTS.iter().map(|v| v.name).collect();
+        (
+            Some(bench_counts(true)?),
+            Some(crate::footprint::variant_bytes(&names)?),
+        )
     } else {
-        None
+        (None, None)
     };
-    let rows = print_table(&sample, counts.as_ref(), csv, seed)?;
+    let rows = print_table(&sample, counts.as_ref(), flash.as_deref(), csv, seed)?;
+    // The model's own error, for scale: the round Earth against WGS 84 (docs/earth-model.md).
+    let earth = format!(
+        "Model error for scale: {}.",
+        crate::ellipsoid::summary()?.line()
+    );
+    if csv {
+        eprintln!("report: {earth}");
+    } else {
+        println!("\n{earth}");
+    }
     // The default (full sample, bench run, markdown) regenerates the doc's table and plot.
     if !csv && counts.is_some() && cases == DEFAULT_CASES && seed == DEFAULT_SEED {
-        write_artefacts(&rows)?;
+        write_artefacts(&rows, &earth)?;
     }
     Ok(())
 }
@@ -120,8 +155,9 @@ const PNG: &str = "docs/error-vs-runtime.png";
 const BEGIN: &str = "<!-- report:begin (written by `cargo xtask report`) -->";
 const END: &str = "<!-- report:end -->";
 
-/// `doc` with the markdown table of `rows` between its markers.
-fn replace_table(doc: &str, rows: &[[String; 7]]) -> Option<String> {
+/// `doc` with the markdown table of `rows`, then the paragraph `trailer`, between its
+/// markers.
+fn replace_table(doc: &str, rows: &[[String; 7]], trailer: &str) -> Option<String> {
     let b = doc.find(BEGIN)?;
     let e = doc[b..].find(END)? + b;
     let mut table = format!(
@@ -133,6 +169,10 @@ fn replace_table(doc: &str, rows: &[[String; 7]]) -> Option<String> {
         table.push_str(&format!("| {} |\n", r.join(" | ")));
     }
     table.push('\n');
+    if !trailer.is_empty() {
+        table.push_str(trailer);
+        table.push_str("\n\n");
+    }
     Some(format!("{}{table}{}", &doc[..b], &doc[e..]))
 }
 
@@ -140,11 +180,12 @@ fn replace_table(doc: &str, rows: &[[String; 7]]) -> Option<String> {
 /// worst error at least 1 deg from the limb (a cross) and within 1 deg (a slash, dashed)
 /// against log10 of its instructions per pixel. The reference is the golden source
 /// (error 0 by definition) and has no point on a log axis.
-fn write_artefacts(rows: &[[String; 7]]) -> Result<(), String> {
+fn write_artefacts(rows: &[[String; 7]], trailer: &str) -> Result<(), String> {
     let root = crate::target::workspace_root();
     let doc_path = root.join(DOC);
     let doc = std::fs::read_to_string(&doc_path).map_err(|e| format!("reading {DOC}: {e}"))?;
-    let new_doc = replace_table(&doc, rows).ok_or(format!("{DOC} lacks the report markers"))?;
+    let new_doc =
+        replace_table(&doc, rows, trailer).ok_or(format!("{DOC} lacks the report markers"))?;
     std::fs::write(&doc_path, new_doc).map_err(|e| format!("writing {DOC}: {e}"))?;
     let mut plot = crate::plot::Plot::new(
         "Error against run time, per backend (Cortex-M4 under QEMU)",
@@ -230,7 +271,7 @@ fn sweep(seed: u64, cases: usize) -> Sample {
         let is_near = margin_deg < NEAR_LIMB_DEG;
         near += usize::from(is_near);
         let g32 = g.to::<f32>();
-        let speeds: [Option<f64>; 5] = [
+        let speeds: [Option<f64>; 6] = [
             NaiveF32
                 .evaluate(&CAMERA, &g32, n_px)
                 .ok()
@@ -244,6 +285,10 @@ fn sweep(seed: u64, cases: usize) -> Sample {
                 .evaluate(&CAMERA, &g32, n_px)
                 .ok()
                 .map(|m| f64::from(m.speed_mps())),
+            CLOSED_MICROMATH
+                .evaluate(&CAMERA, &g.to::<MicroF32>(), n_px)
+                .ok()
+                .map(|m| m.speed_mps().0.into()),
             geometry_from_f64(&g)
                 .and_then(|gq| FIXED.evaluate(&CAMERA, &gq, n_px))
                 .ok()
@@ -283,20 +328,24 @@ const HEADER: [&str; 7] = [
 fn print_table(
     sample: &Sample,
     counts: Option<&BenchCounts>,
+    flash: Option<&[u64]>,
     csv: bool,
     seed: u64,
 ) -> Result<Vec<[String; 7]>, String> {
     let notes = format!(
         "{} cases (seed {seed:#x}), {} within {NEAR_LIMB_DEG} deg of the limb; errors of |v_P| \
          relative to the f64 reference chain (reference: 0 by definition); instructions: \
-         Cortex-M4 under QEMU {}, release, motion at n = 0 and one update, instructions \
-         not cycles; flash_bytes not measured (fat LTO inlines every backend)",
+         Cortex-M4 under QEMU {}, release, per pixel = motion over {LOOP_PX} pixels in a \
+         loop / {LOOP_PX}, per update = update + motion at the default scene's planned \
+         sample points, instructions not cycles; flash_bytes = loadable bytes the backend's \
+         pixel + update + motion add to an empty binary (xtask/src/footprint.rs)",
         sample.cases,
         sample.near,
         counts.map_or("(not run: --no-bench)", |c| c.qemu_version.as_str()),
     );
     let mut rows = Vec::new();
-    for ((name, motion, update), e) in VARIANTS.iter().zip(&sample.errors) {
+    for (i, (v, e)) in VARIANTS.iter().zip(&sample.errors).enumerate() {
+        let name = v.name;
         let mut far = e.far.clone();
         far.sort_by(f64::total_cmp);
         let max = far.last().copied().unwrap_or(0.0);
@@ -304,23 +353,29 @@ fn print_table(
             .get(((far.len().max(1) - 1) as f64 * 0.99).round() as usize)
             .copied()
             .unwrap_or(0.0);
-        let count = |label: &str| -> Result<String, String> {
+        let count = |label: &str| -> Result<Option<u64>, String> {
             match counts {
-                None => Ok(String::new()),
+                None => Ok(None),
                 Some(c) => c
                     .net(label)
-                    .map(|n| n.to_string())
+                    .map(Some)
                     .ok_or_else(|| format!("report: no bench region `{label}`")),
             }
         };
+        let per_pixel = count(v.loop_label)?.map_or(String::new(), |n| {
+            format!("{:.1}", n as f64 / LOOP_PX as f64)
+        });
+        let per_update = count(v.full_update_label)?.map_or(String::new(), |n| n.to_string());
         rows.push([
             name.to_string(),
             format!("{max:.2e}"),
             format!("{p99:.2e}"),
             format!("{:.2e}", e.max_near),
-            count(motion)?,
-            count(update)?,
-            String::new(),
+            per_pixel,
+            per_update,
+            flash
+                .and_then(|f| f.get(i))
+                .map_or(String::new(), |b| b.to_string()),
         ]);
         if e.refused > 0 {
             eprintln!(
@@ -354,11 +409,12 @@ mod tests {
     fn the_table_between_the_markers_is_replaced_and_the_rest_kept() {
         let doc = format!("intro\n{BEGIN}\nold table\n{END}\nreading\n");
         let row = ["f32", "1e-7", "1e-7", "1e-7", "87", "5264", ""].map(String::from);
-        let new = replace_table(&doc, &[row]).unwrap();
+        let new = replace_table(&doc, &[row], "model error").unwrap();
         assert!(new.starts_with("intro\n"));
         assert!(new.ends_with(&format!("{END}\nreading\n")));
         assert!(!new.contains("old table"));
         assert!(new.contains("| f32 | 1e-7 | 1e-7 | 1e-7 | 87 | 5264 |  |"));
-        assert!(replace_table("no markers", &[]).is_none());
+        assert!(new.contains("|  |\n\nmodel error\n\n<!-- report:end"));
+        assert!(replace_table("no markers", &[], "").is_none());
     }
 }

@@ -27,6 +27,8 @@ pub use tools::ensure_target_tools;
 
 /// The firmware's target: Cortex-M4F, hard-float ABI.
 pub const TARGET: &str = "thumbv7em-none-eabihf";
+/// A core without an FPU (Cortex-M3), for the fixed-point backend's build check.
+pub const NO_FPU_TARGET: &str = "thumbv7m-none-eabi";
 
 /// `cargo xtask run [--demo] [--debug] [--short] [--telemetry FILE] [--plot PNG]
 /// [--every S] [--segments LIST|all] [--export-telemetry FILE]`: a pass through the firmware under QEMU (docs/telemetry.md),
@@ -100,7 +102,7 @@ pub fn run(args: &[String]) -> Result<(), String> {
 
 /// Every check of the target crates, for `cargo xtask test`: toolchain and QEMU present,
 /// clippy with `-D warnings` on thumbv7em for core-math, controller, firmware and
-/// hil-tests, the hil-tests under QEMU in the test (dev) and release profiles, then the
+/// hil-tests, and on thumbv7m (no FPU) for core-math's fixed-point backend, the hil-tests under QEMU in the test (dev) and release profiles, then the
 /// end-to-end pass test ([`e2e_test`]).
 pub fn test_target() -> Result<(), String> {
     let started = Instant::now();
@@ -126,6 +128,21 @@ pub fn test_target() -> Result<(), String> {
         args.extend_from_slice(&["--target", TARGET, "--", "-D", "warnings"]);
         cargo(&args)?;
     }
+    // The fixed-point backend alone, for a core without an FPU.
+    cargo(&[
+        "clippy",
+        "--package",
+        "core-math",
+        "--lib",
+        "--no-default-features",
+        "--features",
+        "fixed-point",
+        "--target",
+        NO_FPU_TARGET,
+        "--",
+        "-D",
+        "warnings",
+    ])?;
     let runner = runner_config()?;
     for profile in [None, Some("--release")] {
         let mut args = vec!["test", "--package", "hil-tests", "--target", TARGET];
@@ -195,9 +212,25 @@ fn build_bin(
     release: bool,
     features: &[&str],
 ) -> Result<PathBuf, String> {
+    build_bin_with(package, bin, release, features, &[])
+}
+
+/// [`build_bin`] with `rustc_args` passed to the compiler for that binary alone
+/// (`cargo rustc ... -- rustc_args`; with none, `cargo build`).
+pub(crate) fn build_bin_with(
+    package: &str,
+    bin: &str,
+    release: bool,
+    features: &[&str],
+    rustc_args: &[&str],
+) -> Result<PathBuf, String> {
     let mut cmd = cargo_command();
     cmd.args([
-        "build",
+        if rustc_args.is_empty() {
+            "build"
+        } else {
+            "rustc"
+        },
         "--package",
         package,
         "--bin",
@@ -212,9 +245,22 @@ fn build_bin(
     if release {
         cmd.arg("--release");
     }
+    if !rustc_args.is_empty() {
+        cmd.arg("--").args(rustc_args);
+    }
     eprintln!(
-        "xtask: cargo build --package {package} --bin {bin} --target {TARGET}{}",
-        if release { " --release" } else { "" }
+        "xtask: cargo {} --package {package} --bin {bin} --target {TARGET}{}{}",
+        if rustc_args.is_empty() {
+            "build"
+        } else {
+            "rustc"
+        },
+        if release { " --release" } else { "" },
+        if rustc_args.is_empty() {
+            String::new()
+        } else {
+            format!(" -- {}", rustc_args.join(" "))
+        }
     );
     let out = cmd
         .stderr(std::process::Stdio::inherit())

@@ -32,6 +32,7 @@ pub fn run(args: &[String]) -> Result<(), String> {
     cargo(&["test", "--release"])?;
     derivation_check()?;
     crate::target::test_target()?;
+    crate::no_panic::check()?;
     eprintln!(
         "\nxtask test: all checks passed in {:.0} s",
         t0.elapsed().as_secs_f64()

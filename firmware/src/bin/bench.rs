@@ -13,7 +13,10 @@
 use core::hint::black_box;
 
 use core_math::fixed_point::geometry_from_f64;
-use core_math::{Backend, Camera, Geometry, NaiveF32, Reference, CLOSED_F32, CLOSED_F64, FIXED};
+use core_math::{
+    Backend, Camera, Geometry, MicroF32, NaiveF32, Reference, CLOSED_F32, CLOSED_F64,
+    CLOSED_MICROMATH, FIXED,
+};
 use cortex_m_rt::entry;
 use firmware::pipeline::{Plan, SamplePoint};
 use firmware::platform;
@@ -50,6 +53,86 @@ fn region<I, O>(label: &str, input: I, f: impl FnOnce(I) -> O) {
     let out = f(black_box(input));
     black_box(out);
     bench_stop();
+}
+
+/// Pixels per loop region: one pixel every 1 935 across the default swath.
+const LOOP_PX: usize = 32;
+
+/// `LOOP_PX` pixel constants of `backend`, n = -30 000 ... +30 000.
+fn loop_pixels<B: Backend>(
+    backend: &B,
+    camera: &Camera,
+) -> Result<[B::Pixel; LOOP_PX], FirmwareError>
+where
+    B::Pixel: Copy,
+{
+    let first = backend.pixel(camera, -30_000.0)?;
+    let mut out = [first; LOOP_PX];
+    for (i, p) in out.iter_mut().enumerate() {
+        let n_px = -30_000.0 + 60_000.0 * i as f64 / (LOOP_PX - 1) as f64;
+        *p = backend.pixel(camera, n_px)?;
+    }
+    Ok(out)
+}
+
+/// `motion` of every pixel in a loop, each result kept (`black_box`): the count divided
+/// by `LOOP_PX` is the marginal cost of a pixel inside a loop, the way the controller
+/// evaluates its sample points, without the call and return of a one-pixel region.
+fn loop_region<B: Backend>(label: &str, backend: &B, u: &B::Update, pixels: &[B::Pixel; LOOP_PX]) {
+    region(label, (u, pixels), |(u, pixels)| {
+        for p in pixels {
+            let _kept = black_box(backend.motion(u, p));
+        }
+    });
+}
+
+/// Most sample points of one update (10 segments of at most 9).
+const MAX_POINTS: usize = 90;
+
+/// The default scene's planned sample pixels (the controller's plan, the one the
+/// firmware evaluates every update), as one backend's pixel constants.
+fn plan_pixels<B: Backend>(
+    backend: &B,
+    camera: &Camera,
+) -> Result<([B::Pixel; MAX_POINTS], usize), FirmwareError>
+where
+    B::Pixel: Copy,
+{
+    let plan = controller::plan::Plan::new(
+        &controller::Scene::paper_default(),
+        &Config::default().envelope(),
+    )
+    .map_err(|_| FirmwareError::Layout)?;
+    let mut out = [backend.pixel(camera, 0.0)?; MAX_POINTS];
+    let mut count = 0;
+    for seg in plan.active() {
+        for &n_px in seg.sample_px() {
+            let slot = out.get_mut(count).ok_or(FirmwareError::Layout)?;
+            *slot = backend.pixel(camera, f64::from(n_px))?;
+            count += 1;
+        }
+    }
+    Ok((out, count))
+}
+
+/// One full update of the default scene with `backend`: its `update`, then `motion` at
+/// every planned sample point, each result kept. The same work for every backend (the
+/// controller's own update adds |v|, period, ticks, the MTF guard and the outputs).
+fn full_update_region<B: Backend>(
+    label: &str,
+    backend: &B,
+    g: &Geometry<B::Real>,
+    pixels: &([B::Pixel; MAX_POINTS], usize),
+) {
+    region(label, (g, pixels), |(g, (pixels, count))| {
+        let u = backend.update(g);
+        if let Ok(u) = &u {
+            for p in pixels.iter().take(*count) {
+                let _kept = black_box(backend.motion(u, p));
+            }
+        }
+        black_box(u.is_ok())
+    });
 }
 
 /// Period registers that keep nothing (the bench measures the computation).
@@ -197,7 +280,74 @@ fn run() -> Result<(), FirmwareError> {
         pixel: axis,
     };
 
+    let loop_f32 = loop_pixels(&CLOSED_F32, &camera)?;
+    let loop_f64 = loop_pixels(&CLOSED_F64, &camera)?;
+    let loop_fx = loop_pixels(&FIXED, &camera)?;
+    let loop_naive = loop_pixels(&NaiveF32, &camera)?;
+    let loop_ref = loop_pixels(&Reference, &camera)?;
+
+    let plan_f32 = plan_pixels(&CLOSED_F32, &camera)?;
+    let plan_f64 = plan_pixels(&CLOSED_F64, &camera)?;
+    let plan_fx = plan_pixels(&FIXED, &camera)?;
+    let plan_naive = plan_pixels(&NaiveF32, &camera)?;
+    let plan_ref = plan_pixels(&Reference, &camera)?;
+    let plan_micro = plan_pixels(&CLOSED_MICROMATH, &camera)?;
+    let g_micro: Geometry<MicroF32> = g64.to();
+    let update_micro = CLOSED_MICROMATH.update(&g_micro)?;
+    let loop_micro = loop_pixels(&CLOSED_MICROMATH, &camera)?;
+    defmt::info!("full update: {=usize} planned sample points", plan_f32.1);
+
     region("empty region (marker overhead)", (), |()| ());
+    full_update_region("CLOSED_F32 full update", &CLOSED_F32, &g32, &plan_f32);
+    full_update_region("CLOSED_F64 full update", &CLOSED_F64, &g64, &plan_f64);
+    full_update_region("FIXED full update", &FIXED, &gfx, &plan_fx);
+    full_update_region("NaiveF32 full update", &NaiveF32, &g32, &plan_naive);
+    full_update_region("Reference full update", &Reference, &g64, &plan_ref);
+    full_update_region(
+        "CLOSED_MICROMATH full update",
+        &CLOSED_MICROMATH,
+        &g_micro,
+        &plan_micro,
+    );
+    loop_region(
+        "CLOSED_MICROMATH motion, 32 pixels in a loop",
+        &CLOSED_MICROMATH,
+        &update_micro,
+        &loop_micro,
+    );
+    region("CLOSED_MICROMATH update", &g_micro, |g| {
+        CLOSED_MICROMATH.update(g)
+    });
+    loop_region(
+        "CLOSED_F32 motion, 32 pixels in a loop",
+        &CLOSED_F32,
+        &update,
+        &loop_f32,
+    );
+    loop_region(
+        "CLOSED_F64 motion, 32 pixels in a loop",
+        &CLOSED_F64,
+        &update64,
+        &loop_f64,
+    );
+    loop_region(
+        "FIXED motion, 32 pixels in a loop",
+        &FIXED,
+        &update_fx,
+        &loop_fx,
+    );
+    loop_region(
+        "NaiveF32 motion, 32 pixels in a loop",
+        &NaiveF32,
+        &update_naive,
+        &loop_naive,
+    );
+    loop_region(
+        "Reference motion, 32 pixels in a loop",
+        &Reference,
+        &g64,
+        &loop_ref,
+    );
     region(
         "CLOSED_F32 motion, 1 pixel (n = 0)",
         (&update, &axis),

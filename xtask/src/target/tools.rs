@@ -8,11 +8,13 @@ use super::TARGET;
 /// the target with rustup and QEMU with apt-get when running as root; otherwise an
 /// error that says what to install.
 pub fn ensure_target_tools() -> Result<(), String> {
-    ensure_rust_target()?;
+    ensure_rust_target(TARGET)?;
+    // The fixed-point backend must build for FPU-less cores (docs/fixed-point.md).
+    ensure_rust_target(super::NO_FPU_TARGET)?;
     ensure_qemu()
 }
 
-fn ensure_rust_target() -> Result<(), String> {
+fn ensure_rust_target(target: &str) -> Result<(), String> {
     let installed = Command::new("rustup")
         .args(["target", "list", "--installed"])
         .output();
@@ -20,19 +22,19 @@ fn ensure_rust_target() -> Result<(), String> {
         Ok(out) if out.status.success() => {
             if String::from_utf8_lossy(&out.stdout)
                 .lines()
-                .any(|l| l.trim() == TARGET)
+                .any(|l| l.trim() == target)
             {
                 return Ok(());
             }
-            eprintln!("xtask: rustup target add {TARGET}");
+            eprintln!("xtask: rustup target add {target}");
             let status = Command::new("rustup")
-                .args(["target", "add", TARGET])
+                .args(["target", "add", target])
                 .status()
                 .map_err(|e| format!("cannot run rustup: {e}"))?;
             if status.success() {
                 Ok(())
             } else {
-                Err(format!("`rustup target add {TARGET}` failed ({status})"))
+                Err(format!("`rustup target add {target}` failed ({status})"))
             }
         }
         _ => {
@@ -42,14 +44,14 @@ fn ensure_rust_target() -> Result<(), String> {
                 let root = String::from_utf8_lossy(&o.stdout).trim().to_string();
                 std::path::Path::new(&root)
                     .join("lib/rustlib")
-                    .join(TARGET)
+                    .join(target)
                     .is_dir()
             });
             if has_core {
                 Ok(())
             } else {
                 Err(format!(
-                    "no rustup, and the toolchain lacks {TARGET}: install rustup and run `rustup target add {TARGET}`"
+                    "no rustup, and the toolchain lacks {target}: install rustup and run `rustup target add {target}`"
                 ))
             }
         }

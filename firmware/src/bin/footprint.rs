@@ -1,0 +1,63 @@
+//! Flash footprint of one backend, for the `flash_bytes` column of `cargo xtask report`.
+//!
+//! Built once per variant with `--cfg footprint="<variant>"` (and once with "none"):
+//! the variant's build calls that backend's `pixel`, `update` and `motion` on inputs the
+//! optimiser cannot see (`black_box`) and keeps the result; "none" only touches the
+//! inputs. Everything else (runtime, logger, exit) is common to both, so the difference
+//! of the two images' loadable sections is the code and constant data that backend
+//! brings into a binary. Never run; only linked and measured.
+#![no_std]
+#![no_main]
+
+use core::hint::black_box;
+
+#[allow(unused_imports)]
+use core_math::{Backend, Camera, Geometry};
+use cortex_m_rt::entry;
+use firmware::platform;
+
+/// 645 km circular orbit, roll 20 deg (values only; they reach the code through
+/// `black_box`).
+const GEOMETRY: Geometry<f64> = Geometry {
+    roll_rad: 0.349_065_850_398_865_9,
+    inclination_rad: 1.710_073_105_064_591,
+    arg_latitude_rad: 0.5,
+    altitude_m: 645e3,
+    earth_radius_m: 6_371e3,
+    earth_rate_rad_s: core_math::EARTH_RATE_RAD_S,
+    orbit_rate_rad_s: 1.077e-3,
+};
+
+/// Boot, update and per-pixel work of `backend`, the result kept.
+#[allow(dead_code)]
+fn exercise<B: Backend>(backend: &B, g: &Geometry<B::Real>) {
+    let camera = black_box(Camera {
+        focal_m: 0.555,
+        pixel_m: 13e-6,
+    });
+    let n_px = black_box(12_345.0);
+    if let (Ok(p), Ok(u)) = (backend.pixel(&camera, n_px), backend.update(black_box(g))) {
+        let _kept = black_box(backend.motion(&u, &p));
+    }
+}
+
+#[entry]
+fn main() -> ! {
+    #[allow(unused_variables)] // "none" keeps only the input
+    let g = black_box(GEOMETRY);
+    #[cfg(footprint = "naive-f32")]
+    exercise(&core_math::NaiveF32, &g.to());
+    #[cfg(footprint = "reference")]
+    exercise(&core_math::Reference, &g);
+    #[cfg(footprint = "f64")]
+    exercise(&core_math::CLOSED_F64, &g);
+    #[cfg(footprint = "f32")]
+    exercise(&core_math::CLOSED_F32, &g.to());
+    #[cfg(footprint = "f32-micromath")]
+    exercise(&core_math::CLOSED_MICROMATH, &g.to());
+    #[cfg(footprint = "fixed")]
+    if let Ok(gq) = core_math::fixed_point::geometry_from_f64(&g) {
+        exercise(&core_math::FIXED, &gq);
+    }
+    platform::exit(0)
+}
