@@ -16,12 +16,8 @@
 //!   [`stack`]: the stack's high-water mark (the firmware's RAM use).
 //!
 //! The default-scene demo (`src/bin/demo.rs`, `cargo xtask run --demo`) and the
-//! benchmark use the older one-shot pipeline, no telemetry:
-//! - [`scene`]: the built-in default scene ([`scene::SceneSource`], [`scene::NoTelemetry`]);
-//! - [`pipeline`]: boot-time pixel constants per sample point
-//!   ([`core_math::Backend::pixel`]), then one [`core_math::Backend::update`] and per
-//!   sample point one [`core_math::Backend::motion`] plus the line period;
-//! - [`output`]: defmt log lines.
+//! benchmark run the same controller without a link: [`synthetic`] primes it with one
+//! NAV frame.
 //!
 //! No function here panics: every refusal is a `Result` (no `unwrap`, `expect` or
 //! indexing that can fail).
@@ -31,11 +27,9 @@ pub mod cmsdk;
 pub mod line_clock;
 pub mod link;
 pub mod logger;
-pub mod output;
-pub mod pipeline;
 pub mod platform;
-pub mod scene;
 pub mod stack;
+pub mod synthetic;
 pub mod telemetry;
 
 use core_math::ModelError;
@@ -45,10 +39,9 @@ use core_math::ModelError;
 pub enum FirmwareError {
     /// The model refused an input or a geometry.
     Model(ModelError),
-    /// The detector layout cannot be sampled (no segments, too many, or pixel
-    /// offsets out of range).
+    /// The controller refused the scene or its plan (a layout it cannot sample).
     Layout,
-    /// The scene source failed (no telemetry controller yet: never today).
+    /// The synthetic NAV frame was not accepted, or no update ran.
     Telemetry,
 }
 
@@ -66,18 +59,4 @@ impl defmt::Format for FirmwareError {
             FirmwareError::Telemetry => defmt::write!(f, "telemetry error"),
         }
     }
-}
-
-/// One pass of the application: take a scene, compute every segment's line period,
-/// hand the results to the output.
-pub fn run<S: scene::SceneSource>(source: &mut S) -> Result<(), FirmwareError> {
-    let scene = source.scene()?;
-    output::log_scene(&scene);
-    let plan = pipeline::Plan::new(&scene)?;
-    let update = plan.update(&scene.geometry)?;
-    for segment in plan.segments() {
-        let report = plan.segment_report(&update, segment)?;
-        output::log_segment(&report);
-    }
-    Ok(())
 }

@@ -3,7 +3,7 @@
 //!
 //! - `cargo xtask run`: build the firmware (release) and play a pass through it under
 //!   QEMU (`pass`: telemetry on UART0 through a unix socket, the decoded defmt log on
-//!   stdout, table, plot, reference and fault checks); `--demo` runs the old
+//!   stdout, table, plot, reference and fault checks); `--demo` runs the
 //!   default-scene demo instead.
 //! - `cargo xtask qemu ELF`: the cargo runner for thumbv7em-none-eabihf (QEMU + defmt
 //!   decoding); `.cargo/config.toml` reaches it through `tools/qemu-runner`.
@@ -32,7 +32,7 @@ pub const NO_FPU_TARGET: &str = "thumbv7m-none-eabi";
 
 /// `cargo xtask run [--demo] [--debug] [--short] [--telemetry FILE] [--plot PNG]
 /// [--every S] [--segments LIST|all] [--export-telemetry FILE]`: a pass through the firmware under QEMU (docs/telemetry.md),
-/// or the old default-scene demo.
+/// or the default-scene demo.
 pub fn run(args: &[String]) -> Result<(), String> {
     const USAGE: &str = "usage: run [--demo] [--debug] [--short] [--telemetry FILE.csv] [--plot FILE.png] [--every SECONDS] [--segments 0,5,9|all] [--export-telemetry FILE.csv]";
     let mut release = true;

@@ -18,15 +18,11 @@ use core_math::{
     CLOSED_MICROMATH, FIXED,
 };
 use cortex_m_rt::entry;
-use firmware::pipeline::{Plan, SamplePoint};
 use firmware::platform;
-use firmware::scene::{NoTelemetry, Scene, SceneSource};
+use firmware::synthetic::{controller_with_nav, NoRegisters};
 use firmware::FirmwareError;
 
-use controller::frame::{encode, kind, Decoder, Event, MAX_FRAME};
-use controller::nav::{Attitude, Nav};
-use controller::{Config, Controller, LinePeriodSink};
-use core_math::StateVector;
+use controller::{Config, Controller};
 
 /// Start of a measured region (the plugin watches its first instruction). The
 /// `black_box` of a constant of its own is a side effect the optimiser must keep, and
@@ -135,67 +131,6 @@ fn full_update_region<B: Backend>(
     });
 }
 
-/// Period registers that keep nothing (the bench measures the computation).
-struct NoRegisters;
-
-impl LinePeriodSink for NoRegisters {
-    type Error = ();
-    fn write_period(&mut self, _index: u8, ticks: u32) -> Result<(), ()> {
-        black_box(ticks);
-        Ok(())
-    }
-}
-
-/// A controller holding one accepted NAV frame: 645 km circular orbit, i0 97.98 deg,
-/// argument of latitude 0.5 rad, roll `roll_rad`.
-fn controller_with_nav(
-    scene: controller::Scene,
-    exhaustive: bool,
-    roll_rad: f32,
-) -> Result<Controller, FirmwareError> {
-    let config = Config::default();
-    let c = if exhaustive {
-        Controller::evaluate_everything(config, scene)
-    } else {
-        Controller::new(config, scene)
-    };
-    let mut c = c.map_err(|_| FirmwareError::Layout)?;
-    let (r_m, i0, u) = (6_371e3 + 645e3, 97.98f64.to_radians(), 0.5f64);
-    let speed = libm::sqrt(core_math::GM_M3_S2 / r_m);
-    let (si, ci, su, cu) = (libm::sin(i0), libm::cos(i0), libm::sin(u), libm::cos(u));
-    let state = StateVector {
-        position_m: [r_m * cu, r_m * su * ci, r_m * su * si],
-        velocity_mps: [-speed * su, speed * cu * ci, speed * cu * si],
-    };
-    let attitude = Attitude {
-        roll_rad,
-        ..Attitude::default()
-    };
-    let mut payload = [0u8; 96];
-    let n = Nav { state, attitude }
-        .encode(&mut payload)
-        .ok_or(FirmwareError::Layout)?;
-    let mut frame = [0u8; MAX_FRAME];
-    let len = encode(
-        kind::NAV,
-        1,
-        1_000_000,
-        payload.get(..n).ok_or(FirmwareError::Layout)?,
-        &mut frame,
-    )
-    .ok_or(FirmwareError::Layout)?;
-    let mut decoder = Decoder::new();
-    decoder.feed(frame.get(..len).ok_or(FirmwareError::Layout)?, |e| {
-        if let Event::Frame(f) = e {
-            c.on_frame(&f);
-        }
-    });
-    if c.nav().is_none() {
-        return Err(FirmwareError::Telemetry);
-    }
-    Ok(c)
-}
-
 /// One whole controller update (update constants, every planned segment, outputs).
 fn update_region(label: &str, c: &mut Controller, t_us: u64) -> Result<(), FirmwareError> {
     let mut regs = NoRegisters;
@@ -249,13 +184,31 @@ fn scene_kinds() -> Result<(), FirmwareError> {
     Ok(())
 }
 
+/// The paper's camera and instant: f 0.555 m, pixel 13 um; H 645 km over R 6 370 km,
+/// i0 97.98 deg, argument of latitude 0, roll 25 deg (the right edge of the swath is 5 deg
+/// from the limb: the near-limb form).
+const CAMERA: Camera = Camera {
+    focal_m: 0.555,
+    pixel_m: 13e-6,
+};
+/// The line clock of the default scene (Hz).
+const LINE_CLOCK_HZ: f32 = 10e6;
+
+fn paper_geometry() -> Geometry<f64> {
+    Geometry::circular(
+        25f64.to_radians(),
+        97.98f64.to_radians(),
+        0.0,
+        645e3,
+        6_370e3,
+    )
+}
+
 fn run() -> Result<(), FirmwareError> {
-    let scene: Scene = NoTelemetry.scene()?;
-    let camera: Camera = scene.camera;
-    let g32: Geometry<f32> = scene.geometry;
+    let camera = CAMERA;
+    let g32: Geometry<f32> = paper_geometry().to();
     let g64: Geometry<f64> = g32.to_f64();
-    let plan = Plan::new(&scene)?;
-    let update = plan.update(&g32)?;
+    let update = CLOSED_F32.update(&g32)?;
     let axis = CLOSED_F32.pixel(&camera, 0.0)?;
     let edge = CLOSED_F32.pixel(&camera, 30_000.0)?;
     let axis64 = CLOSED_F64.pixel(&camera, 0.0)?;
@@ -275,10 +228,6 @@ fn run() -> Result<(), FirmwareError> {
     let update_naive = NaiveF32.update(&g32)?;
     let axis_naive = NaiveF32.pixel(&camera, 0.0)?;
     let edge_naive = NaiveF32.pixel(&camera, 30_000.0)?;
-    let axis_sample = SamplePoint {
-        n_px: 0,
-        pixel: axis,
-    };
 
     let loop_f32 = loop_pixels(&CLOSED_F32, &camera)?;
     let loop_f64 = loop_pixels(&CLOSED_F64, &camera)?;
@@ -360,8 +309,12 @@ fn run() -> Result<(), FirmwareError> {
     );
     region(
         "CLOSED_F32 motion + |v| + line period + ticks, 1 pixel (n = 0; the firmware's per-point work)",
-        (&plan, &update, &axis_sample),
-        |(plan, u, s)| plan.point(u, s),
+        (&update, &axis),
+        |(u, p)| -> Result<u32, FirmwareError> {
+            let speed = CLOSED_F32.motion(u, p)?.speed_mps();
+            let period = core_math::line_period_s(CAMERA.pixel_m as f32, speed)?;
+            Ok(core_math::line_period_ticks(period, LINE_CLOCK_HZ)?.ticks)
+        },
     );
     region("CLOSED_F32 update (once per telemetry update)", &g32, |g| {
         CLOSED_F32.update(g)
@@ -381,21 +334,6 @@ fn run() -> Result<(), FirmwareError> {
         "Reference motion (f64 chain), 1 pixel (n = 0)",
         (&g64, &ref_pixel),
         |(g, p)| Reference.motion(g, p),
-    );
-    region(
-        "whole update: CLOSED_F32 update + 10 segments x 3 points (motion, |v|, period, ticks)",
-        (&plan, &g32),
-        |(plan, g)| -> Result<u32, FirmwareError> {
-            let u = plan.update(g)?;
-            let mut sum = 0_u32;
-            for seg in plan.segments() {
-                let r = plan.segment_report(&u, seg)?;
-                for p in r.points {
-                    sum = sum.wrapping_add(p.ticks);
-                }
-            }
-            Ok(sum)
-        },
     );
     region(
         "FIXED motion, 1 pixel (n = 0; integer only)",
