@@ -9,7 +9,8 @@ use core_math::{Backend, Camera, Geometry, Reference, CLOSED_F32, CLOSED_F64};
 const U32: f64 = f32::EPSILON as f64 / 2.0;
 
 /// Limb-margin buckets (deg): a case falls in the first bucket whose lower bound it meets.
-const BUCKETS_DEG: [(f64, &str); 6] = [
+/// Shared with `stability`'s limb table, so that the two documents' bands are the same.
+pub(crate) const BUCKETS_DEG: [(f64, &str); 6] = [
     (1.0, ">= 1 deg"),
     (0.1, "0.1 - 1 deg"),
     (0.01, "0.01 - 0.1 deg"),

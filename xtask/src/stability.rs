@@ -17,6 +17,9 @@ mod point;
 use std::collections::BTreeMap;
 use std::time::Instant;
 
+// Map A's limb-margin bands are the accuracy report's buckets, so that its table and
+// this document's split the margin the same way.
+use crate::accuracy::BUCKETS_DEG;
 use doc::{agg_table, aggregate, describe, e2, parts, sig, Agg};
 use maps::{sweep, Map, MAPS};
 use point::{Outcome, Point, U_F32, U_FIXED};
@@ -116,16 +119,6 @@ pub fn check_bounds(maps: &[Map]) -> Result<(), String> {
     }
 }
 
-/// Limb-margin bands of map A (deg): lower bound, label.
-const BANDS_DEG: [(f64, &str); 6] = [
-    (1.0, ">= 1 deg"),
-    (0.1, "0.1 - 1 deg"),
-    (0.01, "0.01 - 0.1 deg"),
-    (1e-3, "1e-3 - 0.01 deg"),
-    (1e-4, "1e-4 - 1e-3 deg"),
-    (0.0, "< 1e-4 deg"),
-];
-
 /// Altitude bands of map A (km).
 const ALT_BANDS_KM: [(f64, f64); 5] = [
     (200.0, 400.0),
@@ -187,16 +180,9 @@ fn figures(maps: &[Map], quick: bool, secs: f64) -> BTreeMap<String, String> {
             ("max_kappa", &a.max_kappa),
         ] {
             if let Some((p, o)) = w {
-                put(&format!("{letter}.{what}.at"), describe(p, o));
-                put(&format!("{letter}.{what}.kappa"), sig(o.kappa));
-                put(&format!("{letter}.{what}.parts"), parts(o));
-                put(&format!("{letter}.{what}.e_f32"), e2(o.e_f32));
-                put(&format!("{letter}.{what}.e_f32_in"), e2(o.e_f32_in));
-                put(
-                    &format!("{letter}.{what}.e_fixed"),
-                    e2(o.e_fixed.max(o.e_fixed_in)),
-                );
-                put(&format!("{letter}.{what}.q"), sig(o.q));
+                for (k, s) in sample_figures(&format!("{letter}.{what}"), p, o) {
+                    put(&k, s);
+                }
             }
         }
         put(
@@ -213,9 +199,9 @@ fn figures(maps: &[Map], quick: bool, secs: f64) -> BTreeMap<String, String> {
         );
         put(&format!("{letter}.kappa_min"), sig(a.kappa_min));
         put(&format!("{letter}.kappa_max"), sig(a.kappa_max));
-        put(&format!("{letter}.e_f32"), e2(a.e_f32));
-        put(&format!("{letter}.e_f32_in"), e2(a.e_f32_in));
-        put(&format!("{letter}.e_fixed"), e2(a.e_fixed));
+        put(&format!("{letter}.e_f32"), e2(a.err.f32));
+        put(&format!("{letter}.e_f32_in"), e2(a.err.f32_in));
+        put(&format!("{letter}.e_fixed"), e2(a.err.fixed_worst()));
         put(
             &format!("{letter}.max_v1_terms"),
             format!("{:.4}", a.max_v1_terms),
@@ -228,26 +214,17 @@ fn figures(maps: &[Map], quick: bool, secs: f64) -> BTreeMap<String, String> {
     put("ratio_f32", format!("{:.2}", whole.ratio_f32));
     put("ratio_f32_in", format!("{:.2}", whole.ratio_f32_in));
     put("ratio_fixed", format!("{:.2}", whole.ratio_fixed));
-    put("e_f32", e2(whole.e_f32));
-    put("e_fixed", e2(whole.e_fixed));
+    put("e_f32", e2(whole.err.f32));
+    put("e_fixed", e2(whole.err.fixed_worst()));
     for (what, w) in [
         ("f32", &whole.worst_f32),
         ("f32_in", &whole.worst_f32_in),
         ("fixed", &whole.worst_fixed),
     ] {
         if let Some((p, o)) = w {
-            put(&format!("worst.{what}.at"), describe(p, o));
-            put(&format!("worst.{what}.kappa"), sig(o.kappa));
-            put(&format!("worst.{what}.parts"), parts(o));
-            put(&format!("worst.{what}.e_f32"), e2(o.e_f32));
-            put(
-                &format!("worst.{what}.e_f32_u"),
-                format!("{:.1}", o.e_f32 / U_F32),
-            );
-            put(
-                &format!("worst.{what}.e_fixed"),
-                e2(o.e_fixed.max(o.e_fixed_in)),
-            );
+            for (k, s) in sample_figures(&format!("worst.{what}"), p, o) {
+                put(&k, s);
+            }
         }
     }
     rows.push(("all maps".into(), whole.clone()));
@@ -265,12 +242,12 @@ fn figures(maps: &[Map], quick: bool, secs: f64) -> BTreeMap<String, String> {
     let band_of = |m: &Map, iy: usize| {
         let (_, y) = m.centre(0, iy);
         let deg = 10f64.powf(y);
-        BANDS_DEG
+        BUCKETS_DEG
             .iter()
             .position(|(lo, _)| deg >= *lo)
-            .unwrap_or(BANDS_DEG.len() - 1)
+            .unwrap_or(BUCKETS_DEG.len() - 1)
     };
-    let band_rows: Vec<(String, Agg)> = BANDS_DEG
+    let band_rows: Vec<(String, Agg)> = BUCKETS_DEG
         .iter()
         .enumerate()
         .map(|(b, (_, name))| {
@@ -281,20 +258,20 @@ fn figures(maps: &[Map], quick: bool, secs: f64) -> BTreeMap<String, String> {
         })
         .collect();
     put("limb_table", agg_table("limb margin", &band_rows));
-    let near = &band_rows[BANDS_DEG.len() - 1].1;
+    let near = &band_rows[BUCKETS_DEG.len() - 1].1;
     put("limb.kappa_max", sig(near.kappa_max));
-    put("limb.e_f32", e2(near.e_f32));
-    put("limb.e_f32_in", e2(near.e_f32_in));
-    put("limb.e_fixed", e2(near.e_fixed));
+    put("limb.e_f32", e2(near.err.f32));
+    put("limb.e_f32_in", e2(near.err.f32_in));
+    put("limb.e_fixed", e2(near.err.fixed_worst()));
     put("limb.ratio_f32_in", format!("{:.2}", near.ratio_f32_in));
     put(
         "limb.kq",
         format!("{} - {}", sig(near.kq.0), sig(near.kq.1)),
     );
     if let Some((p, o)) = &near.max_kappa {
-        put("limb.max_kappa.at", describe(p, o));
-        put("limb.max_kappa.parts", parts(o));
-        put("limb.max_kappa.q", sig(o.q));
+        for (k, s) in sample_figures("limb.max_kappa", p, o) {
+            put(&k, s);
+        }
     }
     let far = &band_rows[0].1;
     put(
@@ -322,10 +299,10 @@ fn figures(maps: &[Map], quick: bool, secs: f64) -> BTreeMap<String, String> {
         agg_table("altitude (limb margin >= 1 deg)", &alt_rows),
     );
     let (alt_lo, alt_hi) = (&alt_rows[0].1, &alt_rows[alt_rows.len() - 1].1);
-    put("alt.fixed_lo", e2(alt_lo.e_fixed));
-    put("alt.fixed_hi", e2(alt_hi.e_fixed));
-    put("alt.f32_lo", e2(alt_lo.e_f32));
-    put("alt.f32_hi", e2(alt_hi.e_f32));
+    put("alt.fixed_lo", e2(alt_lo.err.fixed_worst()));
+    put("alt.fixed_hi", e2(alt_hi.err.fixed_worst()));
+    put("alt.f32_lo", e2(alt_lo.err.f32));
+    put("alt.f32_hi", e2(alt_hi.err.f32));
     put("alt.ratio_fixed_lo", format!("{:.2}", alt_lo.ratio_fixed));
     put("alt.ratio_fixed_hi", format!("{:.2}", alt_hi.ratio_fixed));
     // The fixed backend's bracket scale: |b/c0| in its units of 2^-10 rad/s (i0 97.98 deg).
@@ -340,23 +317,20 @@ fn figures(maps: &[Map], quick: bool, secs: f64) -> BTreeMap<String, String> {
     }
     // Where map A's fixed error peaks, and where the fixed backend switches to its
     // near-limb form there (m = 1 - k|sin eta| = 2^-12, i.e. delta ~ 2^-12 / sqrt(c0)).
-    if let Some((ix, iy)) = a_map.argmax(|c| c.e_fixed.max(c.e_fixed_in)) {
+    if let Some((ix, iy)) = a_map.argmax(|c| c.err.fixed_worst()) {
         let (h_km, y) = a_map.centre(ix, iy);
         let c = &a_map.cells[iy * a_map.nx + ix];
         put(
             "A.max_e_fixed.cell",
             format!("H {h_km:.0} km, limb margin {} deg", sig(10f64.powf(y))),
         );
-        put("A.max_e_fixed", e2(c.e_fixed.max(c.e_fixed_in)));
+        put("A.max_e_fixed", e2(c.err.fixed_worst()));
         let h = h_km / (point::EARTH_RADIUS_M / 1e3);
         let switch = (2f64.powi(-12) / (h * (2.0 + h)).sqrt()).to_degrees();
         put("A.max_e_fixed.switch_deg", sig(switch));
         let q2 = 2.0 * (h * (2.0 + h)).sqrt() * (switch.to_radians());
         put("A.max_e_fixed.switch_q", sig(q2.sqrt()));
-        put(
-            "A.max_e_fixed.times_q",
-            e2(c.e_fixed.max(c.e_fixed_in) * q2.sqrt()),
-        );
+        put("A.max_e_fixed.times_q", e2(c.err.fixed_worst() * q2.sqrt()));
     }
 
     // Map B: how close its cells come to the limb.
@@ -412,6 +386,25 @@ fn figures(maps: &[Map], quick: bool, secs: f64) -> BTreeMap<String, String> {
     v
 }
 
+/// The values the document may quote about one sample (a map's worst or largest-kappa
+/// case), as (`{prefix}.<what>`, text): where it is, kappa and its parts, q, and the
+/// errors. Every such sample gets the same set, so the template can quote any of them the
+/// same way; the keys it does not use are ignored by [`doc::fill`].
+fn sample_figures(prefix: &str, p: &Point, o: &Outcome) -> [(String, String); 8] {
+    let key = |what: &str| format!("{prefix}.{what}");
+    [
+        (key("at"), describe(p, o)),
+        (key("kappa"), sig(o.kappa)),
+        (key("parts"), parts(o)),
+        (key("q"), sig(o.q)),
+        (key("e_f32"), e2(o.err.f32)),
+        // In units of u, for the whole's worst f32 case.
+        (key("e_f32_u"), format!("{:.1}", o.err.f32 / U_F32)),
+        (key("e_f32_in"), e2(o.err.f32_in)),
+        (key("e_fixed"), e2(o.err.fixed_worst())),
+    ]
+}
+
 /// Maxima over several aggregates.
 fn merge(all: &[Agg]) -> Agg {
     let mut m = Agg {
@@ -424,11 +417,7 @@ fn merge(all: &[Agg]) -> Agg {
         m.n += a.n;
         m.refused += a.refused;
         m.refused_by = m.refused_by.or(a.refused_by);
-        m.e_f32 = m.e_f32.max(a.e_f32);
-        m.e_f32_v1 = m.e_f32_v1.max(a.e_f32_v1);
-        m.e_f32_in = m.e_f32_in.max(a.e_f32_in);
-        m.e_fixed = m.e_fixed.max(a.e_fixed);
-        m.e_fixed_v1 = m.e_fixed_v1.max(a.e_fixed_v1);
+        m.err.max_assign(&a.err);
         m.kappa_min = m.kappa_min.min(a.kappa_min);
         m.kq = (m.kq.0.min(a.kq.0), m.kq.1.max(a.kq.1));
         m.max_v1_terms = m.max_v1_terms.max(a.max_v1_terms);
@@ -474,13 +463,17 @@ mod tests {
         // kappa >= 3 everywhere: altitude, radius and orbit rate contribute ~1 each.
         assert!(a.kappa_min > 2.5, "min kappa {}", a.kappa_min);
         // Real errors: several u for f32, the input rounding near the limb, a few LSB fixed.
-        assert!(a.e_f32 > 3.0 * U_F32, "f32 err {}", a.e_f32);
+        assert!(a.err.f32 > 3.0 * U_F32, "f32 err {}", a.err.f32);
         assert!(
-            a.e_f32_in > 1e-5,
+            a.err.f32_in > 1e-5,
             "f32 err at unrounded inputs {}",
-            a.e_f32_in
+            a.err.f32_in
         );
-        assert!(a.e_fixed > U_FIXED, "fixed err {}", a.e_fixed);
+        assert!(
+            a.err.fixed_worst() > U_FIXED,
+            "fixed err {}",
+            a.err.fixed_worst()
+        );
         // Tight enough to mean something.
         assert!(
             a.ratio_f32.max(a.ratio_f32_in) > 0.3 * C_F32,

@@ -6,7 +6,7 @@ use std::path::Path;
 use crate::plot::heatmap::Heatmap;
 
 use super::maps::{Cell, Map};
-use super::point::{Outcome, Point, INPUTS};
+use super::point::{Outcome, Point, RelErrors, INPUTS};
 use super::{C_F32, C_FIXED};
 
 /// log10 with a floor, so that an exact 0 lands at the bottom of the colour scale.
@@ -81,7 +81,7 @@ const PANELS: [Panel; 6] = [
         z_label: "rel. error |v_P|",
         z_range: ERR_RANGE,
         linear: false,
-        value: |c| lg(c.e_f32),
+        value: |c| lg(c.err.f32),
         bound: None,
     },
     Panel {
@@ -90,7 +90,7 @@ const PANELS: [Panel; 6] = [
         z_label: "rel. error |v_P|",
         z_range: ERR_RANGE,
         linear: false,
-        value: |c| lg(c.e_f32_in),
+        value: |c| lg(c.err.f32_in),
         bound: None,
     },
     Panel {
@@ -99,7 +99,7 @@ const PANELS: [Panel; 6] = [
         z_label: "rel. error |v_P|",
         z_range: ERR_RANGE,
         linear: false,
-        value: |c| lg(c.e_fixed.max(c.e_fixed_in)),
+        value: |c| lg(c.err.fixed_worst()),
         bound: None,
     },
     Panel {
@@ -213,11 +213,8 @@ pub struct Agg {
     pub n: u64,
     pub refused: u64,
     pub refused_by: Option<&'static str>,
-    pub e_f32: f64,
-    pub e_f32_v1: f64,
-    pub e_f32_in: f64,
-    pub e_fixed: f64,
-    pub e_fixed_v1: f64,
+    /// Quote `err.fixed_worst()` for the fixed |v_P| error, as the cells' maps do.
+    pub err: RelErrors,
     pub kappa_min: f64,
     pub kappa_max: f64,
     pub ratio_f32: f64,
@@ -248,11 +245,7 @@ pub fn aggregate(map: &Map, keep: impl Fn(usize, usize, &Cell) -> bool) -> Agg {
             a.n += c.n as u64;
             a.refused += c.refused as u64;
             a.refused_by = a.refused_by.or(c.refused_by);
-            a.e_f32 = a.e_f32.max(c.e_f32);
-            a.e_f32_v1 = a.e_f32_v1.max(c.e_f32_v1);
-            a.e_f32_in = a.e_f32_in.max(c.e_f32_in);
-            a.e_fixed = a.e_fixed.max(c.e_fixed.max(c.e_fixed_in));
-            a.e_fixed_v1 = a.e_fixed_v1.max(c.e_fixed_v1);
+            a.err.max_assign(&c.err);
             a.kappa_min = a.kappa_min.min(c.min_kappa);
             a.max_v1_terms = a.max_v1_terms.max(c.v1_term_ratio);
             let take = |best: &mut f64, slot: &mut Option<(Point, Outcome)>, v: f64, w| {
@@ -317,11 +310,11 @@ fn agg_row(first: String, a: &Agg) -> Vec<String> {
         first,
         a.n.to_string(),
         format!("{} - {}", sig(a.kappa_min), sig(a.kappa_max)),
-        e2(a.e_f32),
-        e2(a.e_f32_v1),
-        e2(a.e_f32_in),
-        e2(a.e_fixed),
-        e2(a.e_fixed_v1),
+        e2(a.err.f32),
+        e2(a.err.f32_v1),
+        e2(a.err.f32_in),
+        e2(a.err.fixed_worst()),
+        e2(a.err.fixed_v1),
         f2(a.ratio_f32),
         f2(a.ratio_f32_in),
         f2(a.ratio_fixed),

@@ -1,6 +1,6 @@
 //! The three maps: which variables span each, where the others sit, and the sweep.
 
-use super::point::{evaluate, Outcome, Point, Skip, EARTH_RADIUS_M};
+use super::point::{evaluate, Outcome, Point, RelErrors, Skip, EARTH_RADIUS_M};
 
 /// Sun-synchronous inclination of the paper's orbit (deg).
 pub const I0_SSO_DEG: f64 = 97.98;
@@ -143,12 +143,7 @@ pub struct Cell {
     pub n: u32,
     pub refused: u32,
     pub refused_by: Option<&'static str>,
-    pub e_f32: f64,
-    pub e_f32_v1: f64,
-    pub e_f32_in: f64,
-    pub e_fixed: f64,
-    pub e_fixed_v1: f64,
-    pub e_fixed_in: f64,
+    pub err: RelErrors,
     pub kappa: f64,
     pub min_kappa: f64,
     pub ratio_f32: f64,
@@ -170,12 +165,7 @@ impl Cell {
             self.v1_term_ratio = f64::NEG_INFINITY;
         }
         self.n += 1;
-        self.e_f32 = self.e_f32.max(o.e_f32);
-        self.e_f32_v1 = self.e_f32_v1.max(o.e_f32_v1);
-        self.e_f32_in = self.e_f32_in.max(o.e_f32_in);
-        self.e_fixed = self.e_fixed.max(o.e_fixed);
-        self.e_fixed_v1 = self.e_fixed_v1.max(o.e_fixed_v1);
-        self.e_fixed_in = self.e_fixed_in.max(o.e_fixed_in);
+        self.err.max_assign(&o.err);
         self.min_kappa = self.min_kappa.min(o.kappa);
         self.min_margin_rad = self.min_margin_rad.min(o.margin_rad);
         self.v1_term_ratio = self.v1_term_ratio.max(o.v1_term_ratio);

@@ -59,21 +59,48 @@ impl Point {
     }
 }
 
-/// What one point measures. Errors are relative to the reference |v_P| (v1's to |v1|).
+/// The backends' errors, relative to the reference |v_P| (the `_v1` ones to |v1|). One
+/// point's in [`Outcome`]; the maxima over samples in a map cell and over cells in the
+/// document's aggregates, so that all three keep and combine the same set.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Outcome {
+pub struct RelErrors {
     /// f32 at f32-rounded inputs against the reference at the same (widened) inputs:
     /// the algorithm's own error.
-    pub e_f32: f64,
-    pub e_f32_v1: f64,
+    pub f32: f64,
+    pub f32_v1: f64,
     /// f32 at f32-rounded inputs against the reference at the unrounded inputs: the
     /// algorithm and the rounding of its inputs, what a user sees.
-    pub e_f32_in: f64,
+    pub f32_in: f64,
     /// Fixed at I24F40-rounded inputs against the reference at the same inputs.
-    pub e_fixed: f64,
-    pub e_fixed_v1: f64,
+    pub fixed: f64,
+    pub fixed_v1: f64,
     /// Fixed against the reference at the unrounded inputs.
-    pub e_fixed_in: f64,
+    pub fixed_in: f64,
+}
+
+impl RelErrors {
+    /// Field by field maximum with `other` (f64::max: a NaN never displaces a number).
+    pub fn max_assign(&mut self, other: &RelErrors) {
+        self.f32 = self.f32.max(other.f32);
+        self.f32_v1 = self.f32_v1.max(other.f32_v1);
+        self.f32_in = self.f32_in.max(other.f32_in);
+        self.fixed = self.fixed.max(other.fixed);
+        self.fixed_v1 = self.fixed_v1.max(other.fixed_v1);
+        self.fixed_in = self.fixed_in.max(other.fixed_in);
+    }
+
+    /// The fixed backend's |v_P| error against the reference at its rounded or at the
+    /// unrounded inputs, whichever is larger: the one fixed error the document quotes,
+    /// maps and bounds.
+    pub fn fixed_worst(&self) -> f64 {
+        self.fixed.max(self.fixed_in)
+    }
+}
+
+/// What one point measures.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Outcome {
+    pub err: RelErrors,
     /// Relative condition number of |v_P|: the sum of `kappa_parts`.
     pub kappa: f64,
     /// |d ln|v_P| / d ln x_i| for the inputs of [`INPUTS`].
@@ -89,13 +116,13 @@ pub struct Outcome {
 
 impl Outcome {
     pub fn ratio_f32(&self) -> f64 {
-        self.e_f32 / (self.kappa * U_F32)
+        self.err.f32 / (self.kappa * U_F32)
     }
     pub fn ratio_f32_in(&self) -> f64 {
-        self.e_f32_in / (self.kappa * U_F32)
+        self.err.f32_in / (self.kappa * U_F32)
     }
     pub fn ratio_fixed(&self) -> f64 {
-        self.e_fixed.max(self.e_fixed_in) / (self.kappa * U_FIXED)
+        self.err.fixed_worst() / (self.kappa * U_FIXED)
     }
 }
 
@@ -167,12 +194,14 @@ pub fn evaluate(pt: &Point) -> Result<Outcome, Skip> {
 
     let (kappa, kappa_parts) = condition(&pt.g, alpha, margin, v_exact);
     Ok(Outcome {
-        e_f32: (s32 - v_r32).abs() / v_r32,
-        e_f32_v1: (m32.v1_mps as f64 - r32.v1_mps).abs() / r32.v1_mps.abs(),
-        e_f32_in: (s32 - v_exact).abs() / v_exact,
-        e_fixed: (sq - v_rq).abs() / v_rq,
-        e_fixed_v1: (mq.v1_mps - rq.v1_mps).abs() / rq.v1_mps.abs(),
-        e_fixed_in: (sq - v_exact).abs() / v_exact,
+        err: RelErrors {
+            f32: (s32 - v_r32).abs() / v_r32,
+            f32_v1: (m32.v1_mps as f64 - r32.v1_mps).abs() / r32.v1_mps.abs(),
+            f32_in: (s32 - v_exact).abs() / v_exact,
+            fixed: (sq - v_rq).abs() / v_rq,
+            fixed_v1: (mq.v1_mps - rq.v1_mps).abs() / rq.v1_mps.abs(),
+            fixed_in: (sq - v_exact).abs() / v_exact,
+        },
         kappa,
         kappa_parts,
         margin_rad: margin,
