@@ -316,6 +316,16 @@ fn run() -> Result<(), FirmwareError> {
             Ok(core_math::line_period_ticks(period, LINE_CLOCK_HZ)?.ticks)
         },
     );
+    region(
+        "libm::asin in f64 (soft float): the limb angle, part of CLOSED_F32 update",
+        1.0 / (1.0 + 645e3 / 6_370e3),
+        libm::asin,
+    );
+    region(
+        "core_math::trig::sin_cos_f32 (one call; CLOSED_F32 update makes four)",
+        0.436_332_3_f32,
+        core_math::trig::sin_cos_f32,
+    );
     region("CLOSED_F32 update (once per telemetry update)", &g32, |g| {
         CLOSED_F32.update(g)
     });
