@@ -1,6 +1,8 @@
 //! splitmix64: a seeded, dependency-free generator, so that a sample of the envelope
 //! (the error report's, the tests') is the same on any machine.
 
+use crate::model::Geometry;
+
 pub struct SplitMix64(pub u64);
 
 impl SplitMix64 {
@@ -15,5 +17,21 @@ impl SplitMix64 {
     /// Uniform in [lo, hi).
     pub fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
         lo + (hi - lo) * ((self.next_u64() >> 11) as f64 / (1u64 << 53) as f64)
+    }
+
+    /// A circular-orbit geometry drawn uniformly over the envelope the error report and
+    /// the tests share: roll within +/-45 deg, inclination 0-180 deg, argument of
+    /// latitude 0-360 deg, altitude 200-2000 km, R = 6 371 km; rounded to f32 and
+    /// widened back, so that f32, fixed point and the reference all see the same values.
+    pub fn envelope_geometry(&mut self) -> Geometry<f64> {
+        Geometry::circular(
+            self.uniform(-45.0, 45.0).to_radians(),
+            self.uniform(0.0, 180.0).to_radians(),
+            self.uniform(0.0, 360.0).to_radians(),
+            self.uniform(200e3, 2000e3),
+            6_371e3,
+        )
+        .to::<f32>()
+        .to_f64()
     }
 }

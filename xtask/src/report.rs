@@ -231,15 +231,7 @@ fn parse_seed(v: &str) -> Option<u64> {
 /// One case whose line of sight meets the Earth (per the reference), geometry rounded to
 /// f32, and its limb margin (deg).
 fn case(rng: &mut Rng) -> Option<(Geometry<f64>, f64, f64)> {
-    let g = Geometry::circular(
-        rng.uniform(-45.0, 45.0).to_radians(),
-        rng.uniform(0.0, 180.0).to_radians(),
-        rng.uniform(0.0, 360.0).to_radians(),
-        rng.uniform(200e3, 2000e3),
-        6_371e3,
-    )
-    .to::<f32>()
-    .to_f64();
+    let g = rng.envelope_geometry();
     let limb = libm::asin(g.earth_radius_m / (g.earth_radius_m + g.altitude_m));
     let alpha = if rng.next_u64() & 3 == 0 {
         let margin = libm::pow(10.0, rng.uniform(-5.0, 0.0)).to_radians();
