@@ -20,6 +20,20 @@ pub struct Attitude {
     pub yaw_rate_rad_s: f32,
 }
 
+impl Attitude {
+    /// The six values in payload order: roll, pitch, yaw, then their rates.
+    pub fn values(&self) -> [f32; 6] {
+        [
+            self.roll_rad,
+            self.pitch_rad,
+            self.yaw_rad,
+            self.roll_rate_rad_s,
+            self.pitch_rate_rad_s,
+            self.yaw_rate_rad_s,
+        ]
+    }
+}
+
 /// A NAV payload as sent.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Nav {
@@ -61,15 +75,7 @@ impl Nav {
         for x in self.state.position_m.iter().chain(&self.state.velocity_mps) {
             w.put(&x.to_le_bytes())?;
         }
-        let a = &self.attitude;
-        for x in [
-            a.roll_rad,
-            a.pitch_rad,
-            a.yaw_rad,
-            a.roll_rate_rad_s,
-            a.pitch_rate_rad_s,
-            a.yaw_rate_rad_s,
-        ] {
+        for x in self.attitude.values() {
             w.put(&x.to_le_bytes())?;
         }
         Some(w.len())
@@ -78,16 +84,7 @@ impl Nav {
     /// Orbit quantities, with every value checked: finite, above the ground, in the
     /// controller's envelope.
     pub fn orbit(&self, earth_radius_m: f64) -> Result<OrbitState, Fault> {
-        let a = &self.attitude;
-        let att = [
-            a.roll_rad,
-            a.pitch_rad,
-            a.yaw_rad,
-            a.roll_rate_rad_s,
-            a.pitch_rate_rad_s,
-            a.yaw_rate_rad_s,
-        ];
-        if !att.iter().all(|x| x.is_finite()) {
+        if !self.attitude.values().iter().all(|x| x.is_finite()) {
             return Err(Fault::NonFinite);
         }
         OrbitState::from_state(&self.state, earth_radius_m).map_err(Fault::from)
