@@ -591,44 +591,32 @@ impl Canvas {
 
     /// Text left to right with its top-left corner at (x, y).
     fn text(&mut self, x: i32, y: i32, s: &str, colour: Rgb) {
-        for (i, ch) in s.chars().enumerate() {
-            let g = Self::glyph(ch);
-            let ox = x + i as i32 * GLYPH;
-            for (gy, bits) in g.iter().enumerate() {
-                for gx in 0..8 {
-                    if bits & (1 << gx) != 0 {
-                        for sy in 0..TEXT_SCALE {
-                            for sx in 0..TEXT_SCALE {
-                                self.set(
-                                    ox + gx * TEXT_SCALE + sx,
-                                    y + gy as i32 * TEXT_SCALE + sy,
-                                    colour,
-                                );
-                            }
-                        }
-                    }
-                }
-            }
-        }
+        self.glyph_pixels(s, colour, |i, gx, gy| (x + i * GLYPH + gx, y + gy));
     }
 
     /// Text rotated a quarter turn anticlockwise (reading upward), starting at the
     /// bottom-left corner (x, y).
     fn text_up(&mut self, x: i32, y: i32, s: &str, colour: Rgb) {
+        // Glyph column gx goes up, glyph row gy goes right.
+        self.glyph_pixels(s, colour, |i, gx, gy| (x + gy, y - i * GLYPH - gx));
+    }
+
+    /// Sets every pixel of the glyphs of `s`, scaled by TEXT_SCALE; `place` maps
+    /// (character index, scaled glyph column, scaled glyph row) to the canvas.
+    fn glyph_pixels(&mut self, s: &str, colour: Rgb, place: impl Fn(i32, i32, i32) -> (i32, i32)) {
         for (i, ch) in s.chars().enumerate() {
             let g = Self::glyph(ch);
-            let oy = y - i as i32 * GLYPH;
             for (gy, bits) in g.iter().enumerate() {
                 for gx in 0..8 {
                     if bits & (1 << gx) != 0 {
                         for sy in 0..TEXT_SCALE {
                             for sx in 0..TEXT_SCALE {
-                                // Glyph column gx goes up, glyph row gy goes right.
-                                self.set(
-                                    x + gy as i32 * TEXT_SCALE + sx,
-                                    oy - gx * TEXT_SCALE - sy,
-                                    colour,
+                                let (px, py) = place(
+                                    i as i32,
+                                    gx * TEXT_SCALE + sx,
+                                    gy as i32 * TEXT_SCALE + sy,
                                 );
+                                self.set(px, py, colour);
                             }
                         }
                     }
