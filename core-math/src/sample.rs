@@ -1,7 +1,7 @@
 //! splitmix64: a seeded, dependency-free generator, so that a sample of the envelope
 //! (the error report's, the tests') is the same on any machine.
 
-use crate::model::Geometry;
+use crate::model::{Camera, Geometry};
 
 pub struct SplitMix64(pub u64);
 
@@ -33,5 +33,24 @@ impl SplitMix64 {
         )
         .to::<f32>()
         .to_f64()
+    }
+
+    /// A pixel of `camera` for geometry `g`: three draws in four with the field angle
+    /// uniform in +/-40 deg, one in four with the line of sight log-uniformly 1e-5 to
+    /// 1 deg short of either limb (so that the near-limb cases are populated); `None`
+    /// when that puts the field angle beyond 40 deg.
+    pub fn envelope_pixel(&mut self, g: &Geometry<f64>, camera: &Camera) -> Option<f64> {
+        let limb = libm::asin(g.earth_radius_m / (g.earth_radius_m + g.altitude_m));
+        let alpha = if self.next_u64() & 3 == 0 {
+            let margin = libm::pow(10.0, self.uniform(-5.0, 0.0)).to_radians();
+            let side = if self.next_u64() & 1 == 0 { 1.0 } else { -1.0 };
+            side * (limb - margin) - g.roll_rad
+        } else {
+            self.uniform(-40.0, 40.0).to_radians()
+        };
+        if alpha.abs() > 40f64.to_radians() {
+            return None;
+        }
+        Some(libm::tan(alpha) * camera.focal_m / camera.pixel_m)
     }
 }

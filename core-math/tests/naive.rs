@@ -44,18 +44,8 @@ fn case(rng: &mut Rng) -> Option<(Geometry<f64>, f64)> {
     )
     .to::<f32>()
     .to_f64();
-    let limb = libm::asin(g.earth_radius_m / (g.earth_radius_m + g.altitude_m));
-    let alpha = if rng.next_u64() & 3 == 0 {
-        let margin = libm::pow(10.0, rng.uniform(-5.0, 0.0)).to_radians();
-        let side = if rng.next_u64() & 1 == 0 { 1.0 } else { -1.0 };
-        side * (limb - margin) - g.roll_rad
-    } else {
-        rng.uniform(-40.0, 40.0).to_radians()
-    };
-    if alpha.abs() > 40f64.to_radians() {
-        return None;
-    }
-    Some((g, libm::tan(alpha) * CAMERA.focal_m / CAMERA.pixel_m))
+    let n_px = rng.envelope_pixel(&g, &CAMERA)?;
+    Some((g, n_px))
 }
 
 struct Bucket {

@@ -232,18 +232,7 @@ fn parse_seed(v: &str) -> Option<u64> {
 /// f32, and its limb margin (deg).
 fn case(rng: &mut Rng) -> Option<(Geometry<f64>, f64, f64)> {
     let g = rng.envelope_geometry();
-    let limb = libm::asin(g.earth_radius_m / (g.earth_radius_m + g.altitude_m));
-    let alpha = if rng.next_u64() & 3 == 0 {
-        let margin = libm::pow(10.0, rng.uniform(-5.0, 0.0)).to_radians();
-        let side = if rng.next_u64() & 1 == 0 { 1.0 } else { -1.0 };
-        side * (limb - margin) - g.roll_rad
-    } else {
-        rng.uniform(-40.0, 40.0).to_radians()
-    };
-    if alpha.abs() > 40f64.to_radians() {
-        return None;
-    }
-    let n_px = libm::tan(alpha) * CAMERA.focal_m / CAMERA.pixel_m;
+    let n_px = rng.envelope_pixel(&g, &CAMERA)?;
     let margin = core_math::accuracy::limb_margin_rad(&CAMERA, &g, n_px).ok()?;
     (margin > 0.0).then_some((g, n_px, margin.to_degrees()))
 }
