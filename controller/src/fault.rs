@@ -94,12 +94,17 @@ impl From<ModelError> for Fault {
         match e {
             ModelError::NonFinite(_) => Fault::NonFinite,
             ModelError::LineOfSightMissesEarth => Fault::BeyondLimb,
-            ModelError::NoImageMotion | ModelError::LinePeriodOutOfRange => Fault::PeriodOutOfRange,
+            ModelError::NoImageMotion
+            | ModelError::NoAlongTrackMotion
+            | ModelError::LinePeriodOutOfRange => Fault::PeriodOutOfRange,
             ModelError::NonPositiveAltitude
             | ModelError::NonPositiveEarthRadius
             | ModelError::NonPositiveFocalLength
             | ModelError::NonPositivePixelPitch
-            | ModelError::OutOfDomain(_) => Fault::OutOfRange,
+            | ModelError::OutOfDomain(_)
+            | ModelError::InvalidInput(_)
+            | ModelError::DegenerateState
+            | ModelError::SatelliteNotAboveGround => Fault::OutOfRange,
         }
     }
 }

@@ -26,6 +26,11 @@ impl Dual {
         let (s, c) = libm::sincos(self.re);
         Dual::new(c, -s * self.du)
     }
+    /// sqrt(x), d sqrt(x) = dx / (2 sqrt(x)); for x > 0 only (callers check).
+    pub fn sqrt(self) -> Dual {
+        let r = libm::sqrt(self.re);
+        Dual::new(r, self.du / (r + r))
+    }
 }
 
 impl Add for Dual {

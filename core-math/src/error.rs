@@ -19,6 +19,15 @@ pub enum Param {
     MtfFloor,
     Position,
     Velocity,
+    Pitch,
+    Yaw,
+    RollRate,
+    PitchRate,
+    YawRate,
+    GroundHeight,
+    SemiMajorAxis,
+    Flattening,
+    FocalPlaneP1,
 }
 
 impl Param {
@@ -39,6 +48,15 @@ impl Param {
             Param::MtfFloor => "mtf_floor",
             Param::Position => "position",
             Param::Velocity => "velocity",
+            Param::Pitch => "pitch",
+            Param::Yaw => "yaw",
+            Param::RollRate => "roll_rate",
+            Param::PitchRate => "pitch_rate",
+            Param::YawRate => "yaw_rate",
+            Param::GroundHeight => "ground_height",
+            Param::SemiMajorAxis => "semi_major_axis",
+            Param::Flattening => "flattening",
+            Param::FocalPlaneP1 => "p1",
         }
     }
 }
@@ -64,6 +82,16 @@ pub enum ModelError {
     NoImageMotion,
     /// The line period does not fit the tick counter (zero ticks or more than `u32::MAX`).
     LinePeriodOutOfRange,
+    /// Real-Earth model: an input outside its physical meaning (f, pixel or a <= 0,
+    /// flattening outside [0, 1), ground height <= -b).
+    InvalidInput(Param),
+    /// Real-Earth model: |r| = 0 or r x v = 0, so the local orbital frame is undefined.
+    DegenerateState,
+    /// Real-Earth model: the satellite is on or inside the ground ellipsoid.
+    SatelliteNotAboveGround,
+    /// Real-Earth model: v1 = 0 (no motion along the TDI direction: no line period, no
+    /// drift angle).
+    NoAlongTrackMotion,
 }
 
 impl ModelError {
@@ -79,13 +107,19 @@ impl ModelError {
             ModelError::LineOfSightMissesEarth => "line_of_sight_misses_earth",
             ModelError::NoImageMotion => "no_image_motion",
             ModelError::LinePeriodOutOfRange => "line_period_out_of_range",
+            ModelError::InvalidInput(_) => "invalid_input",
+            ModelError::DegenerateState => "degenerate_state",
+            ModelError::SatelliteNotAboveGround => "satellite_not_above_ground",
+            ModelError::NoAlongTrackMotion => "no_along_track_motion",
         }
     }
 
     /// The parameter concerned, where there is one.
     pub const fn param(self) -> Option<Param> {
         match self {
-            ModelError::NonFinite(p) | ModelError::OutOfDomain(p) => Some(p),
+            ModelError::NonFinite(p) | ModelError::OutOfDomain(p) | ModelError::InvalidInput(p) => {
+                Some(p)
+            }
             _ => None,
         }
     }

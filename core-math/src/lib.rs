@@ -32,6 +32,7 @@ pub mod accuracy;
 pub mod closed_form;
 #[cfg(feature = "reference")]
 pub mod dual;
+pub mod earth;
 pub mod error;
 #[cfg(feature = "fixed-point")]
 pub mod fixed_point;
@@ -52,6 +53,9 @@ mod sqrt;
 pub mod trig;
 
 pub use closed_form::ClosedForm;
+#[cfg(feature = "reference")]
+pub use earth::EarthReference;
+pub use earth::{Earth, EarthCamera, EarthGeometry, Ellipsoid, General};
 pub use error::{ModelError, Param};
 #[cfg(feature = "fixed-point")]
 pub use fixed_point::{Fixed, FixedReal, FIXED};
@@ -59,7 +63,8 @@ pub use line_period::{line_period_s, line_period_ticks, Ticks};
 #[cfg(feature = "micromath")]
 pub use micromath_f32::MicroF32;
 pub use model::{
-    domain, orbital_rate_rad_s, Backend, Camera, Geometry, ImageMotion, EARTH_RATE_RAD_S, GM_M3_S2,
+    domain, orbital_rate_rad_s, Backend, Camera, Geometry, ImageMotion, Model, Sphere,
+    EARTH_RATE_RAD_S, GM_M3_S2,
 };
 pub use mtf::{mtf_mismatch, sinc, StageRule};
 #[cfg(feature = "naive")]
@@ -69,6 +74,10 @@ pub use real::{Real, Scalar};
 #[cfg(feature = "reference")]
 pub use reference::Reference;
 
+/// The real-Earth general form in f64.
+pub const GENERAL_F64: General<f64> = General::new();
+/// The real-Earth general form in f32, the form the firmware flies.
+pub const GENERAL_F32: General<f32> = General::new();
 /// The closed form in f64.
 pub const CLOSED_F64: ClosedForm<f64> = ClosedForm::new();
 /// The closed form in f32, the shipped path.

@@ -228,12 +228,33 @@ impl<T: Real> ImageMotion<T> {
     }
 }
 
-/// One numeric backend of the image-motion model.
+/// What a model is evaluated on: the optics fixed at boot and the geometry of one instant.
+///
+/// Two models share the one [`Backend`] interface: [`Sphere`], the paper's round Earth
+/// (roll only, circular orbit, sea level), and [`crate::earth::Earth`], the real Earth
+/// (`../shared/EARTH-MODEL.md`).
+pub trait Model {
+    /// The optics (known at boot or scene upload).
+    type Camera;
+    /// Orbit, attitude and Earth at one instant, in a backend's scalar `T`.
+    type Geometry<T: Scalar>;
+}
+
+/// The paper's round-Earth model (the default of [`Backend`]).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Sphere;
+
+impl Model for Sphere {
+    type Camera = Camera;
+    type Geometry<T: Scalar> = Geometry<T>;
+}
+
+/// One numeric backend of an image-motion model `M` (the round Earth by default).
 ///
 /// The work is split by how often it must be done: [`Backend::pixel`] once per field
 /// point at boot or scene upload, [`Backend::update`] once per telemetry update,
 /// [`Backend::motion`] per field point per update (no transcendental calls there).
-pub trait Backend {
+pub trait Backend<M: Model = Sphere> {
     /// The scalar of the per-update input and of the output: a [`Real`] (f64, f32) for
     /// the float backends, I24F40 for [`crate::Fixed`]. Only [`Scalar`] is required.
     type Real: Scalar;
@@ -242,8 +263,8 @@ pub trait Backend {
     /// Constants of one instant (depend only on orbit and attitude).
     type Update: Copy;
 
-    fn pixel(&self, camera: &Camera, n_px: f64) -> Result<Self::Pixel, ModelError>;
-    fn update(&self, geometry: &Geometry<Self::Real>) -> Result<Self::Update, ModelError>;
+    fn pixel(&self, camera: &M::Camera, n_px: f64) -> Result<Self::Pixel, ModelError>;
+    fn update(&self, geometry: &M::Geometry<Self::Real>) -> Result<Self::Update, ModelError>;
     fn motion(
         &self,
         update: &Self::Update,
@@ -253,8 +274,8 @@ pub trait Backend {
     /// All three steps for one pixel at one instant (convenience for tools and tests).
     fn evaluate(
         &self,
-        camera: &Camera,
-        geometry: &Geometry<Self::Real>,
+        camera: &M::Camera,
+        geometry: &M::Geometry<Self::Real>,
         n_px: f64,
     ) -> Result<ImageMotion<Self::Real>, ModelError> {
         let p = self.pixel(camera, n_px)?;

@@ -1,0 +1,209 @@
+//! The general form of the real-Earth image motion, written once for any [`Real`]
+//! (derivation and computer-algebra proof: `docs/derivation.md`, "The general model").
+//!
+//! With M = [x_L y_L z_L] A the camera's axes in I, a ground point G at s u (in B) from
+//! the satellite, u = (p1, p2, -f), and c(t) = M(t)^T (G(t) - r(t)):
+//!
+//! ```text
+//! c'/s = -W x u - V / s,      W = w_B - omega z_B   (camera's angular velocity relative
+//!                                                    to the Earth, in B)
+//!                             V = M^T (v - omega z x r)   (satellite's velocity relative
+//!                                                         to the Earth, in B)
+//! v1 = g1 + (p1/f) g3,  v2 = g2 + (p2/f) g3,   g = c'/s
+//! ```
+//!
+//! Per update (once per NAV state; three sine/cosine pairs, one division):
+//! - in L: n = z in L = (x_L,z, y_L,z, z_L,z), the orbit rate nu = |r x v| / |r|^2 (the
+//!   L frame turns about y_L at nu for any central force), V_L = (|h|/|r| - omega |r| n2,
+//!   omega |r| n1, r.v/|r|), W_L = (0, nu, 0) - omega n;
+//! - the attitude: W_B = A^T W_L + w_A, w_A = roll' (c_psi c_theta, -s_psi c_theta,
+//!   s_theta) + pitch' (s_psi, c_psi, 0) + yaw' (0, 0, 1); V_B, n_B = A^T V_L, A^T n;
+//! - the ray/ellipsoid quadratic alpha s^2 + 2 beta s + C = 0 in the coordinates where
+//!   the ground is the sphere of radius A (z stretched by kappa = A/B):
+//!   alpha = |u|^2 + (kappa^2 - 1)(n_B . u)^2, beta = rho_B . u with
+//!   rho_B = A^T ((0, 0, |r|) + (kappa^2 - 1) r_z n), C = |K r|^2 - A^2 (from f64).
+//!
+//! Per pixel (no call, no division): the near root as 1/s = (sqrt(beta^2 - alpha C) -
+//! beta) / C (rationalised: no cancellation between -beta and the square root), then g
+//! and (v1, v2).
+
+use core::marker::PhantomData;
+
+use crate::earth::{Earth, EarthCamera, EarthGeometry, MIN_V1_MPS};
+use crate::error::ModelError;
+use crate::model::{Backend, ImageMotion};
+use crate::real::Real;
+
+/// The general real-Earth backend in scalar `T` (`f64` or `f32`).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct General<T>(PhantomData<T>);
+
+impl<T> General<T> {
+    pub const fn new() -> Self {
+        General(PhantomData)
+    }
+}
+
+/// Constants of one pixel: its line of sight u = (p1, p2, -f) in B and what follows.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GeneralPixel<T> {
+    /// (p1, p2, -f) (m).
+    pub u_m: [T; 3],
+    /// |u|^2 = p1^2 + p2^2 + f^2 (m^2).
+    pub uu_m2: T,
+    /// p1/f and p2/f.
+    pub t1: T,
+    pub t2: T,
+}
+
+/// Constants of one instant.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GeneralUpdate<T> {
+    /// The spin axis z in B.
+    pub n_b: [T; 3],
+    /// rho_B (m): beta = rho_B . u.
+    pub rho_b_m: [T; 3],
+    /// kappa^2 - 1.
+    pub stretch2_minus_1: T,
+    /// C = |K r|^2 - A^2 (m^2) and 1/C.
+    pub c_m2: T,
+    pub inv_c_per_m2: T,
+    /// W_B (rad/s): the camera's angular velocity relative to the Earth, in B.
+    pub w_b_rad_s: [T; 3],
+    /// V_B (m/s): the satellite's velocity relative to the Earth, in B.
+    pub v_b_mps: [T; 3],
+}
+
+fn dot3<T: Real>(a: [T; 3], b: [T; 3]) -> T {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+/// A^T x with A = Rx(roll) Ry(pitch) Rz(yaw) given by its columns.
+fn at_mul<T: Real>(cols: &[[T; 3]; 3], x: [T; 3]) -> [T; 3] {
+    [dot3(cols[0], x), dot3(cols[1], x), dot3(cols[2], x)]
+}
+
+impl<T: Real> Backend<Earth> for General<T> {
+    type Real = T;
+    type Pixel = GeneralPixel<T>;
+    type Update = GeneralUpdate<T>;
+
+    /// Boot-time work in f64, rounded once.
+    fn pixel(&self, camera: &EarthCamera, n_px: f64) -> Result<GeneralPixel<T>, ModelError> {
+        let (p1, p2) = camera.focal_plane_m(n_px)?;
+        let f = camera.focal_m;
+        Ok(GeneralPixel {
+            u_m: [T::from_f64(p1), T::from_f64(p2), T::from_f64(-f)],
+            uu_m2: T::from_f64(p1 * p1 + p2 * p2 + f * f),
+            t1: T::from_f64(p1 / f),
+            t2: T::from_f64(p2 / f),
+        })
+    }
+
+    fn update(&self, g: &EarthGeometry<T>) -> Result<GeneralUpdate<T>, ModelError> {
+        let ground = g.validate()?;
+        let r = g.state.position_m.map(T::from_f64);
+        let v = g.state.velocity_mps.map(T::from_f64);
+        let w = T::from_f64(g.earth_rate_rad_s);
+        let zero = T::ZERO;
+
+        let rn = dot3(r, r).sqrt();
+        let h = [
+            r[1] * v[2] - r[2] * v[1],
+            r[2] * v[0] - r[0] * v[2],
+            r[0] * v[1] - r[1] * v[0],
+        ];
+        let hn = dot3(h, h).sqrt();
+        // In f32 the cross product of a nearly radial state can vanish where f64's did not.
+        if !(hn > zero) {
+            return Err(ModelError::DegenerateState);
+        }
+        // n = z in L: x_L,z = (y_L x z_L)_z, y_L,z = h_z/|h|, z_L,z = r_z/|r|.
+        let inv_hr = T::ONE / (hn * rn);
+        let n_l = [
+            (h[0] * r[1] - h[1] * r[0]) * inv_hr,
+            h[2] * rn * inv_hr,
+            r[2] * hn * inv_hr,
+        ];
+        let inv_r = hn * inv_hr;
+        // Forward speed |h|/|r| and the orbit rate |h|/|r|^2.
+        let v_fwd = hn * inv_r;
+        let nu = v_fwd * inv_r;
+        let rdot = dot3(r, v) * inv_r;
+        let wr = w * rn;
+        let v_l = [v_fwd - wr * n_l[1], wr * n_l[0], rdot];
+        let w_l = [-w * n_l[0], nu - w * n_l[1], -w * n_l[2]];
+        // kappa^2 - 1 = (A - B)(A + B)/B^2, in T (all factors positive: no cancellation).
+        let b = T::from_f64(ground.polar_m);
+        let inv_b2 = T::ONE / (b * b);
+        let k2m1 = T::from_f64(ground.eq_minus_polar_m) * (T::from_f64(ground.eq_m) + b) * inv_b2;
+        let rho_l = [
+            k2m1 * r[2] * n_l[0],
+            k2m1 * r[2] * n_l[1],
+            rn + k2m1 * r[2] * n_l[2],
+        ];
+
+        let at = &g.attitude;
+        let (sp, cp) = at.roll_rad.sin_cos();
+        let (st, ct) = at.pitch_rad.sin_cos();
+        let (sy, cy) = at.yaw_rad.sin_cos();
+        // Columns of A = Rx(roll) Ry(pitch) Rz(yaw).
+        let cols = [
+            [ct * cy, cp * sy + sp * st * cy, sp * sy - cp * st * cy],
+            [-ct * sy, cp * cy - sp * st * sy, sp * cy + cp * st * sy],
+            [st, -sp * ct, cp * ct],
+        ];
+        let w_a = [
+            at.roll_rate_rad_s * cy * ct + at.pitch_rate_rad_s * sy,
+            -at.roll_rate_rad_s * sy * ct + at.pitch_rate_rad_s * cy,
+            at.roll_rate_rad_s * st + at.yaw_rate_rad_s,
+        ];
+        let w_b0 = at_mul(&cols, w_l);
+
+        let c_m2 = T::from_f64(ground.outside_m4) * inv_b2;
+        Ok(GeneralUpdate {
+            n_b: at_mul(&cols, n_l),
+            rho_b_m: at_mul(&cols, rho_l),
+            stretch2_minus_1: k2m1,
+            c_m2,
+            inv_c_per_m2: T::ONE / c_m2,
+            w_b_rad_s: [w_b0[0] + w_a[0], w_b0[1] + w_a[1], w_b0[2] + w_a[2]],
+            v_b_mps: at_mul(&cols, v_l),
+        })
+    }
+
+    #[inline]
+    fn motion(
+        &self,
+        up: &GeneralUpdate<T>,
+        px: &GeneralPixel<T>,
+    ) -> Result<ImageMotion<T>, ModelError> {
+        let u = px.u_m;
+        let nu = dot3(up.n_b, u);
+        let beta = dot3(up.rho_b_m, u);
+        // Both roots share the sign of -beta (C > 0: the satellite is outside).
+        if !(beta < T::ZERO) {
+            return Err(ModelError::LineOfSightMissesEarth);
+        }
+        let alpha = px.uu_m2 + up.stretch2_minus_1 * nu * nu;
+        let disc = beta * beta - alpha * up.c_m2;
+        if !(disc >= T::ZERO) {
+            return Err(ModelError::LineOfSightMissesEarth);
+        }
+        let inv_s = (disc.sqrt() - beta) * up.inv_c_per_m2;
+        let (w, v) = (up.w_b_rad_s, up.v_b_mps);
+        let g = [
+            -(w[1] * u[2] - w[2] * u[1]) - v[0] * inv_s,
+            -(w[2] * u[0] - w[0] * u[2]) - v[1] * inv_s,
+            -(w[0] * u[1] - w[1] * u[0]) - v[2] * inv_s,
+        ];
+        let v1 = g[0] + px.t1 * g[2];
+        if !(v1.abs() >= T::from_f64(MIN_V1_MPS)) {
+            return Err(ModelError::NoAlongTrackMotion);
+        }
+        Ok(ImageMotion {
+            v1_mps: v1,
+            v2_mps: g[1] + px.t2 * g[2],
+        })
+    }
+}

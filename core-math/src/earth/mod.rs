@@ -1,0 +1,402 @@
+//! The real-Earth image-motion model (`../shared/EARTH-MODEL.md`, the contract):
+//! a satellite on a two-body orbit given by its inertial state vector, a camera turned by
+//! roll, pitch and yaw (each moving at its own rate) from the local orbital frame, a
+//! pixel anywhere on the focal plane, and the ground as an ellipsoid of revolution raised
+//! by the terrain height. The image motion is d/dt of where the Earth-fixed ground point
+//! projects on the focal plane, at t = 0.
+//!
+//! Frames (as in the contract):
+//! - **I**, inertial, Earth-centred, z the spin axis; the Earth turns about +z at
+//!   `earth_rate_rad_s`.
+//! - **L**, local orbital: z_L = r/|r| (zenith), y_L = (r x v)/|r x v| (orbit normal, to
+//!   the left of the flight direction), x_L = y_L x z_L (forward).
+//! - **B**, camera: the columns of A = Rx(roll) Ry(pitch) Rz(yaw) are B's axes in L.
+//!   Boresight -z_B; pixel (p1, p2) has line of sight (p1, p2, -f) in B; P = -f (c1, c2)/c3.
+//!
+//! Backends, each one implementation of [`crate::Backend`]`<`[`Earth`]`>`:
+//! - [`EarthReference`] (feature `reference`): the construction evaluated literally on
+//!   dual numbers in f64, the golden source;
+//! - [`General<f64>`] and [`General<f32>`]: the closed general form (`docs/derivation.md`,
+//!   "The general model"), split into a per-update and a per-pixel part.
+
+use crate::error::{ModelError, Param};
+use crate::model::{domain, Model};
+use crate::orbit::StateVector;
+use crate::real::{Real, Scalar};
+
+pub mod general;
+#[cfg(feature = "reference")]
+pub mod reference;
+
+pub use general::General;
+#[cfg(feature = "reference")]
+pub use reference::EarthReference;
+
+/// The real-Earth model: camera [`EarthCamera`], geometry [`EarthGeometry`].
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Earth;
+
+impl Model for Earth {
+    type Camera = EarthCamera;
+    type Geometry<T: Scalar> = EarthGeometry<T>;
+}
+
+/// An ellipsoid of revolution about the spin axis: semi-major axis a, flattening
+/// (b = a (1 - flattening)).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Ellipsoid {
+    pub a_m: f64,
+    pub flattening: f64,
+}
+
+impl Ellipsoid {
+    /// WGS 84: a = 6 378 137 m, f = 1 / 298.257223563.
+    pub const WGS84: Ellipsoid = Ellipsoid {
+        a_m: 6_378_137.0,
+        flattening: 1.0 / 298.257_223_563,
+    };
+
+    /// Semi-minor (polar) axis b = a (1 - f), m.
+    pub fn b_m(&self) -> f64 {
+        self.a_m * (1.0 - self.flattening)
+    }
+}
+
+/// The optics of the real-Earth model: focal length, pixel pitch, and the P1 position of
+/// the detector line on the focal plane (0 when the line crosses the optical axis).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EarthCamera {
+    pub focal_m: f64,
+    pub pixel_m: f64,
+    pub p1_m: f64,
+}
+
+/// Attitude of the camera frame B relative to the local orbital frame L: the angles of
+/// A = Rx(roll) Ry(pitch) Rz(yaw) and their time derivatives (not body rates).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Attitude<T> {
+    pub roll_rad: T,
+    pub pitch_rad: T,
+    pub yaw_rad: T,
+    pub roll_rate_rad_s: T,
+    pub pitch_rate_rad_s: T,
+    pub yaw_rate_rad_s: T,
+}
+
+impl Attitude<f64> {
+    /// The same attitude rounded to another scalar type.
+    pub fn to<T: Real>(&self) -> Attitude<T> {
+        Attitude {
+            roll_rad: T::from_f64(self.roll_rad),
+            pitch_rad: T::from_f64(self.pitch_rad),
+            yaw_rad: T::from_f64(self.yaw_rad),
+            roll_rate_rad_s: T::from_f64(self.roll_rate_rad_s),
+            pitch_rate_rad_s: T::from_f64(self.pitch_rate_rad_s),
+            yaw_rate_rad_s: T::from_f64(self.yaw_rate_rad_s),
+        }
+    }
+}
+
+impl<T: Scalar> Attitude<T> {
+    /// The six values with the parameter each one is: angles, then rates.
+    pub fn values(&self) -> [(T, Param); 6] {
+        [
+            (self.roll_rad, Param::Roll),
+            (self.pitch_rad, Param::Pitch),
+            (self.yaw_rad, Param::Yaw),
+            (self.roll_rate_rad_s, Param::RollRate),
+            (self.pitch_rate_rad_s, Param::PitchRate),
+            (self.yaw_rate_rad_s, Param::YawRate),
+        ]
+    }
+}
+
+/// Everything of one instant: the satellite's inertial state (f64 whatever the backend:
+/// a position in f32 would carry 0.5 m of rounding, 2.5e-6 of a 200 km altitude), the
+/// attitude in the backend's scalar, the ground and the Earth's rate.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EarthGeometry<T> {
+    pub state: StateVector,
+    pub attitude: Attitude<T>,
+    /// Height of the imaged ground above the ellipsoid (m).
+    pub ground_h_m: f64,
+    pub ellipsoid: Ellipsoid,
+    pub earth_rate_rad_s: f64,
+}
+
+impl EarthGeometry<f64> {
+    /// The same geometry with the attitude rounded to another scalar type.
+    pub fn to<T: Real>(&self) -> EarthGeometry<T> {
+        EarthGeometry {
+            state: self.state,
+            attitude: self.attitude.to(),
+            ground_h_m: self.ground_h_m,
+            ellipsoid: self.ellipsoid,
+            earth_rate_rad_s: self.earth_rate_rad_s,
+        }
+    }
+}
+
+/// The ground ellipsoid (semi-axes A = a + h, A, B = b + h) and where the satellite is
+/// relative to it, as [`EarthGeometry::validate`] finds them in f64 with no division and
+/// no square root (both are software routines on the target).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Ground {
+    /// Equatorial semi-axis A = a + h (m).
+    pub eq_m: f64,
+    /// Polar semi-axis B = b + h (m).
+    pub polar_m: f64,
+    /// A - B = a f (m).
+    pub eq_minus_polar_m: f64,
+    /// (x^2 + y^2) B^2 + z^2 A^2 - A^2 B^2 (m^4): A^2 B^2 times the satellite's
+    /// "altitude" |K r|^2 / A^2 - 1, positive outside the ground ellipsoid. Formed in f64
+    /// because it is a difference of nearly equal terms (a factor up to 16 at 200 km).
+    pub outside_m4: f64,
+}
+
+impl Ground {
+    /// kappa^2 - 1, kappa = A/B the stretch of z that makes the ground a sphere of
+    /// radius A: (A - B)(A + B)/B^2, no cancellation.
+    pub fn stretch2_minus_1(&self) -> f64 {
+        self.eq_minus_polar_m * (self.eq_m + self.polar_m) / (self.polar_m * self.polar_m)
+    }
+}
+
+/// Largest |r| accepted (m): beyond the Moon, and no overflow anywhere in f32.
+pub const MAX_POSITION_M: f64 = 1.0e9;
+/// Largest |v| accepted (m/s).
+pub const MAX_VELOCITY_MPS: f64 = 1.0e5;
+/// Largest flattening accepted (the definition allows [0, 1); beyond 0.5 the stretch
+/// kappa^2 exceeds 4 and nothing real is that flat).
+pub const MAX_FLATTENING: f64 = 0.5;
+/// Ground heights accepted: within [-b/2, a] (m, as fractions of the axes).
+pub const MIN_GROUND_H_OVER_B: f64 = -0.5;
+pub const MAX_GROUND_H_OVER_A: f64 = 1.0;
+/// Smallest "altitude" accepted: |K r|^2 / A^2 - 1 (about 2 H / A) at least this (the
+/// sphere model's 1e-9 R, 6 mm on the Earth); below it the satellite is on the ground
+/// for any scalar.
+pub const MIN_ALTITUDE_RATIO: f64 = 2.0e-9;
+/// Largest |r| / (a + h): the sphere model's 16 R altitude limit.
+pub const MAX_RADIUS_RATIO: f64 = 17.0;
+/// Smallest |v1| (m/s) with a finite line period for any pixel pitch of the domain:
+/// below it the motion along the TDI direction is taken as zero.
+pub const MIN_V1_MPS: f64 = 1.0e-30;
+
+fn finite3(x: [f64; 3]) -> bool {
+    x.iter().all(|c| c.is_finite())
+}
+
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+impl EarthCamera {
+    /// Checks the optics and returns the pixel's focal-plane position (p1, p2) (m).
+    pub fn focal_plane_m(&self, n_px: f64) -> Result<(f64, f64), ModelError> {
+        for (x, p) in [
+            (self.focal_m, Param::FocalLength),
+            (self.pixel_m, Param::PixelPitch),
+            (self.p1_m, Param::FocalPlaneP1),
+            (n_px, Param::PixelOffset),
+        ] {
+            if !x.is_finite() {
+                return Err(ModelError::NonFinite(p));
+            }
+        }
+        if !(self.focal_m > 0.0) {
+            return Err(ModelError::InvalidInput(Param::FocalLength));
+        }
+        if !(self.pixel_m > 0.0) {
+            return Err(ModelError::InvalidInput(Param::PixelPitch));
+        }
+        if self.focal_m > domain::MAX_FOCAL_M {
+            return Err(ModelError::OutOfDomain(Param::FocalLength));
+        }
+        if self.pixel_m > domain::MAX_PIXEL_M {
+            return Err(ModelError::OutOfDomain(Param::PixelPitch));
+        }
+        let p2 = n_px * self.pixel_m;
+        let limit = domain::MAX_TAN_FIELD * self.focal_m;
+        if !(self.p1_m.abs() <= limit) {
+            return Err(ModelError::OutOfDomain(Param::FocalPlaneP1));
+        }
+        if !(p2.abs() <= limit) {
+            return Err(ModelError::OutOfDomain(Param::PixelOffset));
+        }
+        Ok((self.p1_m, p2))
+    }
+}
+
+impl<T: Real> EarthGeometry<T> {
+    /// Checks every input against the definition's error table and the model's domain,
+    /// and returns the ground ellipsoid. Every backend calls it first, so the errors agree
+    /// on every backend. The attitude is checked in `T` (no soft-f64 work for it on the
+    /// target).
+    pub fn validate(&self) -> Result<Ground, ModelError> {
+        let (r, v) = (self.state.position_m, self.state.velocity_mps);
+        if !finite3(r) {
+            return Err(ModelError::NonFinite(Param::Position));
+        }
+        if !finite3(v) {
+            return Err(ModelError::NonFinite(Param::Velocity));
+        }
+        for (x, p) in [
+            (self.ground_h_m, Param::GroundHeight),
+            (self.ellipsoid.a_m, Param::SemiMajorAxis),
+            (self.ellipsoid.flattening, Param::Flattening),
+            (self.earth_rate_rad_s, Param::EarthRate),
+        ] {
+            if !x.is_finite() {
+                return Err(ModelError::NonFinite(p));
+            }
+        }
+        for (x, p) in self.attitude.values() {
+            if !x.is_finite() {
+                return Err(ModelError::NonFinite(p));
+            }
+        }
+        let a = self.ellipsoid.a_m;
+        let fl = self.ellipsoid.flattening;
+        if !(a > 0.0) {
+            return Err(ModelError::InvalidInput(Param::SemiMajorAxis));
+        }
+        if !(0.0..1.0).contains(&fl) {
+            return Err(ModelError::InvalidInput(Param::Flattening));
+        }
+        let b = self.ellipsoid.b_m();
+        if !(self.ground_h_m > -b) {
+            return Err(ModelError::InvalidInput(Param::GroundHeight));
+        }
+        let (a_min, a_max) = domain::EARTH_RADIUS_M;
+        if !(a >= a_min && a <= a_max) {
+            return Err(ModelError::OutOfDomain(Param::SemiMajorAxis));
+        }
+        if fl > MAX_FLATTENING {
+            return Err(ModelError::OutOfDomain(Param::Flattening));
+        }
+        if !(self.ground_h_m >= MIN_GROUND_H_OVER_B * b
+            && self.ground_h_m <= MAX_GROUND_H_OVER_A * a)
+        {
+            return Err(ModelError::OutOfDomain(Param::GroundHeight));
+        }
+        if !(self.earth_rate_rad_s.abs() <= domain::MAX_RATE_RAD_S) {
+            return Err(ModelError::OutOfDomain(Param::EarthRate));
+        }
+        let max_angle = T::from_f64(domain::MAX_ANGLE_RAD);
+        let max_rate = T::from_f64(domain::MAX_RATE_RAD_S);
+        for (i, (x, p)) in self.attitude.values().into_iter().enumerate() {
+            let max = if i < 3 { max_angle } else { max_rate };
+            if !(x.abs() <= max) {
+                return Err(ModelError::OutOfDomain(p));
+            }
+        }
+        let r2 = dot(r, r);
+        // Squared bounds: no square root.
+        if !(r2 <= MAX_POSITION_M * MAX_POSITION_M) {
+            return Err(ModelError::OutOfDomain(Param::Position));
+        }
+        if !(dot(v, v) <= MAX_VELOCITY_MPS * MAX_VELOCITY_MPS) {
+            return Err(ModelError::OutOfDomain(Param::Velocity));
+        }
+        let h = [
+            r[1] * v[2] - r[2] * v[1],
+            r[2] * v[0] - r[0] * v[2],
+            r[0] * v[1] - r[1] * v[0],
+        ];
+        if !(r2 > 0.0) || !(dot(h, h) > 0.0) {
+            return Err(ModelError::DegenerateState);
+        }
+        let eq_m = a + self.ground_h_m;
+        let polar_m = b + self.ground_h_m;
+        let (a2, b2) = (eq_m * eq_m, polar_m * polar_m);
+        let ground = Ground {
+            eq_m,
+            polar_m,
+            eq_minus_polar_m: a * fl,
+            outside_m4: (r[0] * r[0] + r[1] * r[1]) * b2 + r[2] * r[2] * a2 - a2 * b2,
+        };
+        if !(ground.outside_m4 > 0.0) {
+            return Err(ModelError::SatelliteNotAboveGround);
+        }
+        let max_r = MAX_RADIUS_RATIO * eq_m;
+        if ground.outside_m4 < MIN_ALTITUDE_RATIO * (a2 * b2) || r2 > max_r * max_r {
+            return Err(ModelError::OutOfDomain(Param::Position));
+        }
+        Ok(ground)
+    }
+}
+
+/// Line period (s) from the image motion: the charge moves along P1, so the line rate
+/// follows v1 (EARTH-MODEL.md, derived outputs), `pixel_m / |v1|`.
+pub fn line_period_s<T: Real>(pixel_m: T, motion: &crate::ImageMotion<T>) -> T {
+    pixel_m / motion.v1_mps.abs()
+}
+
+/// The inertial state of a circular orbit of radius `radius_m` (two-body speed
+/// sqrt(GM/r)), inclination `inclination_rad`, at argument of latitude `arg_latitude_rad`
+/// from the ascending node, the node on +x. With it the real-Earth model reduces to the
+/// round-Earth [`crate::Geometry`] of the same i0 and gamma0.
+pub fn circular_state(radius_m: f64, inclination_rad: f64, arg_latitude_rad: f64) -> StateVector {
+    let (si, ci) = libm::sincos(inclination_rad);
+    let (su, cu) = libm::sincos(arg_latitude_rad);
+    let speed = libm::sqrt(crate::model::GM_M3_S2 / radius_m);
+    StateVector {
+        position_m: [radius_m * cu, radius_m * su * ci, radius_m * su * si],
+        velocity_mps: [-speed * su, speed * cu * ci, speed * cu * si],
+    }
+}
+
+/// The real-Earth geometry that is exactly the round-Earth `g`: a sphere of radius R
+/// (flattening 0), ground height 0, the circular orbit of radius R + H, the roll, no
+/// pitch, yaw or rates. (`g`'s orbit rate must be the circular one, as
+/// [`crate::Geometry::circular`] makes it.)
+pub fn from_sphere(g: &crate::Geometry<f64>) -> EarthGeometry<f64> {
+    EarthGeometry {
+        state: circular_state(
+            g.earth_radius_m + g.altitude_m,
+            g.inclination_rad,
+            g.arg_latitude_rad,
+        ),
+        attitude: Attitude {
+            roll_rad: g.roll_rad,
+            ..Attitude::default()
+        },
+        ground_h_m: 0.0,
+        ellipsoid: Ellipsoid {
+            a_m: g.earth_radius_m,
+            flattening: 0.0,
+        },
+        earth_rate_rad_s: g.earth_rate_rad_s,
+    }
+}
+
+/// Angular distance (rad) from a pixel's line of sight to the limb, positive when the
+/// ray meets the ground: L - eta in the coordinates where the ground ellipsoid is the
+/// sphere of radius A (z stretched by kappa = A/B), eta the angle between the ray and
+/// the nadir there, L = asin(A/|K r|). The stretch changes angles by at most
+/// kappa - 1 (3.4e-3 for WGS 84), so this is the true margin to within 0.4 %: enough to
+/// sort cases into limb bands. Host tools and tests only (f64, libm).
+#[cfg(feature = "reference")]
+pub fn limb_margin_rad(
+    g: &EarthGeometry<f64>,
+    camera: &EarthCamera,
+    n_px: f64,
+) -> Result<f64, ModelError> {
+    let ground = g.validate()?;
+    let (p1, p2) = camera.focal_plane_m(n_px)?;
+    let pixel = reference::EarthReference::line_of_sight(g, p1, p2, camera.focal_m);
+    let kappa = ground.eq_m / ground.polar_m;
+    let r = g.state.position_m;
+    let rs = [r[0], r[1], r[2] * kappa];
+    let ds = [pixel[0], pixel[1], pixel[2] * kappa];
+    let rn = libm::sqrt(dot(rs, rs));
+    // Angle between -r' and d' by atan2 (accurate at every angle).
+    let cr = [
+        rs[1] * ds[2] - rs[2] * ds[1],
+        rs[2] * ds[0] - rs[0] * ds[2],
+        rs[0] * ds[1] - rs[1] * ds[0],
+    ];
+    let eta = libm::atan2(libm::sqrt(dot(cr, cr)), -dot(rs, ds));
+    let limb = libm::asin(ground.eq_m / rn);
+    Ok(limb - eta)
+}
