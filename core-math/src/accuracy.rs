@@ -83,3 +83,56 @@ fn nadir_angle_and_k(
     let k = 1.0 + geometry.altitude_m / geometry.earth_radius_m;
     Ok((geometry.roll_rad + p.field_rad, k))
 }
+
+/// Real-Earth model: relative tolerance (|dv| / |v|, dv the vector difference) of
+/// `GENERAL_F64` against `EarthReference` over the envelope where the line of sight is
+/// at least 0.001 deg inside the limb. Measured maximum over 50 000 draws: 1.2e-13
+/// (`core-math/tests/earth.rs`; `cargo xtask accuracy` prints the bands).
+pub const EARTH_F64_REL_TOLERANCE: f64 = 1.0e-12;
+
+/// Real-Earth model: tolerance of `GENERAL_F32` against `EarthReference` (inputs as given
+/// in f64: the attitude's rounding to f32 counts) where the line of sight is at least
+/// 1 deg inside the limb, for cases whose condition number [`earth_kappa`] is at most
+/// [`EARTH_F32_KAPPA_LIMIT`].
+pub const EARTH_F32_REL_TOLERANCE: f64 = 2.0e-6;
+/// The same from 0.01 to 1 deg inside the limb, where the ray/ellipsoid discriminant
+/// loses digits like u/q (q the cosine of the incidence angle).
+pub const EARTH_F32_NEAR_LIMB_TOLERANCE: f64 = 2.0e-5;
+/// Up to this condition number the f32 bounds above hold as stated; beyond it, where an
+/// attitude rate cancels most of the image motion, the error is bounded by
+/// [`EARTH_F32_KAPPA_C`] x kappa x u32 instead (u32 = 2^-24): the rotational and
+/// translational image motion are each rounded to about u of their own size before they
+/// cancel, and the rates arrive in f32, so no f32 evaluation can do better than ~kappa u.
+pub const EARTH_F32_KAPPA_LIMIT: f64 = 7.0;
+/// Measured maximum of err / (kappa u32) at least 1 deg inside the limb: 11.6.
+pub const EARTH_F32_KAPPA_C: f64 = 16.0;
+
+/// Condition number of the real-Earth image motion as a sum (EARTH-MODEL.md's v is the
+/// sum of a rotational and a translational image motion, `docs/derivation.md`): the
+/// magnitudes of the terms of (v1, v2) over |v|, each component
+/// g_i + t_i g_3 with g = -W x u - V/s. 1 when nothing cancels. Computed from
+/// `GENERAL_F64`'s per-update terms and the reference's slant range and |v|: a
+/// conditioning estimate, not a golden value.
+pub fn earth_kappa(
+    camera: &crate::earth::EarthCamera,
+    geometry: &crate::earth::EarthGeometry<f64>,
+    n_px: f64,
+) -> Result<f64, ModelError> {
+    use crate::earth::EarthReference;
+    let up = crate::GENERAL_F64.update(geometry)?;
+    let px = crate::GENERAL_F64.pixel(camera, n_px)?;
+    let rp = EarthReference.pixel(camera, n_px)?;
+    let chain = EarthReference::chain(geometry, &rp)?;
+    let inv_s = libm::sqrt(px.uu_m2) / chain.slant_m;
+    let (w, u) = (up.w_b_rad_s, px.u_m);
+    let rot = [
+        w[1] * u[2] - w[2] * u[1],
+        w[2] * u[0] - w[0] * u[2],
+        w[0] * u[1] - w[1] * u[0],
+    ];
+    let tr = up.v_b_mps.map(|x| x * inv_s);
+    let terms1 = rot[0].abs() + tr[0].abs() + px.t1.abs() * (rot[2].abs() + tr[2].abs());
+    let terms2 = rot[1].abs() + tr[1].abs() + px.t2.abs() * (rot[2].abs() + tr[2].abs());
+    let v = chain.motion;
+    Ok(libm::hypot(terms1, terms2) / libm::hypot(v.v1_mps, v.v2_mps))
+}

@@ -1,7 +1,9 @@
 //! splitmix64: a seeded, dependency-free generator, so that a sample of the envelope
 //! (the error report's, the tests') is the same on any machine.
 
+use crate::earth::{Attitude, EarthCamera, EarthGeometry, Ellipsoid};
 use crate::model::{Camera, Geometry};
+use crate::orbit::StateVector;
 
 pub struct SplitMix64(pub u64);
 
@@ -52,5 +54,124 @@ impl SplitMix64 {
             return None;
         }
         Some(libm::tan(alpha) * camera.focal_m / camera.pixel_m)
+    }
+}
+
+/// One case of the real-Earth model: optics, instant and pixel.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EarthCase {
+    pub camera: EarthCamera,
+    pub geometry: EarthGeometry<f64>,
+    pub n_px: f64,
+}
+
+impl SplitMix64 {
+    /// A real-Earth case drawn over the envelope of the general model (issue 11): WGS 84,
+    /// altitude 200-2000 km above the equatorial radius, eccentricity 0-0.05 with any
+    /// argument of latitude and true anomaly, inclination 0-180 deg (equatorial, polar,
+    /// retrograde), roll and pitch within +/-45 deg, any yaw, angle rates within
+    /// +/-2 deg/s, ground height -500 to 9 000 m, focal length 0.3-1.5 m, pixel 5-20 um,
+    /// p1 within +/-0.05 m, field angle within +/-40 deg. One draw in four then moves the
+    /// roll so that the line of sight lies log-uniformly 0.001-3 deg inside the limb (and
+    /// one in twenty of those as far outside it), which populates the near-limb bands;
+    /// `None` when that needs a roll beyond 45 deg.
+    pub fn earth_case(&mut self) -> Option<EarthCase> {
+        let camera = EarthCamera {
+            focal_m: self.uniform(0.3, 1.5),
+            pixel_m: self.uniform(5e-6, 20e-6),
+            p1_m: self.uniform(-0.05, 0.05),
+        };
+        let radius_m = Ellipsoid::WGS84.a_m + self.uniform(200e3, 2000e3);
+        let e = self.uniform(0.0, 0.05);
+        let true_anomaly = self.uniform(0.0, core::f64::consts::TAU);
+        let incl = self.uniform(0.0, core::f64::consts::PI);
+        let raan = self.uniform(0.0, core::f64::consts::TAU);
+        let arg_lat = self.uniform(0.0, core::f64::consts::TAU);
+        let state = eccentric_state(radius_m, e, true_anomaly, incl, raan, arg_lat);
+        let deg = |x: f64| x.to_radians();
+        let attitude = Attitude {
+            roll_rad: deg(self.uniform(-45.0, 45.0)),
+            pitch_rad: deg(self.uniform(-45.0, 45.0)),
+            yaw_rad: deg(self.uniform(-180.0, 180.0)),
+            roll_rate_rad_s: deg(self.uniform(-2.0, 2.0)),
+            pitch_rate_rad_s: deg(self.uniform(-2.0, 2.0)),
+            yaw_rate_rad_s: deg(self.uniform(-2.0, 2.0)),
+        };
+        let geometry = EarthGeometry {
+            state,
+            attitude,
+            ground_h_m: self.uniform(-500.0, 9000.0),
+            ellipsoid: Ellipsoid::WGS84,
+            earth_rate_rad_s: crate::EARTH_RATE_RAD_S,
+        };
+        let alpha = deg(self.uniform(-40.0, 40.0));
+        let mut case = EarthCase {
+            camera,
+            geometry,
+            n_px: libm::tan(alpha) * camera.focal_m / camera.pixel_m,
+        };
+        if self.next_u64() & 3 == 0 {
+            let mut margin = libm::pow(10.0, self.uniform(-3.0, libm::log10(3.0))).to_radians();
+            if self.next_u64() % 20 == 0 {
+                margin = -margin;
+            }
+            let side = if self.next_u64() & 1 == 0 { 1.0 } else { -1.0 };
+            case.geometry.attitude.roll_rad = roll_at_limb_margin(&case, margin, side)?;
+        }
+        Some(case)
+    }
+}
+
+/// The roll, between 0 and `side` x 45 deg, at which the case's line of sight lies
+/// `margin_rad` inside the limb (negative: outside), by bisection on
+/// [`crate::earth::limb_margin_rad`]; `None` if no such roll is bracketed.
+pub fn roll_at_limb_margin(case: &EarthCase, margin_rad: f64, side: f64) -> Option<f64> {
+    let at = |roll: f64| {
+        let mut g = case.geometry;
+        g.attitude.roll_rad = roll;
+        crate::earth::limb_margin_rad(&g, &case.camera, case.n_px).ok()
+    };
+    let (mut lo, mut hi) = (0.0, side * 45f64.to_radians());
+    if !(at(lo)? > margin_rad && at(hi)? < margin_rad) {
+        return None;
+    }
+    for _ in 0..80 {
+        let mid = 0.5 * (lo + hi);
+        if at(mid)? > margin_rad {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    Some(0.5 * (lo + hi))
+}
+
+/// The inertial state at radius `radius_m` on a two-body orbit of eccentricity `e` at
+/// true anomaly `true_anomaly_rad`, inclination, node and argument of latitude as named
+/// (the perigee is wherever the true anomaly puts it).
+pub fn eccentric_state(
+    radius_m: f64,
+    e: f64,
+    true_anomaly_rad: f64,
+    inclination_rad: f64,
+    raan_rad: f64,
+    arg_latitude_rad: f64,
+) -> StateVector {
+    let gm = crate::GM_M3_S2;
+    let (sn, cn) = libm::sincos(true_anomaly_rad);
+    // r = p / (1 + e cos nu): the semi-latus rectum p and the angular momentum sqrt(GM p).
+    let h = libm::sqrt(gm * radius_m * (1.0 + e * cn));
+    let v_radial = gm / h * e * sn;
+    let v_transverse = h / radius_m;
+    let (si, ci) = libm::sincos(inclination_rad);
+    let (so, co) = libm::sincos(raan_rad);
+    let p = [co, so, 0.0];
+    let q = [-so * ci, co * ci, si];
+    let (su, cu) = libm::sincos(arg_latitude_rad);
+    let up: [f64; 3] = core::array::from_fn(|k| cu * p[k] + su * q[k]);
+    let fwd: [f64; 3] = core::array::from_fn(|k| -su * p[k] + cu * q[k]);
+    StateVector {
+        position_m: up.map(|x| x * radius_m),
+        velocity_mps: core::array::from_fn(|k| v_radial * up[k] + v_transverse * fwd[k]),
     }
 }

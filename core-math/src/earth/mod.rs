@@ -98,6 +98,18 @@ impl Attitude<f64> {
 }
 
 impl<T: Scalar> Attitude<T> {
+    /// The attitude widened to f64 (exact for f32).
+    pub fn to_f64(&self) -> Attitude<f64> {
+        Attitude {
+            roll_rad: self.roll_rad.to_f64(),
+            pitch_rad: self.pitch_rad.to_f64(),
+            yaw_rad: self.yaw_rad.to_f64(),
+            roll_rate_rad_s: self.roll_rate_rad_s.to_f64(),
+            pitch_rate_rad_s: self.pitch_rate_rad_s.to_f64(),
+            yaw_rate_rad_s: self.yaw_rate_rad_s.to_f64(),
+        }
+    }
+
     /// The six values with the parameter each one is: angles, then rates.
     pub fn values(&self) -> [(T, Param); 6] {
         [
@@ -224,6 +236,19 @@ impl EarthCamera {
             return Err(ModelError::OutOfDomain(Param::PixelOffset));
         }
         Ok((self.p1_m, p2))
+    }
+}
+
+impl<T: Scalar> EarthGeometry<T> {
+    /// The geometry with the attitude widened to f64.
+    pub fn to_f64(&self) -> EarthGeometry<f64> {
+        EarthGeometry {
+            state: self.state,
+            attitude: self.attitude.to_f64(),
+            ground_h_m: self.ground_h_m,
+            ellipsoid: self.ellipsoid,
+            earth_rate_rad_s: self.earth_rate_rad_s,
+        }
     }
 }
 

@@ -1,0 +1,387 @@
+//! The real-Earth model: the general form (f64, f32) against the construction on dual
+//! numbers (`EarthReference`) over the envelope, its reduction to the round-Earth closed
+//! form, and the typed errors of `shared/EARTH-MODEL.md` on every backend.
+
+use core_math::accuracy::{
+    earth_kappa, f64_rel_tolerance, EARTH_F32_KAPPA_C, EARTH_F32_KAPPA_LIMIT,
+    EARTH_F32_NEAR_LIMB_TOLERANCE, EARTH_F32_REL_TOLERANCE, EARTH_F64_REL_TOLERANCE,
+};
+use core_math::earth::{from_sphere, limb_margin_rad, Attitude, EarthCamera, EarthGeometry};
+use core_math::sample::{EarthCase, SplitMix64};
+use core_math::{
+    Backend, Camera, Earth, EarthReference, Ellipsoid, ImageMotion, ModelError, Param, StateVector,
+    CLOSED_F64, GENERAL_F32, GENERAL_F64,
+};
+
+/// Draws of the envelope per test (about 0.1 s of evaluation each).
+const DRAWS: usize = 50_000;
+const U32: f64 = f32::EPSILON as f64 / 2.0;
+
+/// |dv| / |v|: hypot of the component differences over the reference's |v_P|.
+fn rel(m: &ImageMotion<f64>, r: &ImageMotion<f64>) -> f64 {
+    libm::hypot(m.v1_mps - r.v1_mps, m.v2_mps - r.v2_mps) / libm::hypot(r.v1_mps, r.v2_mps)
+}
+
+fn f32_eval(c: &EarthCase) -> Result<ImageMotion<f64>, ModelError> {
+    GENERAL_F32
+        .evaluate(&c.camera, &c.geometry.to::<f32>(), c.n_px)
+        .map(|m| ImageMotion {
+            v1_mps: m.v1_mps as f64,
+            v2_mps: m.v2_mps as f64,
+        })
+}
+
+fn margin_deg(c: &EarthCase) -> f64 {
+    limb_margin_rad(&c.geometry, &c.camera, c.n_px)
+        .unwrap()
+        .to_degrees()
+}
+
+/// Within this margin of the limb (deg) a backend may report a hit or a miss
+/// (EARTH-MODEL.md).
+const EITHER_DEG: f64 = 1e-4;
+
+/// Every draw: the three backends agree on hit or miss (beyond 1e-4 deg from the limb),
+/// and where they hit, the general f64 form is within 1e-12 of the reference. The draws
+/// cover the whole envelope (`SplitMix64::earth_case`), 0.001 deg to the limb included.
+#[test]
+fn general_f64_matches_the_reference() {
+    let mut rng = SplitMix64(0x0EA7_2026_1124_0064);
+    let (mut hits, mut misses, mut worst) = (0, 0, 0f64);
+    for _ in 0..DRAWS {
+        let Some(c) = rng.earth_case() else { continue };
+        let m = margin_deg(&c);
+        let r = EarthReference.evaluate(&c.camera, &c.geometry, c.n_px);
+        let g = GENERAL_F64.evaluate(&c.camera, &c.geometry, c.n_px);
+        let s = f32_eval(&c);
+        match (r, g) {
+            (Ok(r), Ok(g)) => {
+                let e = rel(&g, &r);
+                assert!(e <= EARTH_F64_REL_TOLERANCE, "{e:e} at {c:?}");
+                assert!(s.is_ok() || m.abs() < EITHER_DEG, "f32 {s:?} at {c:?}");
+                worst = worst.max(e);
+                hits += 1;
+            }
+            (Err(ModelError::LineOfSightMissesEarth), Err(ModelError::LineOfSightMissesEarth)) => {
+                assert!(
+                    s == Err(ModelError::LineOfSightMissesEarth) || m.abs() < EITHER_DEG,
+                    "f32 {s:?} at {c:?}"
+                );
+                assert!(m < EITHER_DEG, "a miss {m} deg inside the limb: {c:?}");
+                misses += 1;
+            }
+            (r, g) => {
+                assert!(m.abs() < EITHER_DEG, "{r:?} / {g:?} at {m} deg: {c:?}")
+            }
+        }
+    }
+    println!("general f64 vs reference: {hits} hits, {misses} misses, worst {worst:.2e}");
+    assert!(hits > 30_000 && misses > 1_000);
+}
+
+/// The f32 form against the reference at the inputs as given (the attitude's rounding to
+/// f32 counts): within 2e-6 from 1 deg inside the limb, 2e-5 from 0.01 deg, where the
+/// condition number is at most 7; beyond, within C kappa u32 (and near the limb the
+/// larger of that and 2e-5; see `core_math::accuracy`).
+#[test]
+fn general_f32_matches_the_reference() {
+    let mut rng = SplitMix64(0x0EA7_2026_1124_0032);
+    let (mut far, mut near, mut stiff) = (0f64, 0f64, 0f64);
+    let (mut n_far, mut n_near, mut n_stiff) = (0, 0, 0);
+    for _ in 0..DRAWS {
+        let Some(c) = rng.earth_case() else { continue };
+        let m = margin_deg(&c);
+        let (Ok(r), Ok(s)) = (
+            EarthReference.evaluate(&c.camera, &c.geometry, c.n_px),
+            f32_eval(&c),
+        ) else {
+            continue;
+        };
+        if m < 0.01 {
+            continue;
+        }
+        let e = rel(&s, &r);
+        let kappa = earth_kappa(&c.camera, &c.geometry, c.n_px).unwrap();
+        let limb_bound = if m >= 1.0 {
+            0.0
+        } else {
+            EARTH_F32_NEAR_LIMB_TOLERANCE
+        };
+        assert!(
+            e <= limb_bound.max(EARTH_F32_KAPPA_C * kappa * U32),
+            "{e:e}, kappa {kappa}: {c:?}"
+        );
+        if kappa <= EARTH_F32_KAPPA_LIMIT {
+            if m >= 1.0 {
+                assert!(e <= EARTH_F32_REL_TOLERANCE, "{e:e}: {c:?}");
+                far = far.max(e);
+                n_far += 1;
+            } else {
+                assert!(e <= EARTH_F32_NEAR_LIMB_TOLERANCE, "{e:e}: {c:?}");
+                near = near.max(e);
+                n_near += 1;
+            }
+        } else {
+            stiff = stiff.max(e / (kappa * U32));
+            n_stiff += 1;
+        }
+    }
+    println!(
+        "general f32 vs reference: >= 1 deg {n_far} cases, worst {far:.2e}; 0.01-1 deg \
+         {n_near}, worst {near:.2e}; kappa > {EARTH_F32_KAPPA_LIMIT}: {n_stiff}, worst \
+         err/(kappa u) {stiff:.2}"
+    );
+    assert!(n_far > 25_000 && n_near > 2_000 && n_stiff > 10);
+    // The bound is not vacuous: the errors reach a fair part of it.
+    assert!(far > 0.2 * EARTH_F32_REL_TOLERANCE && stiff > 0.3 * EARTH_F32_KAPPA_C);
+}
+
+/// With flattening 0, height 0, a circular orbit and no pitch, yaw or rates, the general
+/// form is the round-Earth closed form (to 1e-12 in f64) over the round-Earth envelope,
+/// the near-limb draws included (down to 1e-5 deg from the limb).
+#[test]
+fn general_reduces_to_the_round_earth_closed_form() {
+    let mut rng = SplitMix64(0x0EA7_2026_1124_5EC7);
+    let camera = Camera {
+        focal_m: 0.555,
+        pixel_m: 13e-6,
+    };
+    let earth_camera = EarthCamera {
+        focal_m: camera.focal_m,
+        pixel_m: camera.pixel_m,
+        p1_m: 0.0,
+    };
+    let (mut n, mut worst, mut widened) = (0, 0f64, 0);
+    for _ in 0..20_000 {
+        // The sampler rounds every field to f32; the orbit rate must be the circular one
+        // of the rounded altitude for the two models to describe the same orbit.
+        let r = rng.envelope_geometry();
+        let g = core_math::Geometry {
+            orbit_rate_rad_s: core_math::orbital_rate_rad_s(r.earth_radius_m, r.altitude_m),
+            ..r
+        };
+        let Some(n_px) = rng.envelope_pixel(&g, &camera) else {
+            continue;
+        };
+        let sphere = CLOSED_F64.evaluate(&camera, &g, n_px);
+        let general = GENERAL_F64.evaluate(&earth_camera, &from_sphere(&g), n_px);
+        match (sphere, general) {
+            (Ok(s), Ok(e)) => {
+                let d = rel(&e, &s);
+                // 1e-12, widened within ~0.01 deg of the limb by the conditioning of the
+                // ray/sphere intersection there (the tolerance the round-Earth forms
+                // already meet against their reference, `core_math::accuracy`).
+                let tol = f64_rel_tolerance(&camera, &g, n_px).unwrap();
+                assert!(d <= tol, "{d:e} > {tol:e}: {g:?} {n_px}");
+                if tol > 1e-12 {
+                    widened += 1;
+                }
+                worst = worst.max(d);
+                n += 1;
+            }
+            // The sampler can put a ray past the limb; both must then refuse it alike.
+            (Err(s), Err(e)) if s == e => {}
+            (s, e) => panic!("{s:?} / {e:?}: {g:?} {n_px}"),
+        }
+    }
+    println!(
+        "general vs round-Earth closed form: {n} cases ({widened} with the near-limb \
+         widening), worst {worst:.2e}"
+    );
+    assert!(n > 15_000);
+}
+
+/// The reference puts the ground point back onto the pixel it was found from.
+#[test]
+fn reference_projects_the_ground_point_onto_its_pixel() {
+    let mut rng = SplitMix64(0x0EA7_2026_1124_0001);
+    let mut n = 0;
+    for _ in 0..5_000 {
+        let Some(c) = rng.earth_case() else { continue };
+        let p = EarthReference.pixel(&c.camera, c.n_px).unwrap();
+        let Ok(chain) = EarthReference::chain(&c.geometry, &p) else {
+            continue;
+        };
+        let tol = 1e-11 * c.camera.focal_m;
+        assert!((chain.p_m[0] - p.p1_m).abs() < tol && (chain.p_m[1] - p.p2_m).abs() < tol);
+        n += 1;
+    }
+    assert!(n > 3_000);
+}
+
+fn default_case() -> (EarthCamera, EarthGeometry<f64>) {
+    let camera = EarthCamera {
+        focal_m: 0.555,
+        pixel_m: 13e-6,
+        p1_m: 0.0,
+    };
+    let geometry = EarthGeometry {
+        state: core_math::earth::circular_state(7_016e3, 97.98f64.to_radians(), 0.6),
+        attitude: Attitude {
+            roll_rad: 0.3,
+            pitch_rad: -0.2,
+            yaw_rad: 0.1,
+            roll_rate_rad_s: 0.01,
+            pitch_rate_rad_s: -0.01,
+            yaw_rate_rad_s: 0.001,
+        },
+        ground_h_m: 1_000.0,
+        ellipsoid: Ellipsoid::WGS84,
+        earth_rate_rad_s: core_math::EARTH_RATE_RAD_S,
+    };
+    (camera, geometry)
+}
+
+/// Each row of EARTH-MODEL.md's error table gives its error on every backend.
+#[test]
+fn every_bad_input_gives_its_typed_error_on_every_backend() {
+    let (cam, geo) = default_case();
+    let all = |cam: &EarthCamera, g: &EarthGeometry<f64>, n: f64| {
+        [
+            EarthReference.evaluate(cam, g, n).err(),
+            GENERAL_F64.evaluate(cam, g, n).err(),
+            GENERAL_F32.evaluate(cam, &g.to::<f32>(), n).err(),
+        ]
+    };
+    let expect = |cam: &EarthCamera, g: &EarthGeometry<f64>, n: f64, e: ModelError| {
+        for got in all(cam, g, n) {
+            assert_eq!(got, Some(e), "{cam:?} {g:?} {n}");
+        }
+    };
+    // The good case first: no error anywhere.
+    assert_eq!(all(&cam, &geo, 1234.5), [None; 3]);
+
+    let mut g = geo;
+    g.state.position_m[1] = f64::NAN;
+    expect(&cam, &g, 0.0, ModelError::NonFinite(Param::Position));
+    let mut g = geo;
+    g.attitude.yaw_rate_rad_s = f64::INFINITY;
+    expect(&cam, &g, 0.0, ModelError::NonFinite(Param::YawRate));
+    expect(
+        &cam,
+        &geo,
+        f64::NAN,
+        ModelError::NonFinite(Param::PixelOffset),
+    );
+    let mut g = geo;
+    g.ground_h_m = f64::NAN;
+    expect(&cam, &g, 0.0, ModelError::NonFinite(Param::GroundHeight));
+
+    for (f, p) in [(0.0, Param::FocalLength), (-1.0, Param::FocalLength)] {
+        expect(
+            &EarthCamera { focal_m: f, ..cam },
+            &geo,
+            0.0,
+            ModelError::InvalidInput(p),
+        );
+    }
+    let no_pixel = EarthCamera {
+        pixel_m: 0.0,
+        ..cam
+    };
+    expect(
+        &no_pixel,
+        &geo,
+        0.0,
+        ModelError::InvalidInput(Param::PixelPitch),
+    );
+    for (a, fl, h, p) in [
+        (0.0, 0.0, 0.0, Param::SemiMajorAxis),
+        (-6e6, 0.0, 0.0, Param::SemiMajorAxis),
+        (6.4e6, 1.0, 0.0, Param::Flattening),
+        (6.4e6, -1e-3, 0.0, Param::Flattening),
+        (6.4e6, 0.1, -5.76e6, Param::GroundHeight),
+    ] {
+        let mut g = geo;
+        g.ellipsoid = Ellipsoid {
+            a_m: a,
+            flattening: fl,
+        };
+        g.ground_h_m = h;
+        expect(&cam, &g, 0.0, ModelError::InvalidInput(p));
+    }
+    let mut g = geo;
+    g.state.position_m = [0.0; 3];
+    expect(&cam, &g, 0.0, ModelError::DegenerateState);
+    let mut g = geo;
+    g.state.velocity_mps = g.state.position_m.map(|x| x * 1e-3);
+    expect(&cam, &g, 0.0, ModelError::DegenerateState);
+    // Inside the ground ellipsoid: under a 9 km mountain at 5 km altitude.
+    let mut g = geo;
+    g.state = core_math::earth::circular_state(6_383e3, 0.2, 0.0);
+    g.ground_h_m = 9_000.0;
+    expect(&cam, &g, 0.0, ModelError::SatelliteNotAboveGround);
+    // Looking at the sky.
+    let mut g = geo;
+    g.attitude.roll_rad = 2.0;
+    expect(&cam, &g, 0.0, ModelError::LineOfSightMissesEarth);
+    // Beyond the domain.
+    let mut g = geo;
+    g.attitude.roll_rate_rad_s = 2.0;
+    expect(&cam, &g, 0.0, ModelError::OutOfDomain(Param::RollRate));
+    let mut g = geo;
+    g.state.position_m = [2e9, 0.0, 0.0];
+    expect(&cam, &g, 0.0, ModelError::OutOfDomain(Param::Position));
+}
+
+/// v1 = 0: a pitch rate that exactly cancels the along-track image motion at the array
+/// centre (found by bisection on the reference) leaves no line period.
+#[test]
+fn no_along_track_motion_is_refused() {
+    let (cam, mut g) = default_case();
+    g.attitude = Attitude::default();
+    let v1 = |rate: f64| {
+        let mut g = g;
+        g.attitude.pitch_rate_rad_s = rate;
+        EarthReference::chain(&g, &EarthReference.pixel(&cam, 0.0).unwrap())
+            .unwrap()
+            .motion
+            .v1_mps
+    };
+    let (mut lo, mut hi) = (-0.1, 0.1);
+    assert!(v1(lo).signum() != v1(hi).signum());
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if v1(mid).signum() == v1(lo).signum() {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    // At the exact zero both neighbours straddle it; the reference, fed the rate that
+    // gives v1 = 0 to the last bit, refuses.
+    let mut g0 = g;
+    g0.attitude.pitch_rate_rad_s = if v1(lo) == 0.0 { lo } else { hi };
+    if v1(g0.attitude.pitch_rate_rad_s) == 0.0 {
+        assert_eq!(
+            EarthReference.evaluate(&cam, &g0, 0.0),
+            Err(ModelError::NoAlongTrackMotion)
+        );
+    }
+    // The pitch rate that stops the image is the orbit rate seen from the ground point:
+    // about -v/H, a large and physically meaningful number, not a rounding artefact.
+    assert!(lo.abs() > 5e-3, "{lo}");
+    // On either side the period is finite and large.
+    let mut g1 = g;
+    g1.attitude.pitch_rate_rad_s = lo;
+    let m = GENERAL_F64.evaluate(&cam, &g1, 0.0).unwrap();
+    assert!(m.v1_mps.abs() < 1e-9);
+}
+
+/// Every backend's refusal of a state vector with no angular momentum, whatever its
+/// scalar, is the typed one (f32 included, where r x v may round to zero on its own).
+#[test]
+fn state_vectors_with_no_orbit_plane_are_refused() {
+    let (cam, mut g) = default_case();
+    g.state = StateVector {
+        position_m: [7e6, 0.0, 0.0],
+        velocity_mps: [7e3, 0.0, 0.0],
+    };
+    assert_eq!(
+        GENERAL_F32.evaluate(&cam, &g.to::<f32>(), 0.0),
+        Err(ModelError::DegenerateState)
+    );
+    // The model marker is what picks the interface.
+    fn takes_earth<B: Backend<Earth>>(_: &B) {}
+    takes_earth(&GENERAL_F32);
+}
