@@ -85,6 +85,11 @@ impl Real for MicroF32 {
     fn from_u32(n: u32) -> Self {
         MicroF32(<f32 as Real>::from_u32(n))
     }
+    /// micromath's atan (2.8e-3, EMBEDDED-NOTES.md), consistent with the variant.
+    #[inline(always)]
+    fn atan(self) -> Self {
+        MicroF32(F32Ext::atan(self.0))
+    }
     #[inline(always)]
     fn small_sin_cos(x: Self) -> (Self, Self) {
         let (s, c) = <f32 as Real>::small_sin_cos(x.0);

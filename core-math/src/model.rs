@@ -226,6 +226,12 @@ impl<T: Real> ImageMotion<T> {
     pub fn speed_mps(&self) -> T {
         (self.v1_mps * self.v1_mps + self.v2_mps * self.v2_mps).sqrt()
     }
+
+    /// The drift angle atan(v2/v1) between the image motion and the TDI transfer
+    /// direction (rad; EARTH-MODEL.md, derived outputs). Callers ensure v1 != 0.
+    pub fn drift_rad(&self) -> T {
+        (self.v2_mps / self.v1_mps).atan()
+    }
 }
 
 /// What a model is evaluated on: the optics fixed at boot and the geometry of one instant.

@@ -40,6 +40,9 @@ pub trait Real:
     /// Conversion to u32, saturating at 0 and `u32::MAX` (NaN gives 0), as Rust's `as`.
     fn to_u32(self) -> u32;
     fn from_u32(n: u32) -> Self;
+    /// atan(x) (f32: libm's `atanf`, pure f32, 0.85 ulp; used once per segment, never
+    /// per pixel).
+    fn atan(self) -> Self;
     /// (sin x, cos x) for |x| <= 0.15 by truncated Taylor series, to this type's
     /// precision: no call, a handful of multiply-adds. Used per pixel near the limb.
     fn small_sin_cos(x: Self) -> (Self, Self);
@@ -94,6 +97,10 @@ impl Real for f64 {
     fn from_u32(n: u32) -> Self {
         n as f64
     }
+    #[inline(always)]
+    fn atan(self) -> Self {
+        libm::atan(self)
+    }
     /// Terms to x^9 and x^10: the first omitted ones are below 1.2e-17 x and 2.7e-19.
     #[inline(always)]
     fn small_sin_cos(x: Self) -> (Self, Self) {
@@ -140,6 +147,10 @@ impl Real for f32 {
     #[inline(always)]
     fn from_u32(n: u32) -> Self {
         n as f32
+    }
+    #[inline(always)]
+    fn atan(self) -> Self {
+        libm::atanf(self)
     }
     /// Terms to x^5 and x^4: the first omitted ones are below 3.5e-10 x and 1.6e-8,
     /// both under f32's unit roundoff (6e-8) relative to the results.

@@ -1,5 +1,9 @@
-//! `cargo xtask eval --backend <reference|f64|f32|fixed> --input CASES.csv`: the model on
-//! user-supplied cases, CSV out, so the firmware's numbers can be checked on the ground.
+//! `cargo xtask eval [--model <sphere|earth>] --backend <...> --input CASES.csv`: a model
+//! on user-supplied cases, CSV out, so the firmware's numbers can be checked on the
+//! ground. `sphere` (the default) is the paper's round Earth; `earth` the real-Earth
+//! model of `shared/EARTH-MODEL.md` (`eval/earth.rs`).
+
+mod earth;
 
 use core_math::fixed_point::{geometry_from_f64, motion_to_f64};
 use core_math::{
@@ -25,22 +29,34 @@ pub const OUTPUT_COLUMNS: [&str; 5] = ["v1_mps", "v2_mps", "v_mps", "line_period
 pub fn run(args: &[String]) -> Result<(), String> {
     let mut backend = None;
     let mut input = None;
+    let mut model = "sphere".to_string();
     let mut it = args.iter();
     while let Some(a) = it.next() {
         match a.as_str() {
             "--backend" => backend = it.next().cloned(),
             "--input" => input = it.next().cloned(),
+            "--model" => model = it.next().cloned().unwrap_or_default(),
             other => return Err(format!("eval: unknown argument `{other}`")),
         }
     }
-    let backend = backend.ok_or("eval: --backend <reference|f64|f32|fixed> is required")?;
+    let backends = match model.as_str() {
+        "sphere" => "reference|f64|f32|fixed",
+        "earth" => earth::BACKENDS,
+        other => return Err(format!("eval: unknown model `{other}` (sphere|earth)")),
+    };
+    let backend = backend.ok_or(format!("eval: --backend <{backends}> is required"))?;
     let input = input.ok_or("eval: --input CASES.csv is required")?;
     let text = if input == "-" {
         std::io::read_to_string(std::io::stdin()).map_err(|e| format!("reading stdin: {e}"))?
     } else {
         std::fs::read_to_string(&input).map_err(|e| format!("reading {input}: {e}"))?
     };
-    print!("{}", eval_csv(&backend, &text)?);
+    let out = if model == "earth" {
+        earth::eval_csv(&backend, &text)?
+    } else {
+        eval_csv(&backend, &text)?
+    };
+    print!("{out}");
     Ok(())
 }
 

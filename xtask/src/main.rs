@@ -20,7 +20,8 @@ use std::process::ExitCode;
 const USAGE: &str = "usage: cargo xtask <command>
 
 commands:
-  eval --backend <reference|f64|f32> --input CASES.csv   evaluate cases, CSV to stdout
+  eval [--model sphere|earth] --backend <reference|f64|f32|fixed> --input CASES.csv
+                                                         evaluate cases, CSV to stdout (earth: no fixed)
   accuracy [--quick]                                     f32/f64 error sweep against the reference
   paper                                                  regenerate docs/paper/ (Figs. 5-8)
   test                                                   every check CI runs
