@@ -108,7 +108,7 @@ fn parse_case(
     }
     let mut o = [0.0f64; 4];
     for ((slot, col), (_, default)) in o.iter_mut().zip(optional).zip(OPTIONAL_COLUMNS) {
-        *slot = match col.map(|c| cell(c)) {
+        *slot = match col.map(&cell) {
             None | Some("") => default,
             Some(text) => text.parse::<f64>().map_err(|_| EvalError::Unparsable)?,
         };
