@@ -6,6 +6,10 @@
 //! The numerical model (`motion`) shares no formula with `core_math`; on a sphere it
 //! reproduces `core_math::Reference` (its tests, and the validation line of the output).
 
+// The general model serves the tests only until the cost table uses it.
+#[cfg_attr(not(test), allow(dead_code))]
+mod kepler;
+#[cfg_attr(not(test), allow(dead_code))]
 mod motion;
 
 use std::time::Instant;
