@@ -150,28 +150,19 @@ impl EarthGeometry<f64> {
 }
 
 /// The ground ellipsoid (semi-axes A = a + h, A, B = b + h) and where the satellite is
-/// relative to it, as [`EarthGeometry::validate`] finds them in f64 with no division and
-/// no square root (both are software routines on the target).
+/// relative to it, as [`EarthGeometry::validate`] finds them in f64.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Ground {
     /// Equatorial semi-axis A = a + h (m).
     pub eq_m: f64,
     /// Polar semi-axis B = b + h (m).
     pub polar_m: f64,
-    /// A - B = a f (m).
-    pub eq_minus_polar_m: f64,
-    /// (x^2 + y^2) B^2 + z^2 A^2 - A^2 B^2 (m^4): A^2 B^2 times the satellite's
-    /// "altitude" |K r|^2 / A^2 - 1, positive outside the ground ellipsoid. Formed in f64
-    /// because it is a difference of nearly equal terms (a factor up to 16 at 200 km).
-    pub outside_m4: f64,
-}
-
-impl Ground {
     /// kappa^2 - 1, kappa = A/B the stretch of z that makes the ground a sphere of
-    /// radius A: (A - B)(A + B)/B^2, no cancellation.
-    pub fn stretch2_minus_1(&self) -> f64 {
-        self.eq_minus_polar_m * (self.eq_m + self.polar_m) / (self.polar_m * self.polar_m)
-    }
+    /// radius A: (A - B)(A + B)/B^2, A - B = a f (no cancellation).
+    pub stretch2_minus_1: f64,
+    /// C = |K r|^2 - A^2 = (|r|^2 - A^2) + (kappa^2 - 1) z^2 (m^2), K = diag(1, 1, kappa):
+    /// positive outside the ground ellipsoid.
+    pub c_m2: f64,
 }
 
 /// Largest |r| accepted (m): beyond the Moon, and no overflow anywhere in f32.
@@ -184,10 +175,12 @@ pub const MAX_FLATTENING: f64 = 0.5;
 /// Ground heights accepted: within [-b/2, a] (m, as fractions of the axes).
 pub const MIN_GROUND_H_OVER_B: f64 = -0.5;
 pub const MAX_GROUND_H_OVER_A: f64 = 1.0;
-/// Smallest "altitude" accepted: |K r|^2 / A^2 - 1 (about 2 H / A) at least this (the
-/// sphere model's 1e-9 R, 6 mm on the Earth); below it the satellite is on the ground
-/// for any scalar.
-pub const MIN_ALTITUDE_RATIO: f64 = 2.0e-9;
+/// Smallest "altitude" accepted: C / A^2 = |K r|^2 / A^2 - 1 (about 2 H / A) at least
+/// this, 1e-6 (about 3 m on the Earth). Below it f32's rounding of C (a relative 1e-7 of
+/// |r|^2) could not tell the satellite from the ground.
+pub const MIN_ALTITUDE_RATIO: f64 = 1.0e-6;
+/// Smallest |r x v|^2 / (|r|^2 |v|^2), the squared sine of the angle between r and v.
+pub const MIN_SIN2_FLIGHT_PATH: f64 = 1.0e-12;
 /// Largest |r| / (a + h): the sphere model's 16 R altitude limit.
 pub const MAX_RADIUS_RATIO: f64 = 17.0;
 /// Smallest |v1| (m/s) with a finite line period for any pixel pitch of the domain:
@@ -253,11 +246,10 @@ impl<T: Scalar> EarthGeometry<T> {
 }
 
 impl<T: Real> EarthGeometry<T> {
-    /// Checks every input against the definition's error table and the model's domain,
-    /// and returns the ground ellipsoid. Every backend calls it first, so the errors agree
-    /// on every backend. The attitude is checked in `T` (no soft-f64 work for it on the
-    /// target).
-    pub fn validate(&self) -> Result<Ground, ModelError> {
+    /// The checks that need no arithmetic on the state vector: finiteness, the Earth and
+    /// the ground (definition and domain), the Earth's rate, the attitude (in `T`: no
+    /// soft-f64 work for it on the target). Returns (A, B) = (a + h, b + h).
+    pub fn check_inputs(&self) -> Result<(f64, f64), ModelError> {
         let (r, v) = (self.state.position_m, self.state.velocity_mps);
         if !finite3(r) {
             return Err(ModelError::NonFinite(Param::Position));
@@ -315,40 +307,67 @@ impl<T: Real> EarthGeometry<T> {
                 return Err(ModelError::OutOfDomain(p));
             }
         }
-        let r2 = dot(r, r);
-        // Squared bounds: no square root.
-        if !(r2 <= MAX_POSITION_M * MAX_POSITION_M) {
-            return Err(ModelError::OutOfDomain(Param::Position));
-        }
-        if !(dot(v, v) <= MAX_VELOCITY_MPS * MAX_VELOCITY_MPS) {
-            return Err(ModelError::OutOfDomain(Param::Velocity));
-        }
-        let h = [
-            r[1] * v[2] - r[2] * v[1],
-            r[2] * v[0] - r[0] * v[2],
-            r[0] * v[1] - r[1] * v[0],
-        ];
-        if !(r2 > 0.0) || !(dot(h, h) > 0.0) {
-            return Err(ModelError::DegenerateState);
-        }
-        let eq_m = a + self.ground_h_m;
-        let polar_m = b + self.ground_h_m;
-        let (a2, b2) = (eq_m * eq_m, polar_m * polar_m);
-        let ground = Ground {
+        Ok((a + self.ground_h_m, b + self.ground_h_m))
+    }
+
+    /// Every check of the definition's error table and the model's domain, all in f64,
+    /// and the ground ellipsoid. The reference and the host tools use it; the general
+    /// form makes the same state checks in its own scalar ([`check_state`]).
+    pub fn validate(&self) -> Result<Ground, ModelError> {
+        let (eq_m, polar_m) = self.check_inputs()?;
+        let (r, v) = (self.state.position_m, self.state.velocity_mps);
+        let r2 = check_state(r, v)?;
+        let a = self.ellipsoid.a_m;
+        let k2m1 = (a * self.ellipsoid.flattening) * (eq_m + polar_m) / (polar_m * polar_m);
+        let c_m2 = (r2 - eq_m * eq_m) + k2m1 * r[2] * r[2];
+        check_altitude(c_m2, r2, eq_m)?;
+        Ok(Ground {
             eq_m,
             polar_m,
-            eq_minus_polar_m: a * fl,
-            outside_m4: (r[0] * r[0] + r[1] * r[1]) * b2 + r[2] * r[2] * a2 - a2 * b2,
-        };
-        if !(ground.outside_m4 > 0.0) {
-            return Err(ModelError::SatelliteNotAboveGround);
-        }
-        let max_r = MAX_RADIUS_RATIO * eq_m;
-        if ground.outside_m4 < MIN_ALTITUDE_RATIO * (a2 * b2) || r2 > max_r * max_r {
-            return Err(ModelError::OutOfDomain(Param::Position));
-        }
-        Ok(ground)
+            stretch2_minus_1: k2m1,
+            c_m2,
+        })
     }
+}
+
+/// The state-vector checks, in any scalar: |r| and |v| within the domain, an orbital
+/// plane (r x v not below 1e-6 |r| |v|: a flight path within a microradian of the
+/// vertical is degenerate for every scalar, so f32 and f64 agree on it). Returns |r|^2.
+pub fn check_state<S: Real>(r: [S; 3], v: [S; 3]) -> Result<S, ModelError> {
+    let dot = |a: [S; 3], b: [S; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    let (r2, v2) = (dot(r, r), dot(v, v));
+    // Squared bounds: no square root.
+    if !(r2 <= S::from_f64(MAX_POSITION_M * MAX_POSITION_M)) {
+        return Err(ModelError::OutOfDomain(Param::Position));
+    }
+    if !(v2 <= S::from_f64(MAX_VELOCITY_MPS * MAX_VELOCITY_MPS)) {
+        return Err(ModelError::OutOfDomain(Param::Velocity));
+    }
+    let h = [
+        r[1] * v[2] - r[2] * v[1],
+        r[2] * v[0] - r[0] * v[2],
+        r[0] * v[1] - r[1] * v[0],
+    ];
+    if !(dot(h, h) > S::from_f64(MIN_SIN2_FLIGHT_PATH) * (r2 * v2)) {
+        return Err(ModelError::DegenerateState);
+    }
+    Ok(r2)
+}
+
+/// The satellite against the ground ellipsoid from C = |K r|^2 - A^2, in any scalar:
+/// inside or on it, refused as such; within [`MIN_ALTITUDE_RATIO`] A^2 above it or
+/// beyond [`MAX_RADIUS_RATIO`] A, out of the domain.
+pub fn check_altitude<S: Real>(c_m2: S, r2: S, eq_m: f64) -> Result<(), ModelError> {
+    if !(c_m2 > S::ZERO) {
+        return Err(ModelError::SatelliteNotAboveGround);
+    }
+    let a2 = S::from_f64(eq_m) * S::from_f64(eq_m);
+    if c_m2 < S::from_f64(MIN_ALTITUDE_RATIO) * a2
+        || r2 > S::from_f64(MAX_RADIUS_RATIO * MAX_RADIUS_RATIO) * a2
+    {
+        return Err(ModelError::OutOfDomain(Param::Position));
+    }
+    Ok(())
 }
 
 /// Line period (s) from the image motion: the charge moves along P1, so the line rate

@@ -12,10 +12,11 @@
 
 use core::hint::black_box;
 
+use core_math::earth::{circular_state, Attitude, EarthCamera, EarthGeometry, Ellipsoid};
 use core_math::fixed_point::geometry_from_f64;
 use core_math::{
-    Backend, Camera, Geometry, MicroF32, NaiveF32, Reference, CLOSED_F32, CLOSED_F64,
-    CLOSED_MICROMATH, FIXED,
+    Backend, Camera, EarthReference, Geometry, MicroF32, Model, NaiveF32, Reference, CLOSED_F32,
+    CLOSED_F64, CLOSED_MICROMATH, FIXED, GENERAL_F32, GENERAL_F64,
 };
 use cortex_m_rt::entry;
 use firmware::platform;
@@ -55,9 +56,9 @@ fn region<I, O>(label: &str, input: I, f: impl FnOnce(I) -> O) {
 const LOOP_PX: usize = 32;
 
 /// `LOOP_PX` pixel constants of `backend`, n = -30 000 ... +30 000.
-fn loop_pixels<B: Backend>(
+fn loop_pixels<M: Model, B: Backend<M>>(
     backend: &B,
-    camera: &Camera,
+    camera: &M::Camera,
 ) -> Result<[B::Pixel; LOOP_PX], FirmwareError>
 where
     B::Pixel: Copy,
@@ -74,7 +75,12 @@ where
 /// `motion` of every pixel in a loop, each result kept (`black_box`): the count divided
 /// by `LOOP_PX` is the marginal cost of a pixel inside a loop, the way the controller
 /// evaluates its sample points, without the call and return of a one-pixel region.
-fn loop_region<B: Backend>(label: &str, backend: &B, u: &B::Update, pixels: &[B::Pixel; LOOP_PX]) {
+fn loop_region<M: Model, B: Backend<M>>(
+    label: &str,
+    backend: &B,
+    u: &B::Update,
+    pixels: &[B::Pixel; LOOP_PX],
+) {
     region(label, (u, pixels), |(u, pixels)| {
         for p in pixels {
             let _kept = black_box(backend.motion(u, p));
@@ -87,9 +93,9 @@ const MAX_POINTS: usize = 90;
 
 /// The default scene's planned sample pixels (the controller's plan, the one the
 /// firmware evaluates every update), as one backend's pixel constants.
-fn plan_pixels<B: Backend>(
+fn plan_pixels<M: Model, B: Backend<M>>(
     backend: &B,
-    camera: &Camera,
+    camera: &M::Camera,
 ) -> Result<([B::Pixel; MAX_POINTS], usize), FirmwareError>
 where
     B::Pixel: Copy,
@@ -114,10 +120,10 @@ where
 /// One full update of the default scene with `backend`: its `update`, then `motion` at
 /// every planned sample point, each result kept. The same work for every backend (the
 /// controller's own update adds |v|, period, ticks, the MTF guard and the outputs).
-fn full_update_region<B: Backend>(
+fn full_update_region<M: Model, B: Backend<M>>(
     label: &str,
     backend: &B,
-    g: &Geometry<B::Real>,
+    g: &M::Geometry<B::Real>,
     pixels: &([B::Pixel; MAX_POINTS], usize),
 ) {
     region(label, (g, pixels), |(g, (pixels, count))| {
@@ -202,6 +208,96 @@ fn paper_geometry() -> Geometry<f64> {
         645e3,
         6_370e3,
     )
+}
+
+/// The default scene's orbit and camera in the real-Earth model: the same 645 km
+/// sun-synchronous orbit (circular, over WGS 84), argument of latitude 30 deg, an agile
+/// attitude (roll 25, pitch -10, yaw 3 deg, rates of a slew) over 1 000 m of terrain.
+fn earth_geometry() -> EarthGeometry<f64> {
+    EarthGeometry {
+        state: circular_state(
+            Ellipsoid::WGS84.a_m + 645e3,
+            97.98f64.to_radians(),
+            30f64.to_radians(),
+        ),
+        attitude: Attitude {
+            roll_rad: 25f64.to_radians(),
+            pitch_rad: -10f64.to_radians(),
+            yaw_rad: 3f64.to_radians(),
+            roll_rate_rad_s: 0.5f64.to_radians(),
+            pitch_rate_rad_s: -0.2f64.to_radians(),
+            yaw_rate_rad_s: 0.05f64.to_radians(),
+        },
+        ground_h_m: 1_000.0,
+        ellipsoid: Ellipsoid::WGS84,
+        earth_rate_rad_s: core_math::EARTH_RATE_RAD_S,
+    }
+}
+
+const EARTH_CAMERA: EarthCamera = EarthCamera {
+    focal_m: 0.555,
+    pixel_m: 13e-6,
+    p1_m: 0.0,
+};
+
+/// The real-Earth backends' regions: update, motion in a loop and alone, full update.
+fn earth_regions() -> Result<(), FirmwareError> {
+    let camera = EARTH_CAMERA;
+    let e64 = earth_geometry();
+    let e32: EarthGeometry<f32> = e64.to();
+    let up32 = GENERAL_F32.update(&e32)?;
+    let up64 = GENERAL_F64.update(&e64)?;
+    let axis32 = GENERAL_F32.pixel(&camera, 0.0)?;
+    let axis_ref = EarthReference.pixel(&camera, 0.0)?;
+    let loop32 = loop_pixels(&GENERAL_F32, &camera)?;
+    let loop64 = loop_pixels(&GENERAL_F64, &camera)?;
+    let plan32 = plan_pixels(&GENERAL_F32, &camera)?;
+    let plan64 = plan_pixels(&GENERAL_F64, &camera)?;
+    let plan_ref = plan_pixels(&EarthReference, &camera)?;
+    full_update_region("GENERAL_F32 full update", &GENERAL_F32, &e32, &plan32);
+    full_update_region("GENERAL_F64 full update", &GENERAL_F64, &e64, &plan64);
+    full_update_region(
+        "EarthReference full update",
+        &EarthReference,
+        &e64,
+        &plan_ref,
+    );
+    loop_region(
+        "GENERAL_F32 motion, 32 pixels in a loop",
+        &GENERAL_F32,
+        &up32,
+        &loop32,
+    );
+    loop_region(
+        "GENERAL_F64 motion, 32 pixels in a loop",
+        &GENERAL_F64,
+        &up64,
+        &loop64,
+    );
+    region(
+        "GENERAL_F32 update (earth model, once per telemetry update)",
+        &e32,
+        |g| GENERAL_F32.update(g),
+    );
+    region(
+        "EarthGeometry::validate (f32 attitude; part of GENERAL_F32 update)",
+        &e32,
+        |g| g.validate(),
+    );
+    region("GENERAL_F64 update (earth model)", &e64, |g| {
+        GENERAL_F64.update(g)
+    });
+    region(
+        "GENERAL_F32 motion, 1 pixel (n = 0)",
+        (&up32, &axis32),
+        |(u, p)| GENERAL_F32.motion(u, p),
+    );
+    region(
+        "EarthReference motion (f64 construction on dual numbers), 1 pixel (n = 0)",
+        (&e64, &axis_ref),
+        |(g, p)| EarthReference.motion(g, p),
+    );
+    Ok(())
 }
 
 fn run() -> Result<(), FirmwareError> {
@@ -366,6 +462,7 @@ fn run() -> Result<(), FirmwareError> {
         |g| FIXED.update(g),
     );
     scene_kinds()?;
+    earth_regions()?;
     region(
         "NaiveF32 motion, 1 pixel (n = 0)",
         (&update_naive, &axis_naive),
