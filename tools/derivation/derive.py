@@ -12,7 +12,8 @@ at t = 0 (Eq. 13) and proves, exactly:
       equal the (g2, g3) forms once g2, g3 come from Eqs. 1-6;
   (d) dP2/dt vanishes for i0 = 0, 180 deg and g0 = 90, 270 deg;
   (e) what survives of the garbled Eq. 15;
-  (f) the conditioning formulas quoted in the doc.
+  (f) the conditioning formulas quoted in the doc;
+and, in general.py (part II of the doc), the general real-Earth model.
 
 "Exactly" means: every sin x, cos x is replaced by a symbol S_x, C_x; the difference of
 the two sides is brought over a common denominator and its numerator is reduced modulo
@@ -512,6 +513,16 @@ for label, Hm_, ph_, al_ in cases:
           f"{mp.nstr(e[3], 2):>9} {mp.nstr(b1, 2):>10} {mp.nstr(b2, 2):>9}")
 info("relative errors; inputs are the same binary64 numbers for both routes and the reference is exact for them;")
 info("u*cond = 2^-53 |tan(eta) d ln v/d eta|: the error that one rounding of sin(eta) alone causes")
+
+# --------------------------------------------------------------------------------------
+# Part II: the general (real-Earth) model, tools/derivation/general.py. `--full` adds the
+# literal end-to-end symbolic checks (about two minutes more).
+# --------------------------------------------------------------------------------------
+import general  # noqa: E402  (same directory as this script)
+
+general.run(check, info, full="--full" in sys.argv)
+general.run_numeric(check, info)
+general.run_case(check, info)
 
 # --------------------------------------------------------------------------------------
 n_fail = sum(1 for _, ok in RESULTS if not ok)

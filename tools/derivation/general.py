@@ -366,6 +366,378 @@ def run(check, info, full=False):
     info(f"symbolic part of the general model took {time.time() - T0:.1f} s")
 
 
+# --------------------------------------------------------------------------------------
+# High precision: the literal construction on dual numbers vs the general form.
+# --------------------------------------------------------------------------------------
+
+class Dual:
+    """a + b e, e^2 = 0 (mpmath parts): the value and the exact derivative in t."""
+    __slots__ = ("a", "b")
+
+    def __init__(self, a, b=0):
+        self.a, self.b = mp.mpf(a), mp.mpf(b)
+
+    @staticmethod
+    def lift(o):
+        return o if isinstance(o, Dual) else Dual(o)
+
+    def __add__(self, o):
+        o = Dual.lift(o)
+        return Dual(self.a + o.a, self.b + o.b)
+    __radd__ = __add__
+
+    def __sub__(self, o):
+        o = Dual.lift(o)
+        return Dual(self.a - o.a, self.b - o.b)
+
+    def __rsub__(self, o):
+        return Dual.lift(o) - self
+
+    def __neg__(self):
+        return Dual(-self.a, -self.b)
+
+    def __mul__(self, o):
+        o = Dual.lift(o)
+        return Dual(self.a * o.a, self.a * o.b + self.b * o.a)
+    __rmul__ = __mul__
+
+    def __truediv__(self, o):
+        o = Dual.lift(o)
+        return Dual(self.a / o.a, (self.b * o.a - self.a * o.b) / o.a**2)
+
+    def __rtruediv__(self, o):
+        return Dual.lift(o) / self
+
+
+def d_sqrt(x):
+    r = mp.sqrt(x.a)
+    return Dual(r, x.b / (2 * r))
+
+
+def d_sin(x):
+    return Dual(mp.sin(x.a), mp.cos(x.a) * x.b)
+
+
+def d_cos(x):
+    return Dual(mp.cos(x.a), -mp.sin(x.a) * x.b)
+
+
+def _cross(a, b):
+    return [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+
+
+def _dot(a, b):
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+def _matmul(A, B):
+    return [[sum((A[i][k] * B[k][j] for k in range(3)), Dual(0)) for j in range(3)] for i in range(3)]
+
+
+def _rot(axis, ang):
+    sn, cs, o, z0 = d_sin(ang), d_cos(ang), Dual(1), Dual(0)
+    if axis == 0:
+        return [[o, z0, z0], [z0, cs, -sn], [z0, sn, cs]]
+    if axis == 1:
+        return [[cs, z0, sn], [z0, o, z0], [-sn, z0, cs]]
+    return [[cs, -sn, z0], [sn, cs, z0], [z0, z0, o]]
+
+
+GM = mp.mpf("3.986004418e14")
+
+
+def literal(c):
+    """EARTH-MODEL.md's construction, literally: (v1, v2), P(0), slant range s |d|.
+
+    r(t) = r + v t, v(t) = v + a t with the two-body a = -GM r/|r|^3; L(t) by normalising
+    r and r x v; A(t) = Rx Ry Rz of the moving angles; the first intersection of
+    r + s M(0) u with the ground ellipsoid by the textbook root; G(t) = Rz(omega t) G;
+    c(t) = M(t)^T (G(t) - r(t)); P = -f (c1, c2)/c3; d/dt by the dual parts."""
+    T = Dual(0, 1)
+    rr, vv = c["r"], c["v"]
+    rn0 = mp.sqrt(_dot(rr, rr))
+    acc = [-GM * q / rn0**3 for q in rr]
+    r = [Dual(rr[i]) + vv[i] * T for i in range(3)]
+    v = [Dual(vv[i]) + acc[i] * T for i in range(3)]
+
+    def unit(a):
+        nrm = d_sqrt(_dot(a, a))
+        return [q / nrm for q in a]
+    zL = unit(r)
+    yL = unit(_cross(r, v))
+    xL = _cross(yL, zL)
+    E = [[xL[i], yL[i], zL[i]] for i in range(3)]
+    ang = [Dual(c["att"][i]) + c["rate"][i] * T for i in range(3)]
+    A = _matmul(_matmul(_rot(0, ang[0]), _rot(1, ang[1])), _rot(2, ang[2]))
+    M = _matmul(E, A)
+    u = [c["p1"], c["p2"], -c["f"]]
+    d = [sum(M[i][j].a * u[j] for j in range(3)) for i in range(3)]
+    Ae = c["a"] + c["h"]
+    Be = c["a"] * (1 - c["fl"]) + c["h"]
+    qa = (d[0]**2 + d[1]**2) / Ae**2 + d[2]**2 / Be**2
+    qb = 2 * ((rr[0] * d[0] + rr[1] * d[1]) / Ae**2 + rr[2] * d[2] / Be**2)
+    qc = (rr[0]**2 + rr[1]**2) / Ae**2 + rr[2]**2 / Be**2 - 1
+    disc = qb**2 - 4 * qa * qc
+    if not (qc > 0 and disc >= 0 and qb < 0):
+        return None
+    sr = (-qb - mp.sqrt(disc)) / (2 * qa)
+    G = [rr[i] + sr * d[i] for i in range(3)]
+    wt = c["omega"] * T
+    Gt = [d_cos(wt) * G[0] - d_sin(wt) * G[1], d_sin(wt) * G[0] + d_cos(wt) * G[1], Dual(G[2])]
+    rel = [Gt[i] - r[i] for i in range(3)]
+    cam = [sum((M[i][j] * rel[i] for i in range(3)), Dual(0)) for j in range(3)]
+    P1 = -c["f"] * cam[0] / cam[2]
+    P2 = -c["f"] * cam[1] / cam[2]
+    return P1.b, P2.b, (P1.a, P2.a), sr * mp.sqrt(_dot(d, d))
+
+
+def general_form(c):
+    """core-math/src/earth/general.rs, step by step, in mpmath."""
+    rr, vv, w = c["r"], c["v"], c["omega"]
+    rn_ = mp.sqrt(_dot(rr, rr))
+    h = _cross(rr, vv)
+    hn_ = mp.sqrt(_dot(h, h))
+    inv_hr = 1 / (hn_ * rn_)
+    n_l = [(h[0] * rr[1] - h[1] * rr[0]) * inv_hr, h[2] * rn_ * inv_hr, rr[2] * hn_ * inv_hr]
+    inv_r = hn_ * inv_hr
+    v_fwd = hn_ * inv_r
+    nu_ = v_fwd * inv_r
+    rdot = _dot(rr, vv) * inv_r
+    wr = w * rn_
+    v_l = [v_fwd - wr * n_l[1], wr * n_l[0], rdot]
+    w_l = [-w * n_l[0], nu_ - w * n_l[1], -w * n_l[2]]
+    Ae = c["a"] + c["h"]
+    Be = c["a"] * (1 - c["fl"]) + c["h"]
+    k2m1 = c["a"] * c["fl"] * (Ae + Be) / Be**2
+    rho_l = [k2m1 * rr[2] * n_l[0], k2m1 * rr[2] * n_l[1], rn_ + k2m1 * rr[2] * n_l[2]]
+    sp_, cp_ = mp.sin(c["att"][0]), mp.cos(c["att"][0])
+    st_, ct_ = mp.sin(c["att"][1]), mp.cos(c["att"][1])
+    sy_, cy_ = mp.sin(c["att"][2]), mp.cos(c["att"][2])
+    cols = [[ct_ * cy_, cp_ * sy_ + sp_ * st_ * cy_, sp_ * sy_ - cp_ * st_ * cy_],
+            [-ct_ * sy_, cp_ * cy_ - sp_ * st_ * sy_, sp_ * cy_ + cp_ * st_ * sy_],
+            [st_, -sp_ * ct_, cp_ * ct_]]
+    dr, dp, dy = c["rate"]
+    w_a = [dr * cy_ * ct_ + dp * sy_, -dr * sy_ * ct_ + dp * cy_, dr * st_ + dy]
+
+    def at(xv):
+        return [_dot(cols[0], xv), _dot(cols[1], xv), _dot(cols[2], xv)]
+    w_b = [a + b for a, b in zip(at(w_l), w_a)]
+    v_b = at(v_l)
+    n_b = at(n_l)
+    rho_b = at(rho_l)
+    C = ((rr[0]**2 + rr[1]**2) * Be**2 + rr[2]**2 * Ae**2 - Ae**2 * Be**2) / Be**2
+    u = [c["p1"], c["p2"], -c["f"]]
+    nu_u = _dot(n_b, u)
+    beta = _dot(rho_b, u)
+    alpha = _dot(u, u) + k2m1 * nu_u**2
+    disc = beta**2 - alpha * C
+    if not (beta < 0 and disc >= 0):
+        return None
+    inv_s = (mp.sqrt(disc) - beta) / C
+    g = [-(w_b[1] * u[2] - w_b[2] * u[1]) - v_b[0] * inv_s,
+         -(w_b[2] * u[0] - w_b[0] * u[2]) - v_b[1] * inv_s,
+         -(w_b[0] * u[1] - w_b[1] * u[0]) - v_b[2] * inv_s]
+    return g[0] + c["p1"] / c["f"] * g[2], g[1] + c["p2"] / c["f"] * g[2]
+
+
+def random_case(rng):
+    a = mp.mpf(rng.uniform(6.0e6, 6.5e6))
+    fl = mp.mpf(rng.choice([0, rng.uniform(0, 0.01), rng.uniform(0, 0.3)]))
+    h = mp.mpf(rng.uniform(-500, 9000))
+    # Position: any direction, 150 km to 3 radii above the ground.
+    dirv = [rng.gauss(0, 1) for _ in range(3)]
+    nd = math.sqrt(sum(q * q for q in dirv))
+    rmag = float(a) * (1 + 10 ** rng.uniform(math.log10(0.025), math.log10(3)))
+    r = [mp.mpf(rmag * q / nd) for q in dirv]
+    # Velocity: circular speed times 0.8 .. 1.2 along a random tangent, plus a radial part.
+    tv = [rng.gauss(0, 1) for _ in range(3)]
+    dotp = sum(tv[i] * dirv[i] for i in range(3)) / nd
+    tv = [tv[i] - dotp * dirv[i] / nd for i in range(3)]
+    nt = math.sqrt(sum(q * q for q in tv))
+    vc = math.sqrt(3.986004418e14 / rmag) * rng.uniform(0.8, 1.2)
+    vr = vc * rng.uniform(-0.1, 0.1)
+    v = [mp.mpf(vc * tv[i] / nt + vr * dirv[i] / nd) for i in range(3)]
+    att = [mp.radians(rng.uniform(-45, 45)), mp.radians(rng.uniform(-30, 30)), mp.radians(rng.uniform(-180, 180))]
+    rate = [mp.radians(rng.uniform(-2, 2)) for _ in range(3)]
+    fm = mp.mpf(rng.uniform(0.1, 3))
+    return dict(r=r, v=v, att=att, rate=rate, a=a, fl=fl, h=h, f=fm,
+                p1=fm * mp.mpf(rng.uniform(-0.2, 0.2)), p2=fm * mp.mpf(rng.uniform(-0.5, 0.5)),
+                omega=mp.mpf(rng.uniform(-1e-3, 1e-3)))
+
+
+def run_numeric(check, info):
+    T0 = time.time()
+    dps_saved = mp.mp.dps
+    mp.mp.dps = 60
+    print("== (G8) literal construction (dual numbers, textbook root, GM) = general form, 60 digits")
+    rng = random.Random(20261124)
+    n_ok, n_miss, worst, worst_p = 0, 0, mp.mpf(0), mp.mpf(0)
+    while n_ok < 300:
+        c = random_case(rng)
+        lit = literal(c)
+        gen = general_form(c)
+        if lit is None or gen is None:
+            n_miss += 1
+            if (lit is None) != (gen is None):
+                worst = mp.inf
+            continue
+        scale = abs(lit[0]) + abs(lit[1])
+        worst = max(worst, abs(lit[0] - gen[0]) / scale, abs(lit[1] - gen[1]) / scale)
+        worst_p = max(worst_p, abs(lit[2][0] - c["p1"]) / c["f"], abs(lit[2][1] - c["p2"]) / c["f"])
+        n_ok += 1
+    check(f"literal = general form at {n_ok} random geometries (eccentric orbits, any attitude and rates, "
+          f"flattening up to 0.3, terrain, p1 != 0)", worst < mp.mpf("1e-45"),
+          f"max |diff| / (|v1|+|v2|) = {mp.nstr(worst, 3)}")
+    check(f"both agree on which of {n_miss} further rays miss the ground", worst != mp.inf)
+    check("the literal ground point projects on its pixel: P(0) = (p1, p2)", worst_p < mp.mpf("1e-45"),
+          f"max |P(0) - p| / f = {mp.nstr(worst_p, 3)}")
+    c = random_case(random.Random(7))
+    v_a = literal(c)
+    GM_saved = globals()["GM"]
+    globals()["GM"] = GM_saved * 3
+    v_b = literal(c)
+    globals()["GM"] = GM_saved
+    check("the literal construction does not depend on GM (tried GM and 3 GM)",
+          abs(v_a[0] - v_b[0]) + abs(v_a[1] - v_b[1]) < mp.mpf("1e-50") * (abs(v_a[0]) + abs(v_a[1])))
+    info(f"(G8) took {time.time() - T0:.1f} s")
+    mp.mp.dps = dps_saved
+
+
+# The general test case for the Rust tests (every input exact in binary64 except the
+# decimal ones noted in docs/derivation.md).
+CASE_INPUTS = dict(
+    x_m=-2100000, y_m=4800000, z_m=4600000, vx_mps=3198, vy_mps=-3995, vz_mps=5689,
+    roll_deg="20.5", pitch_deg="-7.25", yaw_deg="3.5",
+    roll_rate_dps="0.05", pitch_rate_dps="-0.025", yaw_rate_dps="0.0125",
+    ground_h_m=1500, f_m="0.75", pixel_m="0.0000152587890625", n_px=12000,
+    p1_m="0.001953125", a_m=6378137, flattening="1/298.257223563", earth_rate_rad_s="7.2921159e-5")
+
+
+def case_from_inputs(ci, to_rad):
+    def num(x):
+        if isinstance(x, str) and "/" in x:
+            a_, b_ = x.split("/")
+            return mp.mpf(a_) / mp.mpf(b_)
+        return mp.mpf(x)
+    return dict(r=[num(ci["x_m"]), num(ci["y_m"]), num(ci["z_m"])],
+                v=[num(ci["vx_mps"]), num(ci["vy_mps"]), num(ci["vz_mps"])],
+                att=[to_rad(ci[k]) for k in ("roll_deg", "pitch_deg", "yaw_deg")],
+                rate=[to_rad(ci[k]) for k in ("roll_rate_dps", "pitch_rate_dps", "yaw_rate_dps")],
+                a=num(ci["a_m"]), fl=num(ci["flattening"]), h=num(ci["ground_h_m"]), f=num(ci["f_m"]),
+                p1=num(ci["p1_m"]), p2=num(ci["n_px"]) * num(ci["pixel_m"]), omega=num(ci["earth_rate_rad_s"]))
+
+
+def sinc(xv):
+    return mp.mpf(1) if xv == 0 else mp.sin(mp.pi * xv) / (mp.pi * xv)
+
+
+def circular_case(Rm, Hm, i0d, g0d, phid, fm, p2m, omega):
+    """earth::circular_state + from_sphere: the paper's round Earth as a general case."""
+    rad = Rm + Hm
+    si, ci = mp.sin(mp.radians(i0d)), mp.cos(mp.radians(i0d))
+    su, cu = mp.sin(mp.radians(g0d)), mp.cos(mp.radians(g0d))
+    spd = mp.sqrt(GM / rad)
+    return dict(r=[rad * cu, rad * su * ci, rad * su * si], v=[-spd * su, spd * cu * ci, spd * cu * si],
+                att=[mp.radians(phid), 0, 0], rate=[0, 0, 0], a=Rm, fl=mp.mpf(0), h=mp.mpf(0), f=fm,
+                p1=mp.mpf(0), p2=p2m, omega=omega)
+
+
+def run_case(check, info):
+    T0 = time.time()
+    dps_saved = mp.mp.dps
+    mp.mp.dps = 80
+    print("== (G9) the general test case, 50 digits (literal construction; general form agrees)")
+    ci = CASE_INPUTS
+    info("inputs: " + ", ".join(f"{k}={v}" for k, v in ci.items()))
+    c = case_from_inputs(ci, lambda d: mp.radians(mp.mpf(d)))
+    lit = literal(c)
+    gen = general_form(c)
+    v1, v2 = lit[0], lit[1]
+    Ae = c["a"] + c["h"]
+    rr = c["r"]
+    hv = _cross(rr, c["v"])
+    ecc = _cross(c["v"], hv)
+    ecc = [ecc[i] / GM - rr[i] / mp.sqrt(_dot(rr, rr)) for i in range(3)]
+    info(f"|r| = {mp.nstr(mp.sqrt(_dot(rr, rr)), 12)} m, r.v/|r| = {mp.nstr(_dot(rr, c['v']) / mp.sqrt(_dot(rr, rr)), 8)} m/s, "
+         f"eccentricity {mp.nstr(mp.sqrt(_dot(ecc, ecc)), 6)}, inclination "
+         f"{mp.nstr(mp.degrees(mp.acos(hv[2] / mp.sqrt(_dot(hv, hv)))), 8)} deg; "
+         f"slant range {mp.nstr(lit[3], 12)} m; field angle atan(p2/f) = {mp.nstr(mp.degrees(mp.atan(c['p2'] / c['f'])), 8)} deg")
+    info(f"v1 = {mp.nstr(v1, 50)} m/s")
+    info(f"v2 = {mp.nstr(v2, 50)} m/s")
+    drift = mp.atan(v2 / v1)
+    info(f"v_mps = {mp.nstr(mp.hypot(v1, v2), 20)}, line_period_s = pixel/|v1| = "
+         f"{mp.nstr(mp.mpf(ci['pixel_m']) / abs(v1), 20)}, drift_rad = {mp.nstr(drift, 20)}")
+    check("test case: general form = literal construction", abs(gen[0] - v1) + abs(gen[1] - v2)
+          < mp.mpf("1e-70") * (abs(v1) + abs(v2)), f"difference {mp.nstr(abs(gen[0] - v1) + abs(gen[1] - v2), 3)} m/s")
+    # The same with the angles rounded to binary64 radians as Rust's f64::to_radians does.
+    cb = case_from_inputs(ci, lambda d: mp.mpf(float(d) * (math.pi / 180)))
+    cb["p1"], cb["omega"], cb["fl"], cb["f"] = (mp.mpf(float(cb["p1"])), mp.mpf(float(cb["omega"])),
+                                                mp.mpf(1.0 / 298.257223563), mp.mpf(float(cb["f"])))
+    lb = literal(cb)
+    info("with every input rounded to binary64 first (angles and rates as f64 deg.to_radians(), "
+         "flattening = 1.0/298.257223563, earth rate 7.2921159e-5 as f64):")
+    info(f"v1 = {mp.nstr(lb[0], 50)} m/s")
+    info(f"v2 = {mp.nstr(lb[1], 50)} m/s")
+    info(f"relative change from the decimal inputs: v1 {mp.nstr((lb[0] - v1) / v1, 3)}, v2 {mp.nstr((lb[1] - v2) / v2, 3)}")
+
+    print("== (G10) line period from v1, drift and its MTF")
+    pairs = []
+    for name, cc, Mst in [("test case", c, (16, 48))]:
+        pairs.append((name, v1, v2))
+    Rm, Hm = mp.mpf(6370e3), mp.mpf(645e3)
+    fm, Am = mp.mpf("0.555"), mp.mpf("13e-6")
+    wr = mp.mpf("7.2921159e-5")
+    worst = None
+    for g0d in (0, 45, 90):
+        for n in (-30000, 0, 30000):
+            for phd in (0, 25):
+                cc = circular_case(Rm, Hm, mp.mpf("97.98"), g0d, phd, fm, n * Am, wr)
+                a1, a2 = general_form(cc)
+                dr = abs(mp.atan(a2 / a1))
+                if worst is None or dr > worst[0]:
+                    worst = (dr, g0d, n, phd, a1, a2)
+    dr, g0d, n, phd, a1, a2 = worst
+    pairs.append((f"paper's camera, largest drift (g0 {g0d} deg, n {n}, phi {phd} deg)", a1, a2))
+    cc = circular_case(Rm, Hm, mp.mpf("97.98"), 0, 0, fm, 0, wr)
+    a1, a2 = general_form(cc)
+    pairs.append(("paper's camera, nadir pixel, g0 0 deg, phi 0", a1, a2))
+    info(f"{'case':<58} {'drift deg':>10} {'1/cos-1':>10} {'drift^2/2':>10} {'MTFd M16':>9} {'M48':>7} "
+         f"{'MTFm M16':>9} {'M48':>9} {'prod M16':>9} {'M48':>7}")
+    for name, q1, q2 in pairs:
+        dft = mp.atan(q2 / q1)
+        rel = 1 / mp.cos(dft) - 1
+        row = []
+        for Mst in (16, 48):
+            dpx = Mst * abs(mp.tan(dft))
+            mtf_d = abs(sinc(dpx / 2))
+            mtf_m = abs(sinc(Mst * rel / 2))      # = sin(x)/x, x = pi M (dv/v)/2
+            row.append((mtf_d, mtf_m, mtf_d * mtf_m))
+        info(f"{name:<58} {mp.nstr(mp.degrees(dft), 5):>10} {mp.nstr(rel, 4):>10} {mp.nstr(dft**2 / 2, 4):>10} "
+             f"{mp.nstr(row[0][0], 4):>9} {mp.nstr(row[1][0], 4):>7} {mp.nstr(row[0][1], 6):>9} "
+             f"{mp.nstr(row[1][1], 6):>9} {mp.nstr(row[0][2], 4):>9} {mp.nstr(row[1][2], 4):>7}")
+    info("MTFd = |sinc(M |tan drift| / 2)| (drift smear across the line); MTFm = |sinc(M (1/cos(drift) - 1) / 2)|,")
+    info("the mismatch a line period of pixel/|v_P| (Eq. 16) would add; prod = MTFd * MTFm; sinc(x) = sin(pi x)/(pi x)")
+    # Yaw steering: the yaw that makes v2 = 0 at the nadir pixel of the paper's camera.
+    base = circular_case(Rm, Hm, mp.mpf("97.98"), 0, 0, fm, 0, wr)
+
+    def v2_of_yaw(yw):
+        cy = dict(base)
+        cy["att"] = [0, 0, yw]
+        return general_form(cy)[1]
+    y0 = mp.findroot(v2_of_yaw, mp.atan(a2 / a1))
+    cy = dict(base)
+    cy["att"] = [0, 0, y0]
+    s1, s2 = general_form(cy)
+    info(f"yaw steering, paper's camera, nadir pixel, g0 0: yaw {mp.nstr(mp.degrees(y0), 8)} deg makes v2 = "
+         f"{mp.nstr(s2, 3)}; then |v1| = {mp.nstr(abs(s1), 12)} m/s against the unsteered |v_P| = "
+         f"{mp.nstr(mp.hypot(a1, a2), 12)} and |v1| = {mp.nstr(abs(a1), 12)}")
+    check("yaw steering at the nadir pixel: yaw = drift gives v2 = 0 and |v1| = the unsteered |v_P|",
+          abs(abs(s1) - mp.hypot(a1, a2)) < mp.mpf("1e-40") * abs(s1)
+          and abs(y0 - mp.atan(a2 / a1)) < mp.mpf("1e-40"), f"yaw - drift = {mp.nstr(y0 - mp.atan(a2 / a1), 3)} rad")
+    info(f"(G9, G10) took {time.time() - T0:.1f} s")
+    mp.mp.dps = dps_saved
+
+
 if __name__ == "__main__":
     RESULTS = []
 
@@ -380,6 +752,8 @@ if __name__ == "__main__":
 
     t_start = time.time()
     run(check, info, full="--full" in sys.argv)
+    run_numeric(check, info)
+    run_case(check, info)
     n_fail = RESULTS.count(False)
     print(f"== {len(RESULTS) - n_fail}/{len(RESULTS)} checks passed in {time.time() - t_start:.1f} s")
     sys.exit(1 if n_fail else 0)
