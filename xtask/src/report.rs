@@ -50,7 +50,10 @@ struct Variant {
     full_update_label: &'static str,
 }
 
-const VARIANTS: [Variant; 6] = [
+/// The round-Earth variants first (`SPHERE_VARIANTS` of them, errors over the round-Earth
+/// sample), then the real-Earth ones (errors over the real-Earth sample).
+const SPHERE_VARIANTS: usize = 6;
+const VARIANTS: [Variant; 9] = [
     Variant {
         name: "naive-f32",
         loop_label: "NaiveF32 motion, 32 pixels in a loop",
@@ -81,6 +84,21 @@ const VARIANTS: [Variant; 6] = [
         loop_label: "FIXED motion, 32 pixels in a loop",
         full_update_label: "FIXED full update",
     },
+    Variant {
+        name: "earth-reference",
+        loop_label: "EarthReference motion, 32 pixels in a loop",
+        full_update_label: "EarthReference full update",
+    },
+    Variant {
+        name: "earth-f64",
+        loop_label: "GENERAL_F64 motion, 32 pixels in a loop",
+        full_update_label: "GENERAL_F64 full update",
+    },
+    Variant {
+        name: "earth-f32",
+        loop_label: "GENERAL_F32 motion, 32 pixels in a loop",
+        full_update_label: "GENERAL_F32 full update",
+    },
 ];
 
 #[derive(Default)]
@@ -93,7 +111,26 @@ struct Errors {
 struct Sample {
     cases: usize,
     near: usize,
+    earth_near: usize,
     errors: Vec<Errors>,
+    earth_f32: EarthF32Split,
+}
+
+/// `earth-f32`'s errors against the problem's condition number kappa
+/// (`core_math::accuracy::earth_kappa`): its 2e-6 and 2e-5 bounds hold up to kappa 50;
+/// everywhere at least 0.01 deg from the limb err / (kappa u32) is bounded.
+#[derive(Default)]
+struct EarthF32Split {
+    /// Max error at least 1 deg from the limb, kappa <= 50.
+    far: f64,
+    /// Max error 0.01-1 deg from the limb, kappa <= 50.
+    near: f64,
+    /// Cases with kappa > 50 (at least 0.01 deg from the limb).
+    stiff: usize,
+    /// Max err/(kappa u32) over every case at least 0.01 deg from the limb.
+    ratio: f64,
+    /// Cases at least 0.01 deg from the limb.
+    all: usize,
 }
 
 pub fn run(args: &[String]) -> Result<(), String> {
@@ -289,11 +326,83 @@ fn sweep(seed: u64, cases: usize) -> Sample {
             }
         }
     }
+    let (earth_near, earth_f32) = earth_sweep(seed, cases, &mut errors[SPHERE_VARIANTS..]);
     Sample {
         cases,
         near,
+        earth_near,
         errors,
+        earth_f32,
     }
+}
+
+/// The real-Earth rows: `cases` draws of the real-Earth envelope
+/// (`core_math::sample::SplitMix64::earth_case`, WGS 84, eccentric orbits, agile attitude,
+/// terrain, p1 != 0) that the reference accepts; error |dv| / |v| (the vector
+/// difference) against `EarthReference` at the inputs as given. Returns how many lie
+/// within `NEAR_LIMB_DEG` of the limb, and the f32 errors split by condition number.
+fn earth_sweep(seed: u64, cases: usize, errors: &mut [Errors]) -> (usize, EarthF32Split) {
+    use core_math::accuracy::{earth_kappa, EARTH_F32_KAPPA_LIMIT};
+    use core_math::{EarthReference, GENERAL_F32, GENERAL_F64};
+    let mut split = EarthF32Split::default();
+    let mut rng = Rng(seed ^ 0xEA27_0000_0000_0000);
+    let (mut done, mut near) = (0, 0);
+    while done < cases {
+        let Some(c) = rng.earth_case() else { continue };
+        let Ok(r) = EarthReference.evaluate(&c.camera, &c.geometry, c.n_px) else {
+            continue;
+        };
+        let Ok(margin) = core_math::earth::limb_margin_rad(&c.geometry, &c.camera, c.n_px) else {
+            continue;
+        };
+        done += 1;
+        let is_near = margin.to_degrees() < NEAR_LIMB_DEG;
+        near += usize::from(is_near);
+        let widen = |m: core_math::ImageMotion<f32>| core_math::ImageMotion {
+            v1_mps: f64::from(m.v1_mps),
+            v2_mps: f64::from(m.v2_mps),
+        };
+        let motions = [
+            Some(r),
+            GENERAL_F64.evaluate(&c.camera, &c.geometry, c.n_px).ok(),
+            GENERAL_F32
+                .evaluate(&c.camera, &c.geometry.to::<f32>(), c.n_px)
+                .ok()
+                .map(widen),
+        ];
+        let sp = r.speed_mps();
+        let f32_err = motions[2].map(|m| (m.v1_mps - r.v1_mps).hypot(m.v2_mps - r.v2_mps) / sp);
+        for (e, m) in errors.iter_mut().zip(motions) {
+            let Some(m) = m else {
+                e.refused += 1;
+                continue;
+            };
+            let rel = (m.v1_mps - r.v1_mps).hypot(m.v2_mps - r.v2_mps) / sp;
+            if is_near {
+                e.max_near = e.max_near.max(rel);
+            } else {
+                e.far.push(rel);
+            }
+        }
+        let (Some(err), true) = (f32_err, margin.to_degrees() >= 0.01) else {
+            continue;
+        };
+        let Ok(kappa) = earth_kappa(&c.camera, &c.geometry, c.n_px) else {
+            continue;
+        };
+        split.all += 1;
+        split.ratio = split
+            .ratio
+            .max(err / (kappa * f64::from(f32::EPSILON) / 2.0));
+        if kappa > EARTH_F32_KAPPA_LIMIT {
+            split.stiff += 1;
+        } else if is_near {
+            split.near = split.near.max(err);
+        } else {
+            split.far = split.far.max(err);
+        }
+    }
+    (near, split)
 }
 
 const HEADER: [&str; 7] = [
@@ -315,13 +424,17 @@ fn print_table(
 ) -> Result<Vec<[String; 7]>, String> {
     let notes = format!(
         "{} cases (seed {seed:#x}), {} within {NEAR_LIMB_DEG} deg of the limb; errors of |v_P| \
-         relative to the f64 reference chain (reference: 0 by definition); instructions: \
+         relative to the f64 reference chain (reference: 0 by definition); earth rows: {} \
+         cases of the real-Earth envelope, {} within {NEAR_LIMB_DEG} deg of the limb, error \
+         |dv|/|v| against EarthReference; instructions: \
          Cortex-M4 under QEMU {}, release, per pixel = motion over {LOOP_PX} pixels in a \
          loop / {LOOP_PX}, per update = update + motion at the default scene's planned \
          sample points, instructions not cycles; flash_bytes = loadable bytes the backend's \
          pixel + update + motion add to an empty binary (xtask/src/footprint.rs)",
         sample.cases,
         sample.near,
+        sample.cases,
+        sample.earth_near,
         counts.map_or("(not run: --no-bench)", |c| c.qemu_version.as_str()),
     );
     let mut rows = Vec::new();
@@ -365,6 +478,14 @@ fn print_table(
             );
         }
     }
+    let split = &sample.earth_f32;
+    let notes = format!(
+        "{notes}. earth-f32 against the problem's condition number kappa \
+         (core_math::accuracy::earth_kappa): where kappa <= 50, max {:.2e} at least 1 deg \
+         from the limb and {:.2e} at 0.01-1 deg; kappa > 50 in {} of {} cases at least \
+         0.01 deg from the limb; max err / (kappa u32) over all of them {:.2}",
+        split.far, split.near, split.stiff, split.all, split.ratio
+    );
     if csv {
         eprintln!("report: {notes}");
         println!("{}", HEADER.join(","));

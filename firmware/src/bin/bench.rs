@@ -251,6 +251,7 @@ fn earth_regions() -> Result<(), FirmwareError> {
     let axis_ref = EarthReference.pixel(&camera, 0.0)?;
     let loop32 = loop_pixels(&GENERAL_F32, &camera)?;
     let loop64 = loop_pixels(&GENERAL_F64, &camera)?;
+    let loop_ref = loop_pixels(&EarthReference, &camera)?;
     let plan32 = plan_pixels(&GENERAL_F32, &camera)?;
     let plan64 = plan_pixels(&GENERAL_F64, &camera)?;
     let plan_ref = plan_pixels(&EarthReference, &camera)?;
@@ -273,6 +274,12 @@ fn earth_regions() -> Result<(), FirmwareError> {
         &GENERAL_F64,
         &up64,
         &loop64,
+    );
+    loop_region(
+        "EarthReference motion, 32 pixels in a loop",
+        &EarthReference,
+        &e64,
+        &loop_ref,
     );
     region(
         "GENERAL_F32 update (earth model, once per telemetry update)",

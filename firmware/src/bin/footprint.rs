@@ -12,7 +12,9 @@
 use core::hint::black_box;
 
 #[allow(unused_imports)]
-use core_math::{Backend, Camera, Geometry};
+use core_math::earth::{circular_state, Attitude, EarthCamera, EarthGeometry, Ellipsoid};
+#[allow(unused_imports)]
+use core_math::{Backend, Camera, Earth, Geometry};
 use cortex_m_rt::entry;
 use firmware::platform;
 
@@ -41,6 +43,37 @@ fn exercise<B: Backend>(backend: &B, g: &Geometry<B::Real>) {
     }
 }
 
+/// The same for a real-Earth backend: the default orbit over WGS 84, an agile attitude.
+#[allow(dead_code)]
+fn exercise_earth<B: Backend<Earth>>(
+    backend: &B,
+    to: impl Fn(EarthGeometry<f64>) -> EarthGeometry<B::Real>,
+) {
+    let g = black_box(EarthGeometry {
+        state: circular_state(7_023_137.0, 1.710_073_105_064_591, 0.5),
+        attitude: Attitude {
+            roll_rad: 0.35,
+            pitch_rad: -0.1,
+            yaw_rad: 0.05,
+            roll_rate_rad_s: 0.01,
+            pitch_rate_rad_s: 0.0,
+            yaw_rate_rad_s: 0.0,
+        },
+        ground_h_m: 1_000.0,
+        ellipsoid: Ellipsoid::WGS84,
+        earth_rate_rad_s: core_math::EARTH_RATE_RAD_S,
+    });
+    let camera = black_box(EarthCamera {
+        focal_m: 0.555,
+        pixel_m: 13e-6,
+        p1_m: 0.0,
+    });
+    let n_px = black_box(12_345.0);
+    if let (Ok(p), Ok(u)) = (backend.pixel(&camera, n_px), backend.update(&to(g))) {
+        let _kept = black_box(backend.motion(&u, &p));
+    }
+}
+
 #[entry]
 fn main() -> ! {
     #[allow(unused_variables)] // "none" keeps only the input
@@ -59,5 +92,11 @@ fn main() -> ! {
     if let Ok(gq) = core_math::fixed_point::geometry_from_f64(&g) {
         exercise(&core_math::FIXED, &gq);
     }
+    #[cfg(footprint = "earth-reference")]
+    exercise_earth(&core_math::EarthReference, |g| g);
+    #[cfg(footprint = "earth-f64")]
+    exercise_earth(&core_math::GENERAL_F64, |g| g);
+    #[cfg(footprint = "earth-f32")]
+    exercise_earth(&core_math::GENERAL_F32, |g| g.to());
     platform::exit(0)
 }
