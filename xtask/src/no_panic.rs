@@ -20,19 +20,48 @@ use crate::target::{workspace_root, TARGET};
 
 /// The undefined function the check build's panic handlers call (firmware/src/platform.rs).
 const SYMBOL: &str = "NO_PANIC_CHECK__a_panic_path_is_reachable__see_docs_no_panic_md";
-/// The cargo arguments of the check build.
-const BUILD: [&str; 10] = [
-    "--package",
-    "firmware",
-    "--bin",
-    "firmware",
-    "--target",
-    TARGET,
-    "--release",
-    "--features",
-    "no-panic-check",
-    "--color=never",
+/// One link the proof covers: a binary of the firmware crate, the features of its check
+/// build (with `no-panic-check`), and extra rustc arguments.
+struct Build {
+    what: &'static str,
+    bin: &'static str,
+    features: &'static str,
+    rustc_args: &'static [&'static str],
+}
+
+/// The flight binary, and the real-Earth general form in f32 (its `pixel`, `update` and
+/// `motion`, linked by the footprint binary) until the controller flies it.
+const BUILDS: [Build; 2] = [
+    Build {
+        what: "the release flight binary",
+        bin: "firmware",
+        features: "no-panic-check",
+        rustc_args: &[],
+    },
+    Build {
+        what: "GENERAL_F32 (the real-Earth f32 form: pixel, update, motion)",
+        bin: "footprint",
+        features: "bench,no-panic-check",
+        rustc_args: &["--cfg", "footprint=\"earth-f32\""],
+    },
 ];
+
+impl Build {
+    fn cargo_args(&self) -> Vec<&'static str> {
+        vec![
+            "--package",
+            "firmware",
+            "--bin",
+            self.bin,
+            "--target",
+            TARGET,
+            "--release",
+            "--features",
+            self.features,
+            "--color=never",
+        ]
+    }
+}
 
 /// `cargo` as the one that started us, in the workspace root.
 fn cargo() -> Command {
@@ -41,14 +70,28 @@ fn cargo() -> Command {
     cmd
 }
 
-/// The proof: an error (naming the panic sites when it can) if the release flight binary
-/// still has a path to the panic handler.
+/// The proof: an error (naming the panic sites when it can) if a covered build still has
+/// a path to the panic handler.
 pub fn check() -> Result<(), String> {
+    for build in &BUILDS {
+        check_one(build)?;
+    }
+    Ok(())
+}
+
+fn check_one(build: &Build) -> Result<(), String> {
     let t0 = Instant::now();
-    eprintln!("\n==> no-panic proof: cargo build {}", BUILD.join(" "));
+    let args = build.cargo_args();
+    eprintln!(
+        "\n==> no-panic proof: cargo rustc {} -- {}",
+        args.join(" "),
+        build.rustc_args.join(" ")
+    );
     let out = cargo()
-        .arg("build")
-        .args(BUILD)
+        .arg("rustc")
+        .args(&args)
+        .arg("--")
+        .args(build.rustc_args)
         .stdout(Stdio::null())
         .output()
         .map_err(|e| format!("cannot start cargo: {e}"))?;
@@ -56,7 +99,8 @@ pub fn check() -> Result<(), String> {
     if out.status.success() {
         restore_flight_binary();
         eprintln!(
-            "xtask: no-panic proof passed: the release flight binary links with no path to a panic handler ({:.1} s)",
+            "xtask: no-panic proof passed: {} links with no path to a panic handler ({:.1} s)",
+            build.what,
             t0.elapsed().as_secs_f64()
         );
         return Ok(());
@@ -65,25 +109,28 @@ pub fn check() -> Result<(), String> {
         eprint!("{stderr}");
         return Err(format!("the no-panic check build failed ({})", out.status));
     }
-    let report = match diagnose() {
+    let report = match diagnose(build) {
         Ok(report) => report,
         Err(e) => format!("(could not name the panic sites: {e})\n"),
     };
     Err(format!(
-        "no-panic proof failed: the release flight binary can reach the panic handler \
+        "no-panic proof failed: {} can reach the panic handler \
          (link error: undefined symbol {SYMBOL}).\n{report}\
-         Remove each path (docs/no-panic.md) and rerun `cargo xtask test`."
+         Remove each path (docs/no-panic.md) and rerun `cargo xtask test`.",
+        build.what
     ))
 }
 
 /// Links the check build with the symbol unresolved, lists its panic sites, and puts the
 /// normal flight binary back in its place.
-fn diagnose() -> Result<String, String> {
+fn diagnose(build: &Build) -> Result<String, String> {
     let out = cargo()
         .arg("rustc")
-        .args(BUILD)
+        .args(build.cargo_args())
         .arg("--message-format=json-render-diagnostics")
-        .args(["--", "-C", "link-arg=--unresolved-symbols=ignore-all"])
+        .arg("--")
+        .args(build.rustc_args)
+        .args(["-C", "link-arg=--unresolved-symbols=ignore-all"])
         .stderr(Stdio::null())
         .output()
         .map_err(|e| format!("cannot start cargo: {e}"))?;
@@ -92,7 +139,7 @@ fn diagnose() -> Result<String, String> {
         let Ok(msg) = serde_json::from_str::<serde_json::Value>(line) else {
             continue;
         };
-        if msg["reason"] == "compiler-artifact" && msg["target"]["name"] == "firmware" {
+        if msg["reason"] == "compiler-artifact" && msg["target"]["name"] == build.bin {
             if let Some(path) = msg["executable"].as_str() {
                 elf = Some(PathBuf::from(path));
             }
