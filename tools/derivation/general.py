@@ -717,6 +717,11 @@ def run_case(check, info):
              f"{mp.nstr(row[1][1], 6):>9} {mp.nstr(row[0][2], 4):>9} {mp.nstr(row[1][2], 4):>7}")
     info("MTFd = |sinc(M |tan drift| / 2)| (drift smear across the line); MTFm = |sinc(M (1/cos(drift) - 1) / 2)|,")
     info("the mismatch a line period of pixel/|v_P| (Eq. 16) would add; prod = MTFd * MTFm; sinc(x) = sin(pi x)/(pi x)")
+    x95 = mp.findroot(lambda xv: sinc(xv) - mp.mpf("0.95"), mp.mpf("0.14"))
+    for Mst in (16, 48):
+        info(f"M = {Mst}: MTFd >= 0.95 needs M |tan drift| <= {mp.nstr(2 * x95, 4)} px, |drift| <= "
+             f"{mp.nstr(mp.degrees(mp.atan(2 * x95 / Mst)), 4)} deg; MTFd = 0 at 2 px, drift "
+             f"{mp.nstr(mp.degrees(mp.atan(mp.mpf(2) / Mst)), 4)} deg")
     # Yaw steering: the yaw that makes v2 = 0 at the nadir pixel of the paper's camera.
     base = circular_case(Rm, Hm, mp.mpf("97.98"), 0, 0, fm, 0, wr)
 
