@@ -6,10 +6,8 @@
 //! The numerical model (`motion`) shares no formula with `core_math`; on a sphere it
 //! reproduces `core_math::Reference` (its tests, and the validation line of the output).
 
-// The general model serves the tests only until the cost table uses it.
-#[cfg_attr(not(test), allow(dead_code))]
+mod costs;
 mod kepler;
-#[cfg_attr(not(test), allow(dead_code))]
 mod motion;
 
 use std::time::Instant;
@@ -38,6 +36,8 @@ const ROLLS_DEG: [f64; 3] = [-25.0, 0.0, 25.0];
 const DOC: &str = "docs/earth-model.md";
 const BEGIN: &str = "<!-- ellipsoid:begin (written by `cargo xtask ellipsoid`) -->";
 const END: &str = "<!-- ellipsoid:end -->";
+const COSTS_BEGIN: &str = "<!-- ellipsoid-costs:begin (written by `cargo xtask ellipsoid`) -->";
+const COSTS_END: &str = "<!-- ellipsoid-costs:end -->";
 const CMD: &str = "`cargo xtask ellipsoid`";
 
 /// Worst case and RMS of one error over a set of cases.
@@ -529,8 +529,13 @@ fn render(s: &EllipsoidSummary) -> Result<String, String> {
 }
 
 fn replace_block(doc: &str, block: &str) -> Option<String> {
-    let b = doc.find(BEGIN)?;
-    let e = doc[b..].find(END)? + b + END.len();
+    replace_between(doc, BEGIN, END, block)
+}
+
+/// `doc` with the text from `begin` to `end` (markers included) replaced by `block`.
+fn replace_between(doc: &str, begin: &str, end: &str, block: &str) -> Option<String> {
+    let b = doc.find(begin)?;
+    let e = doc[b..].find(end)? + b + end.len();
     Some(format!("{}{block}{}", &doc[..b], &doc[e..]))
 }
 
@@ -545,13 +550,18 @@ pub fn run(args: &[String]) -> Result<(), String> {
     let t0 = Instant::now();
     let s = summary()?;
     let block = render(&s)?;
+    let c = costs::costs(costs::Grid::FULL);
+    let costs_block = costs::render(&c, COSTS_BEGIN, COSTS_END, CMD);
     if print_only {
         println!("{block}");
+        println!("{costs_block}");
     } else {
         let path = crate::target::workspace_root().join(DOC);
         let doc = std::fs::read_to_string(&path).map_err(|e| format!("reading {DOC}: {e}"))?;
         let new =
             replace_block(&doc, &block).ok_or(format!("{DOC} lacks the ellipsoid markers"))?;
+        let new = replace_between(&new, COSTS_BEGIN, COSTS_END, &costs_block)
+            .ok_or(format!("{DOC} lacks the ellipsoid-costs markers"))?;
         std::fs::write(&path, new).map_err(|e| format!("writing {DOC}: {e}"))?;
         eprintln!("ellipsoid: wrote {DOC}");
     }

@@ -35,7 +35,9 @@
 //! `core_math::EarthReference` over the whole envelope.
 
 use core_math::earth::Attitude;
+use core_math::sample::SplitMix64;
 use core_math::{Camera, EarthCamera, EarthGeometry, ImageMotion, StateVector, GM_M3_S2};
+use core_math::{Ellipsoid, EARTH_RATE_RAD_S};
 
 use super::kepler::Kepler;
 
@@ -427,14 +429,90 @@ pub fn general_motion(
     general_motion_step(g, camera, n_px, GENERAL_STEP_S)
 }
 
+/// The inertial state at radius `r_m` on a two-body orbit of eccentricity `e` at true
+/// anomaly `nu_rad`, of inclination, node and argument of latitude as named (the perigee
+/// lies wherever the true anomaly puts it).
+pub fn eccentric_state(
+    r_m: f64,
+    e: f64,
+    nu_rad: f64,
+    incl_rad: f64,
+    raan_rad: f64,
+    arg_lat_rad: f64,
+) -> StateVector {
+    // Perifocal speeds at true anomaly nu: radial sqrt(GM/p) e sin nu, transverse
+    // sqrt(GM/p) (1 + e cos nu), p = r (1 + e cos nu).
+    let p = r_m * (1.0 + e * nu_rad.cos());
+    let k = (GM_M3_S2 / p).sqrt();
+    let (vr, vt) = (k * e * nu_rad.sin(), k * (1.0 + e * nu_rad.cos()));
+    let orbit = Orbit::circular(r_m, incl_rad, raan_rad);
+    let (pos, fr) = orbit.frame(arg_lat_rad);
+    StateVector {
+        position_m: pos,
+        velocity_mps: comb(vr, fr[2], vt, fr[0], 0.0, fr[1]),
+    }
+}
+
+/// One seeded draw of the general model's envelope (issue 11): WGS 84, altitude
+/// 200-2000 km above the ellipsoid's geocentric radius under the satellite,
+/// eccentricity 0-0.05 at any true anomaly (so any argument of perigee), inclination
+/// 0-180 deg with one draw in eight each exactly equatorial, polar and retrograde
+/// equatorial (and one polar draw in four exactly over a pole), roll and pitch within
+/// +-45 deg, any yaw, angle rates within +-2 deg/s, ground height -500 to 9000 m,
+/// focal length 0.3-1.5 m, pixel 5-20 um, p1 within +-0.05 m, field angle within
+/// +-40 deg.
+pub fn envelope_draw(rng: &mut SplitMix64) -> (EarthGeometry<f64>, EarthCamera, f64) {
+    let camera = EarthCamera {
+        focal_m: rng.uniform(0.3, 1.5),
+        pixel_m: rng.uniform(5e-6, 20e-6),
+        p1_m: rng.uniform(-0.05, 0.05),
+    };
+    let deg = f64::to_radians;
+    let incl = match rng.next_u64() % 8 {
+        0 => 0.0,
+        1 => 90.0,
+        2 => 180.0,
+        _ => rng.uniform(0.0, 180.0),
+    };
+    let mut arg_lat = rng.uniform(0.0, 360.0);
+    if incl == 90.0 && rng.next_u64().is_multiple_of(4) {
+        arg_lat = if rng.next_u64().is_multiple_of(2) {
+            90.0
+        } else {
+            270.0
+        };
+    }
+    let (incl, arg_lat) = (deg(incl), deg(arg_lat));
+    let raan = deg(rng.uniform(0.0, 360.0));
+    let e = rng.uniform(0.0, 0.05);
+    let nu = deg(rng.uniform(0.0, 360.0));
+    let lat = (incl.sin() * arg_lat.sin()).asin();
+    let r = Spheroid::WGS84.geocentric_radius_m(lat) + rng.uniform(200e3, 2000e3);
+    let state = eccentric_state(r, e, nu, incl, raan, arg_lat);
+    let attitude = Attitude {
+        roll_rad: deg(rng.uniform(-45.0, 45.0)),
+        pitch_rad: deg(rng.uniform(-45.0, 45.0)),
+        yaw_rad: deg(rng.uniform(-180.0, 180.0)),
+        roll_rate_rad_s: deg(rng.uniform(-2.0, 2.0)),
+        pitch_rate_rad_s: deg(rng.uniform(-2.0, 2.0)),
+        yaw_rate_rad_s: deg(rng.uniform(-2.0, 2.0)),
+    };
+    let g = EarthGeometry {
+        state,
+        attitude,
+        ground_h_m: rng.uniform(-500.0, 9000.0),
+        ellipsoid: Ellipsoid::WGS84,
+        earth_rate_rad_s: EARTH_RATE_RAD_S,
+    };
+    let n_px = deg(rng.uniform(-40.0, 40.0)).tan() * camera.focal_m / camera.pixel_m;
+    (g, camera, n_px)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use core_math::earth::limb_margin_rad;
-    use core_math::sample::SplitMix64;
-    use core_math::{
-        Backend, EarthReference, Ellipsoid, Geometry, ModelError, Reference, EARTH_RATE_RAD_S,
-    };
+    use core_math::{Backend, EarthReference, Geometry, ModelError, Reference};
 
     const CAMERA: Camera = Camera {
         focal_m: 0.555,
@@ -568,71 +646,6 @@ mod tests {
         println!("WGS 84 vs sphere through the ground point: worst {worst:.2e}");
     }
 
-    /// One seeded draw of the general model's envelope (issue 11): WGS 84, altitude
-    /// 200-2000 km above the ellipsoid's geocentric radius under the satellite,
-    /// eccentricity 0-0.05 at any true anomaly (so any argument of perigee), inclination
-    /// 0-180 deg with one draw in eight each exactly equatorial, polar and retrograde
-    /// equatorial (and one polar draw in four exactly over a pole), roll and pitch within
-    /// +-45 deg, any yaw, angle rates within +-2 deg/s, ground height -500 to 9000 m,
-    /// focal length 0.3-1.5 m, pixel 5-20 um, p1 within +-0.05 m, field angle within
-    /// +-40 deg.
-    fn draw(rng: &mut SplitMix64) -> (EarthGeometry<f64>, EarthCamera, f64) {
-        let camera = EarthCamera {
-            focal_m: rng.uniform(0.3, 1.5),
-            pixel_m: rng.uniform(5e-6, 20e-6),
-            p1_m: rng.uniform(-0.05, 0.05),
-        };
-        let deg = f64::to_radians;
-        let incl = match rng.next_u64() % 8 {
-            0 => 0.0,
-            1 => 90.0,
-            2 => 180.0,
-            _ => rng.uniform(0.0, 180.0),
-        };
-        let mut arg_lat = rng.uniform(0.0, 360.0);
-        if incl == 90.0 && rng.next_u64().is_multiple_of(4) {
-            arg_lat = if rng.next_u64().is_multiple_of(2) {
-                90.0
-            } else {
-                270.0
-            };
-        }
-        let (incl, arg_lat) = (deg(incl), deg(arg_lat));
-        let raan = deg(rng.uniform(0.0, 360.0));
-        let e = rng.uniform(0.0, 0.05);
-        let nu = deg(rng.uniform(0.0, 360.0));
-        let lat = (incl.sin() * arg_lat.sin()).asin();
-        let r = Spheroid::WGS84.geocentric_radius_m(lat) + rng.uniform(200e3, 2000e3);
-        // Perifocal speeds at true anomaly nu: radial sqrt(GM/p) e sin nu, transverse
-        // sqrt(GM/p) (1 + e cos nu), p = r (1 + e cos nu).
-        let p = r * (1.0 + e * nu.cos());
-        let k = (GM_M3_S2 / p).sqrt();
-        let (vr, vt) = (k * e * nu.sin(), k * (1.0 + e * nu.cos()));
-        let orbit = Orbit::circular(r, incl, raan);
-        let (pos, fr) = orbit.frame(arg_lat);
-        let state = StateVector {
-            position_m: pos,
-            velocity_mps: comb(vr, fr[2], vt, fr[0], 0.0, fr[1]),
-        };
-        let attitude = Attitude {
-            roll_rad: deg(rng.uniform(-45.0, 45.0)),
-            pitch_rad: deg(rng.uniform(-45.0, 45.0)),
-            yaw_rad: deg(rng.uniform(-180.0, 180.0)),
-            roll_rate_rad_s: deg(rng.uniform(-2.0, 2.0)),
-            pitch_rate_rad_s: deg(rng.uniform(-2.0, 2.0)),
-            yaw_rate_rad_s: deg(rng.uniform(-2.0, 2.0)),
-        };
-        let g = EarthGeometry {
-            state,
-            attitude,
-            ground_h_m: rng.uniform(-500.0, 9000.0),
-            ellipsoid: Ellipsoid::WGS84,
-            earth_rate_rad_s: EARTH_RATE_RAD_S,
-        };
-        let n_px = deg(rng.uniform(-40.0, 40.0)).tan() * camera.focal_m / camera.pixel_m;
-        (g, camera, n_px)
-    }
-
     /// |dv| / |v|: hypot of the component differences over the reference's hypot.
     fn rel_hypot(x: &ImageMotion<f64>, r: &ImageMotion<f64>) -> f64 {
         (x.v1_mps - r.v1_mps).hypot(x.v2_mps - r.v2_mps) / r.v1_mps.hypot(r.v2_mps)
@@ -689,7 +702,7 @@ mod tests {
         worst_p0_m: f64,
     }
 
-    /// The two routes over `cases` seeded draws ([`draw`], one in four moved to
+    /// The two routes over `cases` seeded draws ([`envelope_draw`], one in four moved to
     /// 0.01-5 deg of the limb, a quarter of those outside it), the numerical model with
     /// stencil unit `step_s`. Panics when the two disagree on a clear hit or miss, or a
     /// ground point does not project back onto its pixel.
@@ -698,7 +711,7 @@ mod tests {
         let mut o = TwoRoute::default();
         let deg = f64::to_degrees;
         for case in 0..cases {
-            let (mut g, cam, n) = draw(&mut rng);
+            let (mut g, cam, n) = envelope_draw(&mut rng);
             if rng.next_u64().is_multiple_of(4) {
                 let m = 10f64.powf(rng.uniform(-2.0, 5f64.log10())).to_radians();
                 let m = if rng.next_u64().is_multiple_of(4) {
@@ -788,7 +801,7 @@ mod tests {
     /// The two-route test: `core_math::EarthReference` (the construction on dual
     /// numbers, the golden source) against this module's general model (Kepler
     /// propagation, nine-point finite difference), |dv| / |v| <= 1e-9 over 20 000 seeded
-    /// draws of the envelope ([`draw`], a quarter of them moved near the limb). A clear
+    /// draws of the envelope ([`envelope_draw`], a quarter of them moved near the limb). A clear
     /// miss (0.5 deg or more outside the limb, `core_math::earth::limb_margin_rad`) must
     /// be a miss for both routes, a clear hit a hit for both; within 0.5 deg of the limb
     /// the cases are counted and excluded from the bound. The ground point must project
