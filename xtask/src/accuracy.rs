@@ -3,10 +3,12 @@
 //! distance from the line of sight to the Earth's limb, with the problem's condition
 //! number. The figures in docs/accuracy.md come from this command.
 
+mod earth;
+
 use core_math::{Backend, Camera, Geometry, Reference, CLOSED_F32, CLOSED_F64};
 
 /// Unit roundoff of f32.
-const U32: f64 = f32::EPSILON as f64 / 2.0;
+pub(crate) const U32: f64 = f32::EPSILON as f64 / 2.0;
 
 /// Limb-margin buckets (deg): a case falls in the first bucket whose lower bound it meets.
 /// Shared with `stability`'s limb table, so that the two documents' bands are the same.
@@ -41,13 +43,27 @@ struct Stat {
 
 pub fn run(args: &[String]) -> Result<(), String> {
     let quick = args.iter().any(|a| a == "--quick");
+    let mut it = args.iter();
+    let mut model = "sphere";
+    while let Some(a) = it.next() {
+        match a.as_str() {
+            "--quick" => {}
+            "--model" => model = it.next().map(String::as_str).unwrap_or(""),
+            other => return Err(format!("accuracy: unknown argument `{other}`")),
+        }
+    }
+    match model {
+        "sphere" => {}
+        "earth" => return earth::run(quick),
+        other => return Err(format!("accuracy: unknown model `{other}` (sphere|earth)")),
+    }
     let t0 = std::time::Instant::now();
     let stats = sweep(quick);
     print_report(&stats, quick, t0.elapsed().as_secs_f64());
     Ok(())
 }
 
-fn bucket(margin_deg: f64) -> usize {
+pub(crate) fn bucket(margin_deg: f64) -> usize {
     BUCKETS_DEG
         .iter()
         .position(|(lo, _)| margin_deg >= *lo)

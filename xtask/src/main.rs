@@ -22,7 +22,7 @@ const USAGE: &str = "usage: cargo xtask <command>
 commands:
   eval [--model sphere|earth] --backend <reference|f64|f32|fixed> --input CASES.csv
                                                          evaluate cases, CSV to stdout (earth: no fixed)
-  accuracy [--quick]                                     f32/f64 error sweep against the reference
+  accuracy [--quick] [--model sphere|earth]              f32/f64 error sweep against the reference
   paper                                                  regenerate docs/paper/ (Figs. 5-8)
   test                                                   every check CI runs
   run [--short] [--telemetry FILE.csv] [--debug]         a pass through the firmware under QEMU (docs/telemetry.md)
