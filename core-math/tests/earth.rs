@@ -102,7 +102,10 @@ fn general_f32_matches_the_reference() {
         }
         let e = rel(&s, &r);
         let kappa = earth_kappa(&c.camera, &c.geometry, c.n_px).unwrap();
-        assert!(e <= EARTH_F32_KAPPA_C * kappa * U32, "{e:e}, kappa {kappa}: {c:?}");
+        assert!(
+            e <= EARTH_F32_KAPPA_C * kappa * U32,
+            "{e:e}, kappa {kappa}: {c:?}"
+        );
         ratio = ratio.max(e / (kappa * U32));
         if kappa > EARTH_F32_KAPPA_LIMIT {
             n_stiff += 1;
@@ -374,4 +377,65 @@ fn state_vectors_with_no_orbit_plane_are_refused() {
     // The model marker is what picks the interface.
     fn takes_earth<B: Backend<Earth>>(_: &B) {}
     takes_earth(&GENERAL_F32);
+}
+
+/// One general case against 50-digit values of the literal construction computed with
+/// mpmath by `tools/derivation/general.py` (an independent route: no Rust, dual numbers
+/// in 60-digit arithmetic, the textbook root), its inputs the binary64 roundings of:
+/// r = (-2 100 000, 4 800 000, 4 600 000) m, v = (3 198, -3 995, 5 689) m/s (e = 0.0247,
+/// i = 97.5 deg), roll 20.5, pitch -7.25, yaw 3.5 deg, rates 0.05, -0.025, 0.0125 deg/s,
+/// ground 1 500 m, f 0.75 m, pixel 2^-16 m, n_px 12 000, p1 2^-9 m, WGS 84.
+#[test]
+// The golden digits are kept as the script printed them; f64 reads the nearest value.
+#[allow(clippy::excessive_precision)]
+fn a_general_case_against_fifty_digits() {
+    let rad = f64::to_radians;
+    let camera = EarthCamera {
+        focal_m: 0.75,
+        pixel_m: 1.0 / 65_536.0,
+        p1_m: 1.0 / 512.0,
+    };
+    let geometry = EarthGeometry {
+        state: StateVector {
+            position_m: [-2_100_000.0, 4_800_000.0, 4_600_000.0],
+            velocity_mps: [3_198.0, -3_995.0, 5_689.0],
+        },
+        attitude: Attitude {
+            roll_rad: rad(20.5),
+            pitch_rad: rad(-7.25),
+            yaw_rad: rad(3.5),
+            roll_rate_rad_s: rad(0.05),
+            pitch_rate_rad_s: rad(-0.025),
+            yaw_rate_rad_s: rad(0.0125),
+        },
+        ground_h_m: 1_500.0,
+        ellipsoid: Ellipsoid::WGS84,
+        earth_rate_rad_s: 7.292_115_9e-5,
+    };
+    let golden = ImageMotion {
+        v1_mps: -0.007_525_801_788_036_971_655_592_857_871_333_662_575_986_491_042_137_6,
+        v2_mps: -0.000_256_250_906_440_766_936_231_590_627_015_827_919_704_291_544_252_33,
+    };
+    let r = EarthReference
+        .evaluate(&camera, &geometry, 12_000.0)
+        .unwrap();
+    let g = GENERAL_F64.evaluate(&camera, &geometry, 12_000.0).unwrap();
+    let s = GENERAL_F32
+        .evaluate(&camera, &geometry.to::<f32>(), 12_000.0)
+        .unwrap();
+    let s = ImageMotion {
+        v1_mps: f64::from(s.v1_mps),
+        v2_mps: f64::from(s.v2_mps),
+    };
+    assert!(rel(&r, &golden) < 1e-14, "reference {:e}", rel(&r, &golden));
+    assert!(
+        rel(&g, &golden) < 1e-14,
+        "general f64 {:e}",
+        rel(&g, &golden)
+    );
+    assert!(
+        rel(&s, &golden) < 1e-6,
+        "general f32 {:e}",
+        rel(&s, &golden)
+    );
 }
