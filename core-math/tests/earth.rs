@@ -293,6 +293,18 @@ fn every_bad_input_gives_its_typed_error_on_every_backend() {
         g.ground_h_m = h;
         expect(&cam, &g, 0.0, ModelError::InvalidInput(p));
     }
+    // F6 (docs/fuzzing.md): a subnormal pixel pitch rounded to 0 in f32 gave a zero
+    // line period; below 1 nm it is out of the domain on every backend.
+    let tiny_pixel = EarthCamera {
+        pixel_m: 3.035_577_859_16e-312,
+        ..cam
+    };
+    expect(
+        &tiny_pixel,
+        &geo,
+        0.0,
+        ModelError::OutOfDomain(Param::PixelPitch),
+    );
     let mut g = geo;
     g.state.position_m = [0.0; 3];
     expect(&cam, &g, 0.0, ModelError::DegenerateState);

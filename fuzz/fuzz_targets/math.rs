@@ -1,5 +1,6 @@
-//! core-math on arbitrary inputs: every backend's `evaluate`, `mtf_mismatch`,
-//! `StageRule::max_stages`, `line_period_s` and `line_period_ticks`.
+//! core-math on arbitrary inputs: every backend's `evaluate` (the round-Earth and the
+//! real-Earth models), `mtf_mismatch`, `StageRule::max_stages`, `line_period_s` and
+//! `line_period_ticks`.
 //!
 //! Oracles: no panic (the crate promises "no panics on any input"), every `Ok` value
 //! finite, `line_period_ticks` within half a tick (plus rounding) of period x clock,
@@ -11,6 +12,7 @@
 #![no_main]
 
 use arbitrary::Arbitrary;
+use core_math::earth::{Attitude, EarthCamera, EarthGeometry, Ellipsoid};
 use core_math::fixed_point::{geometry_from_f64, motion_to_f64};
 use core_math::{
     line_period_s, line_period_ticks, mtf_mismatch, Backend, Camera, Geometry, ImageMotion, Real,
@@ -62,6 +64,82 @@ struct Input {
     stage_limit: u32,
     period_s: V,
     clock_hz: V,
+    earth: EarthInput,
+}
+
+/// The real-Earth model's inputs. `near_earth` maps the state into orbit-like ranges
+/// (radius 6.3e6-9e6 m, speed up to 1.2e4 m/s) so that the arithmetic is reached, not
+/// only the refusals; `wgs84` fixes the Earth.
+#[derive(Arbitrary, Debug)]
+struct EarthInput {
+    near_earth: bool,
+    wgs84: bool,
+    r: [V; 3],
+    v: [V; 3],
+    angles: [V; 3],
+    rates: [V; 3],
+    ground_h: V,
+    a: V,
+    flattening: V,
+    earth_rate: V,
+    focal_m: V,
+    pixel_m: V,
+    p1_m: V,
+    n_px: V,
+}
+
+fn earth(e: &EarthInput) -> (EarthCamera, EarthGeometry<f64>, f64) {
+    let (r_lim, v_lim) = if e.near_earth {
+        (9.0e6, 1.2e4)
+    } else {
+        (1.1e9, 1.1e5)
+    };
+    let ellipsoid = if e.wgs84 {
+        Ellipsoid::WGS84
+    } else {
+        Ellipsoid {
+            a_m: e.a.get(-1.0e3, 1.1e8),
+            flattening: e.flattening.get(-0.1, 1.1),
+        }
+    };
+    let geometry = EarthGeometry {
+        state: core_math::StateVector {
+            position_m: e.r.map(|x| x.get(-r_lim, r_lim)),
+            velocity_mps: e.v.map(|x| x.get(-v_lim, v_lim)),
+        },
+        attitude: Attitude {
+            roll_rad: e.angles[0].get(-1.1e5, 1.1e5),
+            pitch_rad: e.angles[1].get(-1.6, 1.6),
+            yaw_rad: e.angles[2].get(-4.0, 4.0),
+            roll_rate_rad_s: e.rates[0].get(-1.1, 1.1),
+            pitch_rate_rad_s: e.rates[1].get(-1.1, 1.1),
+            yaw_rate_rad_s: e.rates[2].get(-1.1, 1.1),
+        },
+        ground_h_m: e.ground_h.get(-7.0e6, 2.0e4),
+        ellipsoid,
+        earth_rate_rad_s: e.earth_rate.get(-1.1, 1.1),
+    };
+    let camera = EarthCamera {
+        focal_m: e.focal_m.get(0.0, 1.1e3),
+        pixel_m: e.pixel_m.get(0.0, 1.1),
+        p1_m: e.p1_m.get(-1.0, 1.0),
+    };
+    (camera, geometry, e.n_px.get(-1.0e6, 1.0e6))
+}
+
+/// An `Ok` of the real-Earth model: finite motion, v1 != 0, and derived outputs (the
+/// line period pixel/|v1| and the drift atan(v2/v1)) finite.
+fn check_earth<T: Real>(m: &ImageMotion<T>, pixel_m: f64, what: &str, e: &EarthInput) {
+    assert!(
+        m.v1_mps.is_finite() && m.v2_mps.is_finite() && m.speed_mps().is_finite(),
+        "{what}: Ok but non-finite motion {m:?} for {e:?}"
+    );
+    let period = core_math::earth::line_period_s(T::from_f64(pixel_m), m);
+    assert!(
+        period.is_finite() && period > T::ZERO,
+        "{what}: line period {period:?} for {e:?}"
+    );
+    assert!(m.drift_rad().is_finite(), "{what}: drift for {e:?}");
 }
 
 fn check_motion<T: Real>(m: &ImageMotion<T>, what: &str, input: &Input) {
@@ -159,6 +237,19 @@ fuzz_target!(|input: Input| {
             if let Ok(m) = FIXED.evaluate(&camera, &gf, n_px) {
                 check_motion(&motion_to_f64(&m), "FIXED", &input);
             }
+        }
+    }
+
+    {
+        let (ec, eg, en) = earth(&input.earth);
+        if let Ok(m) = core_math::EarthReference.evaluate(&ec, &eg, en) {
+            check_earth(&m, ec.pixel_m, "EarthReference", &input.earth);
+        }
+        if let Ok(m) = core_math::GENERAL_F64.evaluate(&ec, &eg, en) {
+            check_earth(&m, ec.pixel_m, "GENERAL_F64", &input.earth);
+        }
+        if let Ok(m) = core_math::GENERAL_F32.evaluate(&ec, &eg.to::<f32>(), en) {
+            check_earth(&m, ec.pixel_m, "GENERAL_F32", &input.earth);
         }
     }
 

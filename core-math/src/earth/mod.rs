@@ -165,6 +165,11 @@ pub struct Ground {
     pub c_m2: f64,
 }
 
+/// Smallest focal length and pixel pitch accepted (m): a pitch below 1 nm would round to
+/// a subnormal or to 0 in f32 and give a zero line period (fuzz finding F6,
+/// docs/fuzzing.md); nothing real comes near either bound.
+pub const MIN_FOCAL_M: f64 = 1.0e-6;
+pub const MIN_PIXEL_M: f64 = 1.0e-9;
 /// Largest |r| accepted (m): beyond the Moon, and no overflow anywhere in f32.
 pub const MAX_POSITION_M: f64 = 1.0e9;
 /// Largest |v| accepted (m/s).
@@ -214,10 +219,10 @@ impl EarthCamera {
         if !(self.pixel_m > 0.0) {
             return Err(ModelError::InvalidInput(Param::PixelPitch));
         }
-        if self.focal_m > domain::MAX_FOCAL_M {
+        if !(MIN_FOCAL_M..=domain::MAX_FOCAL_M).contains(&self.focal_m) {
             return Err(ModelError::OutOfDomain(Param::FocalLength));
         }
-        if self.pixel_m > domain::MAX_PIXEL_M {
+        if !(MIN_PIXEL_M..=domain::MAX_PIXEL_M).contains(&self.pixel_m) {
             return Err(ModelError::OutOfDomain(Param::PixelPitch));
         }
         let p2 = n_px * self.pixel_m;
