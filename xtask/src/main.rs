@@ -31,7 +31,8 @@ commands:
   bench                                                  guest instructions per evaluation (QEMU plugin)
   report [--csv] [--cases N] [--seed S] [--no-bench]     error against run time per backend (runs the bench)
   stability [--quick]                                    regenerate docs/stability.md and its maps
-  ellipsoid [--print]                                    round-Earth model error against WGS 84 (default scene)
+  ellipsoid [--print]                                    round-Earth model error against WGS 84, cost of each
+                                                         simplification against the real-Earth model
   qemu ELF                                               cargo runner: ELF under QEMU, defmt decoded
 ";
 
