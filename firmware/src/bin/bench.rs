@@ -287,7 +287,12 @@ fn earth_regions() -> Result<(), FirmwareError> {
         |g| GENERAL_F32.update(g),
     );
     region(
-        "EarthGeometry::validate (f32 attitude; part of GENERAL_F32 update)",
+        "EarthGeometry::check_inputs (f32 attitude; part of GENERAL_F32 update)",
+        &e32,
+        |g| g.check_inputs(),
+    );
+    region(
+        "EarthGeometry::validate (every check in f64: the reference's; not on the f32 path)",
         &e32,
         |g| g.validate(),
     );
