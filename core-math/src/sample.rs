@@ -89,17 +89,9 @@ impl SplitMix64 {
         let arg_lat = self.uniform(0.0, core::f64::consts::TAU);
         let state = eccentric_state(radius_m, e, true_anomaly, incl, raan, arg_lat);
         let deg = |x: f64| x.to_radians();
-        let attitude = Attitude {
-            roll_rad: deg(self.uniform(-45.0, 45.0)),
-            pitch_rad: deg(self.uniform(-45.0, 45.0)),
-            yaw_rad: deg(self.uniform(-180.0, 180.0)),
-            roll_rate_rad_s: deg(self.uniform(-2.0, 2.0)),
-            pitch_rate_rad_s: deg(self.uniform(-2.0, 2.0)),
-            yaw_rate_rad_s: deg(self.uniform(-2.0, 2.0)),
-        };
         let geometry = EarthGeometry {
             state,
-            attitude,
+            attitude: self.earth_attitude(),
             ground_h_m: self.uniform(-500.0, 9000.0),
             ellipsoid: Ellipsoid::WGS84,
             earth_rate_rad_s: crate::EARTH_RATE_RAD_S,
@@ -119,6 +111,22 @@ impl SplitMix64 {
             case.geometry.attitude.roll_rad = roll_at_limb_margin(&case, margin, side)?;
         }
         Some(case)
+    }
+}
+
+impl SplitMix64 {
+    /// An attitude of the real-Earth envelope: roll and pitch within +/-45 deg, any yaw,
+    /// each rate within +/-2 deg/s (drawn in that order).
+    pub fn earth_attitude(&mut self) -> Attitude<f64> {
+        let deg = |x: f64| x.to_radians();
+        Attitude {
+            roll_rad: deg(self.uniform(-45.0, 45.0)),
+            pitch_rad: deg(self.uniform(-45.0, 45.0)),
+            yaw_rad: deg(self.uniform(-180.0, 180.0)),
+            roll_rate_rad_s: deg(self.uniform(-2.0, 2.0)),
+            pitch_rate_rad_s: deg(self.uniform(-2.0, 2.0)),
+            yaw_rate_rad_s: deg(self.uniform(-2.0, 2.0)),
+        }
     }
 }
 

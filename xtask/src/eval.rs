@@ -64,13 +64,8 @@ pub fn run(args: &[String]) -> Result<(), String> {
 pub fn eval_csv(backend: &str, text: &str) -> Result<String, String> {
     let table = Table::parse(text)?;
     let cols = table.columns(&INPUT_COLUMNS)?;
-    let mut out = String::new();
-    out.push_str(&table.header.join(","));
-    out.push(',');
-    out.push_str(&OUTPUT_COLUMNS.join(","));
-    out.push('\n');
-    for row in &table.rows {
-        let result = parse_case(row, &cols).and_then(|case| match backend {
+    write_rows(&table, &OUTPUT_COLUMNS, |row| {
+        parse_case(row, &cols).and_then(|case| match backend {
             "reference" => evaluate(&Reference, &case, |g| g),
             "f64" => evaluate(&CLOSED_F64, &case, |g| g),
             "f32" => evaluate(&CLOSED_F32, &case, |g| g.to::<f32>()),
@@ -78,17 +73,28 @@ pub fn eval_csv(backend: &str, text: &str) -> Result<String, String> {
             other => Err(EvalError::Usage(format!(
                 "unknown backend `{other}` (reference|f64|f32|fixed)"
             ))),
-        });
-        let outputs = match result {
-            Ok(nums) => format!("{},{},{},{},", nums[0], nums[1], nums[2], nums[3]),
-            Err(EvalError::Model(e)) => format!(",,,,{}", e.name()),
-            Err(EvalError::Unparsable) => ",,,,unparsable_input".to_string(),
+        })
+    })
+}
+
+/// The output text: the input header and `outputs` (the last of which is `error`), then
+/// each input row as given followed by its numbers and an empty error, or by empty
+/// numbers and the error's name. Stops at the first usage error.
+fn write_rows<const N: usize>(
+    table: &Table,
+    outputs: &[&str],
+    mut eval_row: impl FnMut(&[String]) -> Result<[String; N], EvalError>,
+) -> Result<String, String> {
+    let mut out = format!("{},{}\n", table.header.join(","), outputs.join(","));
+    let empty = ",".repeat(N);
+    for row in &table.rows {
+        let tail = match eval_row(row) {
+            Ok(nums) => format!("{},", nums.join(",")),
+            Err(EvalError::Model(e)) => format!("{empty}{}", e.name()),
+            Err(EvalError::Unparsable) => format!("{empty}unparsable_input"),
             Err(EvalError::Usage(msg)) => return Err(msg),
         };
-        out.push_str(&row.join(","));
-        out.push(',');
-        out.push_str(&outputs);
-        out.push('\n');
+        out.push_str(&format!("{},{tail}\n", row.join(",")));
     }
     Ok(out)
 }

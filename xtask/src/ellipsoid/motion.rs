@@ -489,14 +489,7 @@ pub fn envelope_draw(rng: &mut SplitMix64) -> (EarthGeometry<f64>, EarthCamera, 
     let lat = (incl.sin() * arg_lat.sin()).asin();
     let r = Spheroid::WGS84.geocentric_radius_m(lat) + rng.uniform(200e3, 2000e3);
     let state = eccentric_state(r, e, nu, incl, raan, arg_lat);
-    let attitude = Attitude {
-        roll_rad: deg(rng.uniform(-45.0, 45.0)),
-        pitch_rad: deg(rng.uniform(-45.0, 45.0)),
-        yaw_rad: deg(rng.uniform(-180.0, 180.0)),
-        roll_rate_rad_s: deg(rng.uniform(-2.0, 2.0)),
-        pitch_rate_rad_s: deg(rng.uniform(-2.0, 2.0)),
-        yaw_rate_rad_s: deg(rng.uniform(-2.0, 2.0)),
-    };
+    let attitude = rng.earth_attitude();
     let g = EarthGeometry {
         state,
         attitude,

@@ -72,28 +72,13 @@ pub fn eval_csv(backend: &str, text: &str) -> Result<String, String> {
         .iter()
         .map(|(name, _)| table.header.iter().position(|h| h == name))
         .collect();
-    let mut out = table.header.join(",");
-    out.push(',');
-    out.push_str(&OUTPUT_COLUMNS.join(","));
-    out.push('\n');
-    for row in &table.rows {
-        let result = parse_case(row, &required, &optional).and_then(|case| match backend {
+    super::write_rows(&table, &OUTPUT_COLUMNS, |row| {
+        parse_case(row, &required, &optional).and_then(|case| match backend {
             "reference" => evaluate(&EarthReference, &case, |g| g),
             "f64" => evaluate(&GENERAL_F64, &case, |g| g),
             _ => evaluate(&GENERAL_F32, &case, |g| g.to::<f32>()),
-        });
-        let outputs = match result {
-            Ok(n) => format!("{},{},{},{},{},", n[0], n[1], n[2], n[3], n[4]),
-            Err(EvalError::Model(e)) => format!(",,,,,{}", e.name()),
-            Err(EvalError::Unparsable) => ",,,,,unparsable_input".to_string(),
-            Err(EvalError::Usage(msg)) => return Err(msg),
-        };
-        out.push_str(&row.join(","));
-        out.push(',');
-        out.push_str(&outputs);
-        out.push('\n');
-    }
-    Ok(out)
+        })
+    })
 }
 
 fn parse_case(
