@@ -234,7 +234,7 @@ impl Map {
 
 /// Sub-sample `s` of `sub`: offsets in (0, 1) within the cell, stratified in x and
 /// spread by the golden ratio in y (deterministic).
-fn jitter(s: usize, sub: usize) -> (f64, f64) {
+pub fn jitter(s: usize, sub: usize) -> (f64, f64) {
     let fx = (s as f64 + 0.5) / sub as f64;
     let fy = (0.5 + s as f64 * 0.618_033_988_749_894_9).fract();
     (fx, fy)

@@ -1,0 +1,851 @@
+//! The general (real-Earth) model's maps: `GENERAL_F32` against `EarthReference`, with
+//! the problem's componentwise condition number `earth_kappa` over its 19 inputs, and
+//! the measured bound err <= `EARTH_F32_KAPPA_C` kappa u32.
+//!
+//! Three maps at the default orbit (circular, 645 km above the WGS 84 equatorial radius,
+//! i0 97.98 deg unless the map spans the altitude): pitch x roll (yaw 0, and yaw 30 deg),
+//! altitude x limb margin, and pitch rate x roll rate (the rates that cancel the image
+//! motion). Error |dv|/|v|: hypot of the component differences over the reference's
+//! hypot(v1, v2), inputs as given in f64 (the f32 path rounds the attitude itself).
+
+use core_math::accuracy::{earth_kappa, EARTH_F32_KAPPA_C, EARTH_F32_REL_TOLERANCE};
+use core_math::earth::{circular_state, limb_margin_rad, Attitude, EarthCamera, EarthGeometry};
+use core_math::sample::{roll_at_limb_margin, EarthCase};
+use core_math::{Backend, EarthReference, Ellipsoid, EARTH_RATE_RAD_S, GENERAL_F32};
+
+use std::path::Path;
+
+use super::doc::{e2, sig};
+use super::maps::{jitter, I0_SSO_DEG};
+use super::point::U_F32;
+use crate::plot::heatmap::Heatmap;
+
+/// The paper's camera on the detector line through the optical axis.
+pub const CAMERA: EarthCamera = EarthCamera {
+    focal_m: 0.555,
+    pixel_m: 13e-6,
+    p1_m: 0.0,
+};
+/// The maps keep lines of sight at least this far inside the limb (deg): the bound
+/// err <= C kappa u32 is stated there (`core_math::accuracy::EARTH_F32_KAPPA_C`).
+pub const MIN_MARGIN_DEG: f64 = 0.01;
+/// Default altitude above the equatorial radius (km) and argument of latitude (deg).
+const H0_KM: f64 = 645.0;
+const G0_DEG: f64 = 45.0;
+/// Pixels across the swath (n_px): the two ends and the centre of a 60 000-pixel line.
+const PIXELS: [f64; 3] = [-30_000.0, 0.0, 30_000.0];
+
+/// A circular orbit at `h_km` above the WGS 84 equatorial radius, inclination `i0_deg`,
+/// argument of latitude `g0_deg`, with the attitude given (rad, rad/s).
+fn case(h_km: f64, i0_deg: f64, g0_deg: f64, attitude: Attitude<f64>, n_px: f64) -> EarthCase {
+    let e = Ellipsoid::WGS84;
+    EarthCase {
+        camera: CAMERA,
+        geometry: EarthGeometry {
+            state: circular_state(e.a_m + h_km * 1e3, i0_deg.to_radians(), g0_deg.to_radians()),
+            attitude,
+            ground_h_m: 0.0,
+            ellipsoid: e,
+            earth_rate_rad_s: EARTH_RATE_RAD_S,
+        },
+        n_px,
+    }
+}
+
+fn angles(roll_deg: f64, pitch_deg: f64, yaw_deg: f64) -> Attitude<f64> {
+    Attitude {
+        roll_rad: roll_deg.to_radians(),
+        pitch_rad: pitch_deg.to_radians(),
+        yaw_rad: yaw_deg.to_radians(),
+        ..Attitude::default()
+    }
+}
+
+/// One 2-D map of the general model.
+pub struct GSpec {
+    /// File stem under docs/stability/ and key in the document.
+    pub key: &'static str,
+    pub letter: &'static str,
+    pub title: &'static str,
+    pub x_label: &'static str,
+    pub y_label: &'static str,
+    pub x_range: (f64, f64),
+    pub y_range: (f64, f64),
+    pub y_decades: bool,
+    /// Cells and sub-samples per cell (full run).
+    pub nx: usize,
+    pub ny: usize,
+    pub sub: usize,
+    /// The case of sub-sample `s` at (x, y); None where the map has none.
+    pub case: fn(x: f64, y: f64, s: usize) -> Option<EarthCase>,
+    /// What the other variables are, for the document.
+    pub others: &'static str,
+}
+
+fn pitch_roll(yaw_deg: f64, pitch: f64, roll: f64, s: usize) -> EarthCase {
+    let n = PIXELS[s % PIXELS.len()];
+    case(H0_KM, I0_SSO_DEG, G0_DEG, angles(roll, pitch, yaw_deg), n)
+}
+
+/// Altitude x limb margin: the roll that puts the line of sight `10^y` deg inside the
+/// limb, for a pixel at either end of the line (the side of the roll), with the pitch,
+/// yaw and argument of latitude cycling over the sub-samples.
+fn altitude_limb(h_km: f64, log_margin_deg: f64, s: usize) -> Option<EarthCase> {
+    const PITCH: [f64; 3] = [0.0, 20.0, -30.0];
+    const YAW_G0: [(f64, f64); 2] = [(0.0, G0_DEG), (30.0, 135.0)];
+    let side = [1.0, -1.0][s % 2];
+    let (yaw, g0) = YAW_G0[(s / 2) % 2];
+    let pitch = PITCH[s % 3];
+    let mut c = case(
+        h_km,
+        I0_SSO_DEG,
+        g0,
+        angles(0.0, pitch, yaw),
+        side * PIXELS[2],
+    );
+    let margin = 10f64.powf(log_margin_deg).to_radians();
+    c.geometry.attitude.roll_rad = roll_at_limb_margin(&c, margin, side)?;
+    Some(c)
+}
+
+/// Pitch rate x roll rate (deg/s), the angles 0 (and roll 20, pitch -10 deg).
+fn rates(pitch_rate: f64, roll_rate: f64, s: usize) -> Option<EarthCase> {
+    let (roll, pitch) = [(0.0, 0.0), (20.0, -10.0)][(s / 3) % 2];
+    let mut a = angles(roll, pitch, 0.0);
+    a.roll_rate_rad_s = roll_rate.to_radians();
+    a.pitch_rate_rad_s = pitch_rate.to_radians();
+    Some(case(H0_KM, I0_SSO_DEG, G0_DEG, a, PIXELS[s % 3]))
+}
+
+pub const GMAPS: [GSpec; 5] = [
+    GSpec {
+        key: "general-pitch-roll",
+        letter: "D",
+        title: "pitch x roll, yaw 0",
+        x_label: "pitch (deg)",
+        y_label: "roll (deg)",
+        x_range: (-45.0, 45.0),
+        y_range: (-45.0, 45.0),
+        y_decades: false,
+        nx: 120,
+        ny: 120,
+        sub: 3,
+        case: |x, y, s| Some(pitch_roll(0.0, x, y, s)),
+        others: "645 km above the WGS 84 equatorial radius, circular, i0 97.98 deg, \
+                 g0 45 deg, yaw 0, no rates; n_px = -30 000, 0, 30 000 over the sub-samples",
+    },
+    GSpec {
+        key: "general-pitch-roll-yaw30",
+        letter: "D'",
+        title: "pitch x roll, yaw 30 deg",
+        x_label: "pitch (deg)",
+        y_label: "roll (deg)",
+        x_range: (-45.0, 45.0),
+        y_range: (-45.0, 45.0),
+        y_decades: false,
+        nx: 90,
+        ny: 90,
+        sub: 3,
+        case: |x, y, s| Some(pitch_roll(30.0, x, y, s)),
+        others: "as map D with yaw 30 deg",
+    },
+    GSpec {
+        key: "general-altitude-limb",
+        letter: "E",
+        title: "altitude x limb margin",
+        x_label: "altitude (km)",
+        y_label: "limb margin (deg)",
+        x_range: (200.0, 2000.0),
+        y_range: (-2.0, 1.0),
+        y_decades: true,
+        nx: 96,
+        ny: 96,
+        sub: 6,
+        case: altitude_limb,
+        others: "circular, i0 97.98 deg; n_px = +/-30 000 (35.1 deg field angle) on the side \
+                 of the roll, which is solved for the margin; pitch 0, 20, -30 deg; (yaw, g0) \
+                 (0, 45) and (30, 135) deg, cycling over the sub-samples; no rates",
+    },
+    GSpec {
+        key: "general-rates",
+        letter: "F",
+        title: "pitch rate x roll rate",
+        x_label: "pitch rate (deg/s)",
+        y_label: "roll rate (deg/s)",
+        x_range: (-2.0, 2.0),
+        y_range: (-2.0, 2.0),
+        y_decades: false,
+        nx: 120,
+        ny: 120,
+        sub: 6,
+        case: rates,
+        others: "645 km, circular, i0 97.98 deg, g0 45 deg; n_px = -30 000, 0, 30 000 at \
+                 roll = pitch = yaw = 0, then at roll 20, pitch -10 deg; yaw rate 0",
+    },
+    GSpec {
+        key: "general-rates-zoom",
+        letter: "F'",
+        title: "pitch rate x roll rate, the cancellation",
+        x_label: "pitch rate (deg/s)",
+        y_label: "roll rate (deg/s)",
+        x_range: (0.2, 1.0),
+        y_range: (-0.2, 0.2),
+        y_decades: false,
+        nx: 100,
+        ny: 50,
+        sub: 6,
+        case: rates,
+        others: "as map F",
+    },
+];
+
+/// What one case measures.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct GOutcome {
+    /// |dv| / |v| of GENERAL_F32 (attitude rounded to f32) against the reference.
+    pub err: f64,
+    /// |dv1| / |v1|: the line period's relative error (period = pixel / |v1|).
+    pub err_v1: f64,
+    pub kappa: f64,
+    pub margin_rad: f64,
+    /// |v| and v1 of the reference (m/s).
+    pub v: f64,
+    pub v1: f64,
+}
+
+impl GOutcome {
+    pub fn ratio(&self) -> f64 {
+        self.err / (self.kappa * U_F32)
+    }
+}
+
+pub enum GSkip {
+    /// Beyond the limb or within [`MIN_MARGIN_DEG`] of it.
+    Outside,
+    /// The reference accepts and the f32 backend refuses: a defect.
+    Refused,
+}
+
+pub fn evaluate(c: &EarthCase) -> Result<GOutcome, GSkip> {
+    let margin = limb_margin_rad(&c.geometry, &c.camera, c.n_px).map_err(|_| GSkip::Outside)?;
+    // Also NaN.
+    if margin.to_degrees().partial_cmp(&MIN_MARGIN_DEG) == Some(std::cmp::Ordering::Less)
+        || margin.is_nan()
+    {
+        return Err(GSkip::Outside);
+    }
+    let r = EarthReference
+        .evaluate(&c.camera, &c.geometry, c.n_px)
+        .map_err(|_| GSkip::Outside)?;
+    let m = GENERAL_F32
+        .evaluate(&c.camera, &c.geometry.to::<f32>(), c.n_px)
+        .map_err(|_| GSkip::Refused)?;
+    let kappa = earth_kappa(&c.camera, &c.geometry, c.n_px).map_err(|_| GSkip::Outside)?;
+    let (d1, d2) = (m.v1_mps as f64 - r.v1_mps, m.v2_mps as f64 - r.v2_mps);
+    let v = libm::hypot(r.v1_mps, r.v2_mps);
+    Ok(GOutcome {
+        err: libm::hypot(d1, d2) / v,
+        err_v1: d1.abs() / r.v1_mps.abs(),
+        kappa,
+        margin_rad: margin,
+        v,
+        v1: r.v1_mps,
+    })
+}
+
+/// Maxima over a cell's (or a set of cells') cases, with the case behind each.
+#[derive(Clone, Debug, Default)]
+pub struct GCell {
+    pub n: u64,
+    pub refused: u64,
+    pub err: f64,
+    pub err_v1: f64,
+    pub kappa: f64,
+    pub kappa_min: f64,
+    pub ratio: f64,
+    pub min_margin_rad: f64,
+    /// Cases with err above EARTH_F32_REL_TOLERANCE (2e-6), and the smallest kappa among them.
+    pub over_tol: u64,
+    pub over_tol_kappa_min: f64,
+    /// The largest error among the cases with kappa <= EARTH_F32_KAPPA_LIMIT and at least
+    /// 1 deg inside the limb (where the 2e-6 bound is stated).
+    pub err_tame: f64,
+    pub tame: Option<(EarthCase, GOutcome)>,
+    /// The largest |dv1|/|v1| where the drift is under 60 deg (|v1| >= |v|/2), and the case.
+    pub err_v1_steady: f64,
+    pub steady: Option<(EarthCase, GOutcome)>,
+    pub worst: Option<(EarthCase, GOutcome)>,
+    pub max_kappa: Option<(EarthCase, GOutcome)>,
+    pub max_err: Option<(EarthCase, GOutcome)>,
+    pub max_err_v1: Option<(EarthCase, GOutcome)>,
+}
+
+impl GCell {
+    pub fn empty() -> Self {
+        GCell {
+            kappa_min: f64::INFINITY,
+            min_margin_rad: f64::INFINITY,
+            over_tol_kappa_min: f64::INFINITY,
+            ..GCell::default()
+        }
+    }
+
+    fn add(&mut self, c: &EarthCase, o: &GOutcome) {
+        self.n += 1;
+        self.kappa_min = self.kappa_min.min(o.kappa);
+        self.min_margin_rad = self.min_margin_rad.min(o.margin_rad);
+        if o.err > EARTH_F32_REL_TOLERANCE {
+            self.over_tol += 1;
+            self.over_tol_kappa_min = self.over_tol_kappa_min.min(o.kappa);
+        }
+        if o.kappa <= core_math::accuracy::EARTH_F32_KAPPA_LIMIT
+            && o.margin_rad.to_degrees() >= 1.0
+            && o.err > self.err_tame
+        {
+            self.err_tame = o.err;
+            self.tame = Some((*c, *o));
+        }
+        if o.v1.abs() >= 0.5 * o.v && o.err_v1 > self.err_v1_steady {
+            self.err_v1_steady = o.err_v1;
+            self.steady = Some((*c, *o));
+        }
+        let keep = |best: &mut f64, slot: &mut Option<(EarthCase, GOutcome)>, v: f64| {
+            if slot.is_none() || v > *best {
+                *best = v;
+                *slot = Some((*c, *o));
+            }
+        };
+        keep(&mut self.ratio, &mut self.worst, o.ratio());
+        keep(&mut self.kappa, &mut self.max_kappa, o.kappa);
+        keep(&mut self.err, &mut self.max_err, o.err);
+        keep(&mut self.err_v1, &mut self.max_err_v1, o.err_v1);
+    }
+
+    /// Folds another cell (or aggregate) into this one.
+    pub fn merge(&mut self, o: &GCell) {
+        if o.n == 0 {
+            self.refused += o.refused;
+            return;
+        }
+        self.n += o.n;
+        self.refused += o.refused;
+        self.kappa_min = self.kappa_min.min(o.kappa_min);
+        self.min_margin_rad = self.min_margin_rad.min(o.min_margin_rad);
+        self.over_tol += o.over_tol;
+        self.over_tol_kappa_min = self.over_tol_kappa_min.min(o.over_tol_kappa_min);
+        if o.err_tame > self.err_tame {
+            self.err_tame = o.err_tame;
+            self.tame = o.tame;
+        }
+        if o.err_v1_steady > self.err_v1_steady {
+            self.err_v1_steady = o.err_v1_steady;
+            self.steady = o.steady;
+        }
+        let take = |best: &mut f64, slot: &mut Option<(EarthCase, GOutcome)>, v: f64, w| {
+            if slot.is_none() || v > *best {
+                *best = v;
+                *slot = w;
+            }
+        };
+        take(&mut self.ratio, &mut self.worst, o.ratio, o.worst);
+        take(&mut self.kappa, &mut self.max_kappa, o.kappa, o.max_kappa);
+        take(&mut self.err, &mut self.max_err, o.err, o.max_err);
+        take(
+            &mut self.err_v1,
+            &mut self.max_err_v1,
+            o.err_v1,
+            o.max_err_v1,
+        );
+    }
+}
+
+pub struct GMap {
+    pub spec: &'static GSpec,
+    pub nx: usize,
+    pub ny: usize,
+    pub sub: usize,
+    /// Row-major from the bottom row.
+    pub cells: Vec<GCell>,
+}
+
+impl GMap {
+    pub fn centre(&self, ix: usize, iy: usize) -> (f64, f64) {
+        let (x0, x1) = self.spec.x_range;
+        let (y0, y1) = self.spec.y_range;
+        (
+            x0 + (ix as f64 + 0.5) * (x1 - x0) / self.nx as f64,
+            y0 + (iy as f64 + 0.5) * (y1 - y0) / self.ny as f64,
+        )
+    }
+
+    /// All cells that pass `keep` (by cell centre) merged.
+    pub fn aggregate(&self, keep: impl Fn(f64, f64) -> bool) -> GCell {
+        let mut a = GCell::empty();
+        for iy in 0..self.ny {
+            for ix in 0..self.nx {
+                let (x, y) = self.centre(ix, iy);
+                if keep(x, y) {
+                    a.merge(&self.cells[iy * self.nx + ix]);
+                }
+            }
+        }
+        a
+    }
+
+    fn argmax(&self, f: impl Fn(&GCell) -> f64) -> Option<(usize, usize)> {
+        (0..self.cells.len())
+            .filter(|&i| self.cells[i].n > 0)
+            .max_by(|&a, &b| f(&self.cells[a]).total_cmp(&f(&self.cells[b])))
+            .map(|i| (i % self.nx, i / self.nx))
+    }
+}
+
+/// Sweeps `spec` with `nx` x `ny` cells and `sub` sub-samples per cell, on every core.
+pub fn sweep(spec: &'static GSpec, nx: usize, ny: usize, sub: usize) -> GMap {
+    let (x0, x1) = spec.x_range;
+    let (y0, y1) = spec.y_range;
+    let (dx, dy) = ((x1 - x0) / nx as f64, (y1 - y0) / ny as f64);
+    let cell = |ix: usize, iy: usize| {
+        let mut c = GCell::empty();
+        for s in 0..sub {
+            let (fx, fy) = jitter(s, sub);
+            let (x, y) = (x0 + (ix as f64 + fx) * dx, y0 + (iy as f64 + fy) * dy);
+            let Some(k) = (spec.case)(x, y, s) else {
+                continue;
+            };
+            match evaluate(&k) {
+                Ok(o) => c.add(&k, &o),
+                Err(GSkip::Outside) => {}
+                Err(GSkip::Refused) => c.refused += 1,
+            }
+        }
+        c
+    };
+    let workers = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let mut rows: Vec<Vec<GCell>> = vec![Vec::new(); ny];
+    std::thread::scope(|scope| {
+        let handles: Vec<_> = (0..workers)
+            .map(|w| {
+                let cell = &cell;
+                scope.spawn(move || {
+                    (w..ny)
+                        .step_by(workers)
+                        .map(|iy| (iy, (0..nx).map(|ix| cell(ix, iy)).collect::<Vec<_>>()))
+                        .collect::<Vec<_>>()
+                })
+            })
+            .collect();
+        for h in handles {
+            for (iy, row) in h.join().expect("sweep worker panicked") {
+                rows[iy] = row;
+            }
+        }
+    });
+    GMap {
+        spec,
+        nx,
+        ny,
+        sub,
+        cells: rows.into_iter().flatten().collect(),
+    }
+}
+
+/// Sweeps every general map: full grids, or every dimension divided by `coarse`.
+pub fn sweep_all(coarse: Option<usize>) -> Vec<GMap> {
+    GMAPS
+        .iter()
+        .map(|s| {
+            let c = coarse.unwrap_or(1);
+            sweep(s, s.nx / c, s.ny / c, s.sub)
+        })
+        .collect()
+}
+
+/// Err if a case at least [`MIN_MARGIN_DEG`] inside the limb breaks
+/// err <= EARTH_F32_KAPPA_C kappa u32, or the f32 backend refused a case the reference
+/// accepts.
+pub fn check_bounds(maps: &[GMap]) -> Vec<String> {
+    let mut bad = Vec::new();
+    for m in maps {
+        let a = m.aggregate(|_, _| true);
+        if a.ratio > EARTH_F32_KAPPA_C {
+            let at = a.worst.map(|(c, o)| describe(&c, &o)).unwrap_or_default();
+            bad.push(format!(
+                "{}: general f32 err/(kappa u) = {:.3} > {EARTH_F32_KAPPA_C} at {at}",
+                m.spec.key, a.ratio
+            ));
+        }
+        if a.refused > 0 {
+            bad.push(format!(
+                "{}: {} case(s) the reference accepts refused by GENERAL_F32",
+                m.spec.key, a.refused
+            ));
+        }
+    }
+    bad
+}
+
+/// Where a case is.
+pub fn describe(c: &EarthCase, o: &GOutcome) -> String {
+    let a = &c.geometry.attitude;
+    let r = c.geometry.state.position_m;
+    let h_km =
+        (libm::sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]) - c.geometry.ellipsoid.a_m) / 1e3;
+    let mut s = format!(
+        "H {h_km:.0} km, roll {:.2} deg, pitch {:.2} deg, yaw {:.0} deg",
+        a.roll_rad.to_degrees(),
+        a.pitch_rad.to_degrees(),
+        a.yaw_rad.to_degrees(),
+    );
+    if a.roll_rate_rad_s != 0.0 || a.pitch_rate_rad_s != 0.0 {
+        s.push_str(&format!(
+            ", roll rate {:.3} deg/s, pitch rate {:.3} deg/s",
+            a.roll_rate_rad_s.to_degrees(),
+            a.pitch_rate_rad_s.to_degrees()
+        ));
+    }
+    s.push_str(&format!(
+        ", n_px {:.0}; limb margin {} deg, |v| {} m/s, v1 {} m/s",
+        c.n_px,
+        sig(o.margin_rad.to_degrees()),
+        e2(o.v),
+        e2(o.v1)
+    ));
+    s
+}
+
+fn lg(x: f64) -> f64 {
+    x.max(1e-30).log10()
+}
+
+/// Writes the map's three PNGs (kappa, f32 error, err/(kappa u)) into `dir`.
+pub fn write_pngs(m: &GMap, dir: &Path) -> Result<(), String> {
+    let s = m.spec;
+    let kmax = m
+        .cells
+        .iter()
+        .filter(|c| c.n > 0)
+        .fold(1.0f64, |a, c| a.max(c.kappa));
+    type Value = fn(&GCell) -> f64;
+    /// File suffix, title, colour-bar label, z range (log10), value, bound on the bar.
+    type Panel = (
+        &'static str,
+        &'static str,
+        &'static str,
+        (f64, f64),
+        Value,
+        Option<f64>,
+    );
+    let panels: [Panel; 3] = [
+        (
+            "kappa",
+            "condition number kappa",
+            "kappa",
+            (0.0, lg(kmax).ceil().max(2.0)),
+            |c| lg(c.kappa),
+            Some(lg(core_math::accuracy::EARTH_F32_KAPPA_LIMIT)),
+        ),
+        (
+            "err-f32",
+            "f32 error |dv|/|v|",
+            "rel. error",
+            (-9.0, -3.0),
+            |c| lg(c.err),
+            Some(lg(EARTH_F32_REL_TOLERANCE)),
+        ),
+        (
+            "ratio-f32",
+            "f32: err / (kappa u)",
+            "err / (kappa u)",
+            (-3.0, 1.0),
+            |c| lg(c.ratio),
+            Some(lg(EARTH_F32_KAPPA_C)),
+        ),
+    ];
+    for (suffix, title, z_label, z, value, bound) in panels {
+        let mut h = Heatmap::new(
+            &format!("{}: {title}", s.letter),
+            s.x_label,
+            s.y_label,
+            z_label,
+            (m.nx, m.ny),
+            m.cells
+                .iter()
+                .map(|c| if c.n > 0 { Some(value(c)) } else { None })
+                .collect(),
+        )
+        .x_range(s.x_range.0, s.x_range.1)
+        .y_range(s.y_range.0, s.y_range.1)
+        .y_decades(s.y_decades)
+        .z_range(z.0, z.1)
+        .z_decades(true)
+        .missing_label("< 0.01 deg inside the limb");
+        if let Some(b) = bound {
+            h = h.z_mark(b);
+        }
+        if let Some((ix, iy)) = m.argmax(value) {
+            let (x, y) = m.centre(ix, iy);
+            h = h.mark(x, y);
+        }
+        let name = format!("{}-{suffix}.png", s.key);
+        h.save(&dir.join(name))?;
+    }
+    Ok(())
+}
+
+/// A 96-stage segment's line-period mismatch budget, 0.351 / 96 (`docs/derivation.md`).
+pub const SEGMENT_BUDGET: f64 = 0.351 / 96.0;
+
+const TABLE_HEADER: [&str; 11] = [
+    "map",
+    "cases",
+    "kappa min - max",
+    "f32 err \\|dv\\|/\\|v\\|",
+    "f32 err v1 (line period)",
+    "err, kappa <= 50 and >= 1 deg in",
+    "cases err > 2e-6",
+    "smallest kappa with err > 2e-6",
+    "max err/(kappa u)",
+    "min limb margin (deg)",
+    "refused",
+];
+
+fn row(name: &str, a: &GCell) -> Vec<String> {
+    vec![
+        name.to_string(),
+        a.n.to_string(),
+        format!("{} - {}", sig(a.kappa_min), sig(a.kappa)),
+        e2(a.err),
+        e2(a.err_v1),
+        if a.err_tame > 0.0 {
+            e2(a.err_tame)
+        } else {
+            "-".into()
+        },
+        a.over_tol.to_string(),
+        if a.over_tol > 0 {
+            sig(a.over_tol_kappa_min)
+        } else {
+            "-".into()
+        },
+        format!("{:.2}", a.ratio),
+        sig(a.min_margin_rad.to_degrees()),
+        a.refused.to_string(),
+    ]
+}
+
+/// Every value the document's general-model section quotes, by template key (`G.*`).
+pub fn figures(maps: &[GMap], secs: f64) -> std::collections::BTreeMap<String, String> {
+    let mut v = std::collections::BTreeMap::new();
+    let mut put = |k: &str, s: String| {
+        v.insert(k.to_string(), s);
+    };
+    put("G.secs", format!("{secs:.1}"));
+    put("G.c", format!("{EARTH_F32_KAPPA_C}"));
+    put("G.min_margin", format!("{MIN_MARGIN_DEG}"));
+    let mut rows = Vec::new();
+    let mut all = GCell::empty();
+    for m in maps {
+        let a = m.aggregate(|_, _| true);
+        let l = m.spec.letter.replace('\'', "y");
+        put(
+            &format!("{l}.grid"),
+            format!(
+                "{} x {} cells, {} sub-samples each, {} cases",
+                m.nx, m.ny, m.sub, a.n
+            ),
+        );
+        put(&format!("{l}.others"), m.spec.others.into());
+        put(&format!("{l}.key"), m.spec.key.into());
+        put(&format!("{l}.ratio"), format!("{:.2}", a.ratio));
+        put(&format!("{l}.kappa_max"), sig(a.kappa));
+        put(&format!("{l}.err"), e2(a.err));
+        put(&format!("{l}.err_v1"), e2(a.err_v1));
+        put(&format!("{l}.err_tame"), format!("{:.3e}", a.err_tame));
+        put(&format!("{l}.over_tol"), a.over_tol.to_string());
+        put(&format!("{l}.over_tol_kappa"), sig(a.over_tol_kappa_min));
+        for (what, w) in [
+            ("worst", &a.worst),
+            ("max_kappa", &a.max_kappa),
+            ("max_err", &a.max_err),
+            ("tame", &a.tame),
+            ("max_err_v1", &a.max_err_v1),
+        ] {
+            if let Some((c, o)) = w {
+                put(&format!("{l}.{what}.at"), describe(c, o));
+                put(&format!("{l}.{what}.kappa"), sig(o.kappa));
+                put(&format!("{l}.{what}.err"), e2(o.err));
+                put(&format!("{l}.{what}.ratio"), format!("{:.2}", o.ratio()));
+                put(&format!("{l}.{what}.err_v1"), e2(o.err_v1));
+                put(&format!("{l}.{what}.v"), e2(o.v));
+            }
+        }
+        rows.push(row(&format!("{}: {}", m.spec.letter, m.spec.title), &a));
+        all.merge(&a);
+    }
+    rows.push(row("all general maps", &all));
+    put("G.samples", all.n.to_string());
+    put("G.ratio", format!("{:.2}", all.ratio));
+    put("G.kappa_max", sig(all.kappa));
+    put("G.err", e2(all.err));
+    put("G.err_v1", e2(all.err_v1));
+    put("G.err_v1_steady", e2(all.err_v1_steady));
+    put(
+        "G.err_v1_steady_pct",
+        format!("{:.2}", 100.0 * all.err_v1_steady / SEGMENT_BUDGET),
+    );
+    put("G.err_tame", format!("{:.3e}", all.err_tame));
+    put("G.over_tol_kappa", sig(all.over_tol_kappa_min));
+    for (what, w) in [
+        ("worst", &all.worst),
+        ("max_err_v1", &all.max_err_v1),
+        ("steady", &all.steady),
+    ] {
+        if let Some((c, o)) = w {
+            put(&format!("G.{what}.at"), describe(c, o));
+            put(&format!("G.{what}.kappa"), sig(o.kappa));
+            put(&format!("G.{what}.err"), e2(o.err));
+            put(&format!("G.{what}.err_v1"), e2(o.err_v1));
+            put(&format!("G.{what}.v"), e2(o.v));
+            put(&format!("G.{what}.v1"), e2(o.v1));
+            put(
+                &format!("G.{what}.period_ms"),
+                sig(1e3 * CAMERA.pixel_m / o.v1.abs()),
+            );
+        }
+    }
+    put("G.table", super::doc::table(&TABLE_HEADER, &rows));
+    put(
+        "G.bound_line",
+        format!(
+            "general model (>= {MIN_MARGIN_DEG} deg inside the limb): max err/(kappa u32) {:.2}, \
+             bound {EARTH_F32_KAPPA_C}; max kappa {}; max f32 err {} (line period {})",
+            all.ratio,
+            sig(all.kappa),
+            e2(all.err),
+            e2(all.err_v1)
+        ),
+    );
+    // The line period against a 96-stage segment's budget.
+    put("G.budget", format!("{SEGMENT_BUDGET:.2e}"));
+    put(
+        "G.budget_pct",
+        format!("{:.2}", 100.0 * all.err_v1 / SEGMENT_BUDGET),
+    );
+    put(
+        "G.budget_kappa",
+        sig(SEGMENT_BUDGET / (EARTH_F32_KAPPA_C * U_F32)),
+    );
+    put(
+        "G.tol_kappa",
+        format!(
+            "{:.0}",
+            EARTH_F32_REL_TOLERANCE / (EARTH_F32_KAPPA_C * U_F32)
+        ),
+    );
+
+    // Map E by limb-margin band.
+    if let Some(e) = maps.iter().find(|m| m.spec.letter == "E") {
+        let bands = [
+            (-2.0, -1.0, "0.01 - 0.1 deg"),
+            (-1.0, 0.0, "0.1 - 1 deg"),
+            (0.0, 1.0, "1 - 10 deg"),
+        ];
+        let rows: Vec<Vec<String>> = bands
+            .iter()
+            .map(|&(lo, hi, name)| row(name, &e.aggregate(|_, y| y >= lo && y < hi)))
+            .collect();
+        let mut header = TABLE_HEADER;
+        header[0] = "limb margin";
+        put("E.band_table", super::doc::table(&header, &rows));
+        put(
+            "E.mid_kappa_min",
+            sig(e.aggregate(|_, y| y < 0.0).kappa_min),
+        );
+        let far = e.aggregate(|_, y| y >= 0.0);
+        put("E.far_over_tol", far.over_tol.to_string());
+        put("E.far_over_tol_kappa", sig(far.over_tol_kappa_min));
+        let near = e.aggregate(|_, y| y < -1.0);
+        put(
+            "E.near_kappa",
+            format!("{} - {}", sig(near.kappa_min), sig(near.kappa)),
+        );
+        // kappa x margin over each cell's largest-kappa case: kappa ~ 1/q ~ 1/sqrt(margin).
+        let km: Vec<f64> = e
+            .cells
+            .iter()
+            .filter_map(|c| c.max_kappa)
+            .map(|(_, o)| o.kappa * o.margin_rad.sqrt())
+            .collect();
+        let (lo, hi) = km
+            .iter()
+            .fold((f64::INFINITY, 0.0f64), |(l, h), &x| (l.min(x), h.max(x)));
+        put("E.ksqrtm", format!("{} - {}", sig(lo), sig(hi)));
+    }
+    // Maps D: kappa at least 1 deg inside the limb.
+    for l in ["D", "D'"] {
+        if let Some(d) = maps.iter().find(|m| m.spec.letter == l) {
+            let mut a = GCell::empty();
+            for c in &d.cells {
+                if c.n > 0 && c.min_margin_rad.to_degrees() >= 1.0 {
+                    a.merge(c);
+                }
+            }
+            let l = l.replace('\'', "y");
+            put(
+                &format!("{l}.far_kappa"),
+                format!("{} - {}", sig(a.kappa_min), sig(a.kappa)),
+            );
+            put(&format!("{l}.far_err"), e2(a.err));
+            let grey = d.cells.iter().filter(|c| c.n == 0).count();
+            put(
+                &format!("{l}.grey_pct"),
+                format!("{:.0}", 100.0 * grey as f64 / d.cells.len() as f64),
+            );
+        }
+    }
+    // Map F: the fraction of the rate square where kappa > 50 and where err > 2e-6.
+    if let Some(f) = maps.iter().find(|m| m.spec.letter == "F") {
+        let n = f.cells.iter().filter(|c| c.n > 0).count() as f64;
+        let frac = |p: &dyn Fn(&GCell) -> bool| {
+            format!(
+                "{:.1}",
+                100.0 * f.cells.iter().filter(|c| c.n > 0 && p(c)).count() as f64 / n
+            )
+        };
+        put(
+            "F.pct_stiff",
+            frac(&|c| c.kappa > core_math::accuracy::EARTH_F32_KAPPA_LIMIT),
+        );
+        put("F.pct_over", frac(&|c| c.over_tol > 0));
+        if let Some((c, o)) = &f.aggregate(|_, _| true).max_kappa {
+            let a = &c.geometry.attitude;
+            put("F.cancel.v", e2(o.v));
+            put(
+                "F.cancel.rates",
+                format!(
+                    "pitch rate {:.3} deg/s, roll rate {:.3} deg/s",
+                    a.pitch_rate_rad_s.to_degrees(),
+                    a.roll_rate_rad_s.to_degrees()
+                ),
+            );
+        }
+        // The reference |v| at zero rates, nadir pixel, for scale.
+        let k0 = case(H0_KM, I0_SSO_DEG, G0_DEG, Attitude::default(), 0.0);
+        if let Ok(o) = evaluate(&k0) {
+            put("F.v0", e2(o.v));
+            put("F.v1_0", e2(o.v1));
+            put(
+                "F.period0_ms",
+                format!("{:.3}", 1e3 * CAMERA.pixel_m / o.v1.abs()),
+            );
+            put("F.kappa0", sig(o.kappa));
+            // The pitch rate whose rotational term f w matches |v| at nadir.
+            put(
+                "F.cancel_rate",
+                format!("{:.2}", (o.v / CAMERA.focal_m).to_degrees()),
+            );
+        }
+    }
+    v
+}
