@@ -93,7 +93,7 @@ pub const EARTH_F64_REL_TOLERANCE: f64 = 1.0e-12;
 /// Real-Earth model: tolerance of `GENERAL_F32` against `EarthReference` (inputs as given
 /// in f64: the attitude's rounding to f32 counts) where the line of sight is at least
 /// 1 deg inside the limb and the problem's condition number [`earth_kappa`] is at most
-/// [`EARTH_F32_KAPPA_LIMIT`] (about 95 % of the envelope).
+/// [`EARTH_F32_KAPPA_LIMIT`] (about 90 % of the envelope).
 pub const EARTH_F32_REL_TOLERANCE: f64 = 2.0e-6;
 /// The same from 0.01 to 1 deg inside the limb.
 pub const EARTH_F32_NEAR_LIMB_TOLERANCE: f64 = 2.0e-5;
@@ -101,7 +101,7 @@ pub const EARTH_F32_NEAR_LIMB_TOLERANCE: f64 = 2.0e-5;
 /// attitude rate cancelling most of the image motion, or a grazing ray) the problem
 /// itself amplifies the f32 rounding of its inputs (the NAV attitude is f32) past them,
 /// and [`EARTH_F32_KAPPA_C`] x kappa x u32 is the bound.
-pub const EARTH_F32_KAPPA_LIMIT: f64 = 50.0;
+pub const EARTH_F32_KAPPA_LIMIT: f64 = 30.0;
 /// err <= C kappa u32 (u32 = 2^-24) everywhere at least 0.01 deg inside the limb: the
 /// f32 form is backward stable. Measured maximum of err / (kappa u32): 1.25 (three
 /// seeds of 30 000 draws each; `core-math/tests/earth.rs` and `cargo xtask report`).

@@ -81,7 +81,7 @@ fn general_f64_matches_the_reference() {
 
 /// The f32 form against the reference at the inputs as given (the attitude's rounding to
 /// f32 counts): err <= C kappa u32 at least 0.01 deg inside the limb, kappa the problem's
-/// condition number; and where kappa <= 50, within 2e-6 from 1 deg inside the limb and
+/// condition number; and where kappa <= 30, within 2e-6 from 1 deg inside the limb and
 /// 2e-5 from 0.01 deg (see `core_math::accuracy`).
 #[test]
 fn general_f32_matches_the_reference() {

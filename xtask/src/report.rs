@@ -121,11 +121,11 @@ struct Sample {
 /// everywhere at least 0.01 deg from the limb err / (kappa u32) is bounded.
 #[derive(Default)]
 struct EarthF32Split {
-    /// Max error at least 1 deg from the limb, kappa <= 50.
+    /// Max error at least 1 deg from the limb, kappa <= 30.
     far: f64,
-    /// Max error 0.01-1 deg from the limb, kappa <= 50.
+    /// Max error 0.01-1 deg from the limb, kappa <= 30.
     near: f64,
-    /// Cases with kappa > 50 (at least 0.01 deg from the limb).
+    /// Cases with kappa > 30 (at least 0.01 deg from the limb).
     stiff: usize,
     /// Max err/(kappa u32) over every case at least 0.01 deg from the limb.
     ratio: f64,
@@ -481,8 +481,8 @@ fn print_table(
     let split = &sample.earth_f32;
     let notes = format!(
         "{notes}. earth-f32 against the problem's condition number kappa \
-         (core_math::accuracy::earth_kappa): where kappa <= 50, max {:.2e} at least 1 deg \
-         from the limb and {:.2e} at 0.01-1 deg; kappa > 50 in {} of {} cases at least \
+         (core_math::accuracy::earth_kappa): where kappa <= 30, max {:.2e} at least 1 deg \
+         from the limb and {:.2e} at 0.01-1 deg; kappa > 30 in {} of {} cases at least \
          0.01 deg from the limb; max err / (kappa u32) over all of them {:.2}",
         split.far, split.near, split.stiff, split.all, split.ratio
     );

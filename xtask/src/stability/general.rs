@@ -602,7 +602,7 @@ const TABLE_HEADER: [&str; 11] = [
     "kappa min - max",
     "f32 err \\|dv\\|/\\|v\\|",
     "f32 err v1 (line period)",
-    "err, kappa <= 50 and >= 1 deg in",
+    "err, kappa <= 30 and >= 1 deg in",
     "cases err > 2e-6",
     "smallest kappa with err > 2e-6",
     "max err/(kappa u)",
@@ -804,7 +804,7 @@ pub fn figures(maps: &[GMap], secs: f64) -> std::collections::BTreeMap<String, S
             );
         }
     }
-    // Map F: the fraction of the rate square where kappa > 50 and where err > 2e-6.
+    // Map F: the fraction of the rate square where kappa > 30 and where err > 2e-6.
     if let Some(f) = maps.iter().find(|m| m.spec.letter == "F") {
         let n = f.cells.iter().filter(|c| c.n > 0).count() as f64;
         let frac = |p: &dyn Fn(&GCell) -> bool| {
