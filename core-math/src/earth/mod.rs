@@ -196,6 +196,7 @@ fn finite3(x: [f64; 3]) -> bool {
     x.iter().all(|c| c.is_finite())
 }
 
+#[cfg(feature = "reference")]
 fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
