@@ -135,7 +135,6 @@ pub struct Controller {
     outputs: [SegmentOutput; MAX_SEGMENTS],
     has_output: [bool; MAX_SEGMENTS],
     period_bounds_s: (f32, f32),
-    stale_reported: bool,
     /// Update instants run, whatever they computed: one PERIODS frame each.
     pub updates: u32,
     /// The mode an update ran in (the one its PERIODS frame reports).
@@ -164,7 +163,6 @@ impl Controller {
             outputs: [SegmentOutput::default(); MAX_SEGMENTS],
             has_output: [false; MAX_SEGMENTS],
             period_bounds_s,
-            stale_reported: false,
             updates: 0,
             update_mode: Mode::WaitingForNav,
         })
@@ -317,7 +315,6 @@ impl Controller {
         self.now_us = t_us;
         self.next_update_us = 0;
         self.nav = None;
-        self.stale_reported = false;
         self.hold_all();
     }
 
@@ -333,7 +330,6 @@ impl Controller {
 
     fn accept_nav(&mut self, frame: &Frame<'_>) -> Result<(), Fault> {
         self.nav = Some(self.check_nav(frame)?);
-        self.stale_reported = false;
         Ok(())
     }
 
@@ -392,18 +388,20 @@ impl Controller {
         self.next_update_us = t.saturating_add(period);
         self.last_update_us = Some(t);
         self.updates = self.updates.saturating_add(1);
+        let previous = self.update_mode;
         self.update_mode = self.mode_at(t);
+        // One stale episode is a run of updates in mode stale: so the counter equals
+        // the PERIODS frames in mode stale whose predecessor was not.
+        if self.update_mode == Mode::Stale && previous != Mode::Stale {
+            self.reject(Fault::Stale);
+        }
         self.update_at(t, sink);
         true
     }
 
     fn update_at<S: LinePeriodSink>(&mut self, t_us: u64, sink: &mut S) {
         let Some(nav) = self.nav else { return };
-        if t_us.saturating_sub(nav.time_us) > self.config.stale_after_us {
-            if !self.stale_reported {
-                self.stale_reported = true;
-                self.reject(Fault::Stale);
-            }
+        if self.update_mode == Mode::Stale {
             self.hold_all();
             return;
         }

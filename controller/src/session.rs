@@ -83,6 +83,9 @@ impl Session {
             encode_failures,
             ..
         } = self;
+        // Only an accepted frame moves the clock, so only it can make an update or a
+        // STATUS due: a refused input sends nothing (docs/telemetry.md, "Faults").
+        let mut accepted = false;
         decoder.feed(&[byte], |event| {
             if *end_requested {
                 return;
@@ -100,13 +103,19 @@ impl Session {
                     }
                 }
                 Event::Frame(f) => {
+                    let before = controller.frames_accepted;
                     controller.on_frame(&f);
-                    let now = controller.now_us();
-                    advance(controller, now, sink, sequence, encode_failures, send);
+                    if controller.frames_accepted != before {
+                        accepted = true;
+                        let now = controller.now_us();
+                        advance(controller, now, sink, sequence, encode_failures, send);
+                    }
                 }
             }
         });
-        self.status_if_due(send);
+        if accepted || self.end_requested {
+            self.status_if_due(send);
+        }
     }
 
     /// Moves the clock to `now_us` from a time source of the firmware's own (a board's
