@@ -114,6 +114,7 @@ pub enum Mode {
     Stale = 2,
 }
 
+#[derive(Clone)]
 pub struct Controller {
     pub config: Config,
     scene: Scene,

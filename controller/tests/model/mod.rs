@@ -10,7 +10,7 @@
 
 use controller::control::MAX_TIME_TAG_US;
 use controller::frame::{
-    encode, kind, Decoder, Event, HEADER_LEN, MAX_FRAME, MAX_PAYLOAD, SYNC, VERSION,
+    encode, kind, Decoder, Event, FrameError, HEADER_LEN, MAX_FRAME, MAX_PAYLOAD, SYNC, VERSION,
 };
 use controller::nav::{Attitude, Nav};
 use controller::report::{Periods, Status};
@@ -88,7 +88,8 @@ impl Action {
             0..=7 => Action::Nav {
                 dt_us: dt(a),
                 u_rad: frac(b) * core::f64::consts::TAU,
-                h_m: 500e3 + frac(b >> 20) * 300e3,
+                // Inside the band, off its edges (the altitude is recomputed from r).
+                h_m: 501e3 + frac(b >> 20) * 298e3,
                 i_rad: frac(c) * core::f64::consts::PI,
                 roll_rad: (frac(c >> 20) as f32 - 0.5) * 0.8,
             },
@@ -437,8 +438,13 @@ impl Default for Harness {
 
 impl Harness {
     pub fn new() -> Harness {
-        let config = Config::default();
-        let c = Controller::new(config, Scene::paper_default()).unwrap();
+        Harness::with(Controller::new(Config::default(), Scene::paper_default()).unwrap())
+    }
+
+    /// A harness around `c`, a controller fresh from `Controller::new` (the fuzz target
+    /// clones one, which saves planning the default scene per input).
+    pub fn with(c: Controller) -> Harness {
+        let config = c.config;
         Harness {
             session: Session::new(c),
             model: Model {
@@ -789,8 +795,15 @@ impl Harness {
             }
             Action::Cut { at, dt_us } => {
                 let p = nav_payload(state(1.7, 0.3, 645e3), Attitude::default());
+                let good = nav_payload(
+                    state(1.7, 0.3 + dt_us as f64 * 1e-9, 645e3),
+                    Attitude::default(),
+                );
+                let next = self.frame(kind::NAV, now + dt_us, &good);
                 // The cut frame's tag and content do not matter (it is lost); its bytes
-                // after the first must hold no sync byte, so that the rescan skips them.
+                // after the first must hold no sync byte, so that the rescan skips them,
+                // and the cut frame with the next one's start must not pass the CRC by
+                // chance (1 in 65 536: the fuzzer found one).
                 let mut cut = None;
                 for s in 0..64u64 {
                     let f = self.frame(kind::NAV, 0x0102_0304 + s, &p);
@@ -799,7 +812,16 @@ impl Harness {
                     let n = (HEADER_LEN + usize::from(at) % 72)
                         .min(clean)
                         .min(f.len() - 3);
-                    if n >= HEADER_LEN {
+                    if n < HEADER_LEN {
+                        continue;
+                    }
+                    let mut both = f[..n].to_vec();
+                    both.extend_from_slice(&next);
+                    let mut events = Vec::new();
+                    Decoder::new().feed(&both, |e| {
+                        events.push(matches!(e, Event::Rejected(FrameError::Truncated)))
+                    });
+                    if events == [true, false] {
                         cut = Some(f[..n].to_vec());
                         break;
                     }
@@ -814,11 +836,6 @@ impl Harness {
                 let sent = self.feed(&cut);
                 assert_eq!(self.snapshot(), before);
                 assert!(sent.periods.is_empty() && sent.status.is_empty());
-                let good = nav_payload(
-                    state(1.7, 0.3 + dt_us as f64 * 1e-9, 645e3),
-                    Attitude::default(),
-                );
-                let next = self.frame(kind::NAV, now + dt_us, &good);
                 self.deliver(&next, now + dt_us, Ok(()), None);
             }
             Action::Noise { len, seed } => {
