@@ -34,6 +34,10 @@ pub struct Config {
     pub update_period_us: u64,
     /// No valid NAV frame for longer than this (us) is a [`Fault::Stale`] and stops updates.
     pub stale_after_us: u64,
+    /// Largest step (us) a time tag may take ahead of the controller's clock. A tag
+    /// further ahead is refused ([`Fault::TimeJump`]) unless the next frame confirms
+    /// the new time line (a re-synchronisation, docs/telemetry.md "Time").
+    pub max_time_jump_us: u64,
     /// Round-Earth radius of the model (m).
     pub earth_radius_m: f64,
     /// The mission's altitude band (m): NAV frames outside it are refused, and scenes
@@ -61,6 +65,7 @@ impl Default for Config {
         Config {
             update_period_us: 20_000,
             stale_after_us: 1_000_000,
+            max_time_jump_us: 5_000_000,
             earth_radius_m: 6_371_000.0,
             altitude_range_m: (500e3, 800e3),
             pitch_yaw_tolerance_rad: 0.5f32.to_radians(),
@@ -68,6 +73,10 @@ impl Default for Config {
         }
     }
 }
+
+/// Largest time tag the clock takes (us, 2^53: 285 years). Up to it every tag is exact
+/// in f64 (the propagation's `dt`), and the schedule's sums cannot overflow.
+pub const MAX_TIME_TAG_US: u64 = 1 << 53;
 
 /// The last accepted NAV state.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -105,6 +114,7 @@ pub enum Mode {
     Stale = 2,
 }
 
+#[derive(Clone)]
 pub struct Controller {
     pub config: Config,
     scene: Scene,
@@ -112,17 +122,24 @@ pub struct Controller {
     nav: Option<NavState>,
     /// Time tag of the last accepted frame of any kind (us).
     last_time_us: Option<u64>,
+    /// Time tag of the previous frame, when it was refused for its time tag alone: the
+    /// first half of a re-synchronisation.
+    resync_candidate_us: Option<u64>,
     now_us: u64,
     next_update_us: u64,
     last_update_us: Option<u64>,
     pub counters: Counters,
     pub last_fault: Option<Fault>,
     pub frames_accepted: u32,
+    /// Re-synchronisations of the clock (each also counts as an accepted frame).
+    pub time_resyncs: u32,
     outputs: [SegmentOutput; MAX_SEGMENTS],
     has_output: [bool; MAX_SEGMENTS],
     period_bounds_s: (f32, f32),
-    stale_reported: bool,
+    /// Update instants run, whatever they computed: one PERIODS frame each.
     pub updates: u32,
+    /// The mode an update ran in (the one its PERIODS frame reports).
+    update_mode: Mode,
 }
 
 impl Controller {
@@ -136,17 +153,19 @@ impl Controller {
             plan,
             nav: None,
             last_time_us: None,
+            resync_candidate_us: None,
             now_us: 0,
             next_update_us: 0,
             last_update_us: None,
             counters: Counters::default(),
             last_fault: None,
             frames_accepted: 0,
+            time_resyncs: 0,
             outputs: [SegmentOutput::default(); MAX_SEGMENTS],
             has_output: [false; MAX_SEGMENTS],
             period_bounds_s,
-            stale_reported: false,
             updates: 0,
+            update_mode: Mode::WaitingForNav,
         })
     }
 
@@ -180,12 +199,21 @@ impl Controller {
         self.period_bounds_s
     }
 
+    /// The mode at the controller's clock (STATUS).
     pub fn mode(&self) -> Mode {
+        self.mode_at(self.now_us)
+    }
+
+    /// The mode of the last update, at its instant (PERIODS): the clock may be up to an
+    /// update period later, and NAV may go stale in between.
+    pub fn update_mode(&self) -> Mode {
+        self.update_mode
+    }
+
+    fn mode_at(&self, t_us: u64) -> Mode {
         match &self.nav {
             None => Mode::WaitingForNav,
-            Some(n) if self.now_us.saturating_sub(n.time_us) > self.config.stale_after_us => {
-                Mode::Stale
-            }
+            Some(n) if t_us.saturating_sub(n.time_us) > self.config.stale_after_us => Mode::Stale,
             Some(_) => Mode::Nominal,
         }
     }
@@ -205,30 +233,108 @@ impl Controller {
     }
 
     /// One decoded frame. Its time tag moves the controller's clock forward.
+    ///
+    /// The time window (docs/telemetry.md "Time"): a tag is taken when it is after the
+    /// last accepted one and at most `max_time_jump_us` ahead of the clock (any tag up
+    /// to [`MAX_TIME_TAG_US`] before the first frame). A tag outside it is refused, but
+    /// remembered: if the very next frame is valid and lies after it by at most the
+    /// jump, the two agree on a new time line and the clock re-synchronises to it.
     pub fn on_frame(&mut self, frame: &Frame<'_>) {
-        if let Some(last) = self.last_time_us {
-            if frame.time_us <= last {
-                return self.reject(Fault::TimeWentBackwards);
+        let t = frame.time_us;
+        let candidate = self.resync_candidate_us.take();
+        let resync = match self.time_check(t) {
+            Ok(()) => false,
+            Err(f) => {
+                let confirms = candidate.is_some_and(|c| {
+                    t > c && t - c <= self.config.max_time_jump_us && t <= MAX_TIME_TAG_US
+                });
+                if !confirms {
+                    // A tag the clock can never take cannot start a new time line.
+                    if t <= MAX_TIME_TAG_US {
+                        self.resync_candidate_us = Some(t);
+                    }
+                    return self.reject(f);
+                }
+                true
             }
-        }
-        let result = match frame.kind {
-            kind::NAV => self.accept_nav(frame),
-            kind::SCENE => self.accept_scene(frame.payload),
-            kind::TIME if frame.payload.is_empty() => Ok(()),
-            kind::TIME => Err(Fault::BadLength),
-            _ => Err(Fault::UnknownKind),
         };
+        if resync {
+            // Content first: a frame refused for its content re-synchronises nothing.
+            if let Err(f) = self.check_content(frame) {
+                return self.reject(f);
+            }
+            self.resynchronise(t);
+        }
+        let result = self.apply(frame);
         match result {
             Ok(()) => {
                 self.frames_accepted = self.frames_accepted.saturating_add(1);
-                self.last_time_us = Some(frame.time_us);
-                self.now_us = self.now_us.max(frame.time_us);
+                self.last_time_us = Some(t);
+                self.now_us = self.now_us.max(t);
             }
             Err(f) => self.reject(f),
         }
     }
 
+    /// Whether `t_us` lies in the time window.
+    fn time_check(&self, t_us: u64) -> Result<(), Fault> {
+        if t_us > MAX_TIME_TAG_US {
+            return Err(Fault::TimeJump);
+        }
+        let Some(last) = self.last_time_us else {
+            return Ok(());
+        };
+        if t_us <= last {
+            return Err(Fault::TimeWentBackwards);
+        }
+        // `now_us` <= MAX_TIME_TAG_US, but the jump is configuration: saturate.
+        if t_us > self.now_us.saturating_add(self.config.max_time_jump_us) {
+            return Err(Fault::TimeJump);
+        }
+        Ok(())
+    }
+
+    /// The checks `apply` makes, without their effect.
+    fn check_content(&self, frame: &Frame<'_>) -> Result<(), Fault> {
+        match frame.kind {
+            kind::NAV => self.check_nav(frame).map(|_| ()),
+            kind::SCENE => Scene::decode(frame.payload)
+                .and_then(|s| Plan::new(&s, &self.config.envelope()))
+                .map(|_| ()),
+            kind::TIME if frame.payload.is_empty() => Ok(()),
+            kind::TIME => Err(Fault::BadLength),
+            _ => Err(Fault::UnknownKind),
+        }
+    }
+
+    /// A new time line from `t_us` on: the NAV state of the old one cannot be
+    /// propagated across the discontinuity, so it is dropped (mode waiting for NAV, the
+    /// periods in force held), and the next update is the one due at the new clock.
+    fn resynchronise(&mut self, t_us: u64) {
+        self.time_resyncs = self.time_resyncs.saturating_add(1);
+        self.last_time_us = None;
+        self.now_us = t_us;
+        self.next_update_us = 0;
+        self.nav = None;
+        self.hold_all();
+    }
+
+    fn apply(&mut self, frame: &Frame<'_>) -> Result<(), Fault> {
+        match frame.kind {
+            kind::NAV => self.accept_nav(frame),
+            kind::SCENE => self.accept_scene(frame.payload),
+            kind::TIME if frame.payload.is_empty() => Ok(()),
+            kind::TIME => Err(Fault::BadLength),
+            _ => Err(Fault::UnknownKind),
+        }
+    }
+
     fn accept_nav(&mut self, frame: &Frame<'_>) -> Result<(), Fault> {
+        self.nav = Some(self.check_nav(frame)?);
+        Ok(())
+    }
+
+    fn check_nav(&self, frame: &Frame<'_>) -> Result<NavState, Fault> {
         let nav = Nav::decode(frame.payload)?;
         let orbit = nav.orbit(self.config.earth_radius_m)?;
         let (h_lo, h_hi) = self.config.altitude_range_m;
@@ -248,13 +354,11 @@ impl Controller {
         {
             return Err(Fault::AttitudeOutsideModel);
         }
-        self.nav = Some(NavState {
+        Ok(NavState {
             time_us: frame.time_us,
             orbit,
             attitude: a,
-        });
-        self.stale_reported = false;
-        Ok(())
+        })
     }
 
     fn accept_scene(&mut self, payload: &[u8]) -> Result<(), Fault> {
@@ -271,7 +375,9 @@ impl Controller {
     /// Moves the clock to `now_us` (from the time source) and runs the update that is due,
     /// if any, writing periods to `sink`. Returns true when an update ran.
     pub fn advance<S: LinePeriodSink>(&mut self, now_us: u64, sink: &mut S) -> bool {
-        self.now_us = self.now_us.max(now_us);
+        // The clock never passes the largest tag, whatever the time source says: past
+        // it no frame could be accepted again.
+        self.now_us = self.now_us.max(now_us.min(MAX_TIME_TAG_US));
         if self.now_us < self.next_update_us {
             return false;
         }
@@ -279,24 +385,27 @@ impl Controller {
         // updates would only delay the current one.
         let period = self.config.update_period_us.max(1);
         let t = self.now_us - self.now_us % period;
-        // Saturating: a (valid) time tag near u64::MAX must not wrap the schedule.
+        // t <= MAX_TIME_TAG_US; saturating all the same, for any configured period.
         self.next_update_us = t.saturating_add(period);
         self.last_update_us = Some(t);
+        self.updates = self.updates.saturating_add(1);
+        let previous = self.update_mode;
+        self.update_mode = self.mode_at(t);
+        // One stale episode is a run of updates in mode stale: so the counter equals
+        // the PERIODS frames in mode stale whose predecessor was not.
+        if self.update_mode == Mode::Stale && previous != Mode::Stale {
+            self.reject(Fault::Stale);
+        }
         self.update_at(t, sink);
         true
     }
 
     fn update_at<S: LinePeriodSink>(&mut self, t_us: u64, sink: &mut S) {
         let Some(nav) = self.nav else { return };
-        if t_us.saturating_sub(nav.time_us) > self.config.stale_after_us {
-            if !self.stale_reported {
-                self.stale_reported = true;
-                self.reject(Fault::Stale);
-            }
+        if self.update_mode == Mode::Stale {
             self.hold_all();
             return;
         }
-        self.updates = self.updates.wrapping_add(1);
         // Propagate from the frame to this instant: the argument of latitude at the orbit
         // rate, the roll at its rate (a manoeuvre moves the far point fast).
         let dt_s = (t_us as f64 - nav.time_us as f64) * 1e-6;
@@ -339,6 +448,10 @@ impl Controller {
                             *o = out;
                             *h = true;
                         }
+                    } else if let Some(o) = self.outputs.get_mut(slot) {
+                        // The register kept its old period: report it as held, not as
+                        // the new value.
+                        o.held = true;
                     }
                 }
                 Err(f) => {
@@ -391,7 +504,11 @@ impl Controller {
         let worst_mismatch = (v_line / v_min - 1.0)
             .abs()
             .max((1.0 - v_line / v_max).abs());
-        let mtf = mtf_mismatch(u32::from(seg.tdi_stages), worst_mismatch).map_err(Fault::from)?;
+        // Past the sinc's first zero no contrast is left; its negative lobe is a phase
+        // reversal, not an MTF below 0.
+        let mtf = mtf_mismatch(u32::from(seg.tdi_stages), worst_mismatch)
+            .map_err(Fault::from)?
+            .clamp(0.0, 1.0);
         let max_stages = self
             .plan
             .stage_rule

@@ -37,10 +37,13 @@ pub enum Fault {
     PeriodOutOfRange,
     /// A scene upload that does not describe a usable focal plane.
     InvalidScene,
+    /// Time tag too far ahead of the controller's clock (more than
+    /// `Config::max_time_jump_us`), or beyond the largest tag the clock takes.
+    TimeJump,
 }
 
 impl Fault {
-    pub const COUNT: usize = 14;
+    pub const COUNT: usize = 15;
     pub const ALL: [Fault; Fault::COUNT] = [
         Fault::BadCrc,
         Fault::Truncated,
@@ -56,6 +59,7 @@ impl Fault {
         Fault::Stale,
         Fault::PeriodOutOfRange,
         Fault::InvalidScene,
+        Fault::TimeJump,
     ];
 
     pub const fn name(self) -> &'static str {
@@ -74,6 +78,7 @@ impl Fault {
             Fault::Stale => "stale",
             Fault::PeriodOutOfRange => "period_out_of_range",
             Fault::InvalidScene => "invalid_scene",
+            Fault::TimeJump => "time_jump",
         }
     }
 }

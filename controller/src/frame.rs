@@ -8,7 +8,9 @@
 use crate::crc;
 
 pub const SYNC: [u8; 2] = [0xEB, 0x90];
-pub const VERSION: u8 = 1;
+/// 2 since issue 13: STATUS carries the re-synchronisation count and the `time_jump`
+/// counter (docs/telemetry.md, "Versions").
+pub const VERSION: u8 = 2;
 /// sync (2) + version (1) + kind (1) + length (2) + sequence (2) + time tag (8).
 pub const HEADER_LEN: usize = 16;
 pub const CRC_LEN: usize = 2;
@@ -67,7 +69,9 @@ pub enum Event<'a> {
 pub struct Decoder {
     buf: [u8; MAX_FRAME],
     len: usize,
-    /// Bytes dropped while hunting for a sync word (line noise, not frames).
+    /// Every byte received that is not part of a delivered frame: line noise, and the
+    /// bytes of rejected frames. So bytes received = delivered frames' bytes + skipped
+    /// + [`Decoder::buffered`].
     pub skipped_bytes: u32,
 }
 
@@ -131,10 +135,16 @@ impl Decoder {
                 }
                 Step::Reject(e) => {
                     on_event(Event::Rejected(e));
+                    self.skipped_bytes = self.skipped_bytes.saturating_add(1);
                     self.consume(1);
                 }
             }
         }
+    }
+
+    /// Bytes held for a frame not yet complete.
+    pub fn buffered(&self) -> usize {
+        self.len
     }
 
     fn step(&self) -> Step {

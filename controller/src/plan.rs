@@ -217,6 +217,19 @@ impl Plan {
 
     fn build(scene: &Scene, env: &Envelope, exhaustive: bool) -> Result<Plan, Fault> {
         scene.validate()?;
+        // The focal plane the scene describes must see the Earth: a pixel whose field
+        // angle is past the limb at the highest altitude, even at nadir, images nothing.
+        let r = env.earth_radius_m;
+        let limb = libm::asin(r / (r + env.altitude_range_m.1));
+        for spec in scene.segments.iter().take(usize::from(scene.count)) {
+            for n in [spec.first_px, spec.last_px] {
+                let alpha =
+                    libm::atan((f64::from(n) * scene.camera.pixel_m / scene.camera.focal_m).abs());
+                if !(alpha < limb) {
+                    return Err(Fault::InvalidScene);
+                }
+            }
+        }
         let stage_rule =
             StageRule::<f32>::new(f64::from(scene.mtf_floor)).map_err(|_| Fault::InvalidScene)?;
         let updates = probe_updates(scene, env);

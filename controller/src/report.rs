@@ -11,7 +11,7 @@ use crate::scene::MAX_SEGMENTS;
 pub const PERIODS_HEADER_LEN: usize = 4;
 pub const RECORD_LEN: usize = 20;
 /// STATUS payload length.
-pub const STATUS_LEN: usize = 16 + 4 * Fault::COUNT;
+pub const STATUS_LEN: usize = 20 + 4 * Fault::COUNT;
 
 /// Flag bit of a record: the value is the last good one, held over a fault.
 pub const FLAG_HELD: u8 = 1;
@@ -20,7 +20,7 @@ pub const FLAG_HELD: u8 = 1;
 pub fn encode_periods(c: &Controller, out: &mut [u8]) -> Option<usize> {
     let mut w = Writer::new(out);
     let count = c.outputs().count() as u8;
-    w.put(&[c.mode() as u8, count, 0, 0])?;
+    w.put(&[c.update_mode() as u8, count, 0, 0])?;
     for o in c.outputs() {
         w.put(&[o.index, if o.held { FLAG_HELD } else { 0 }])?;
         w.put(&o.max_stages.to_le_bytes())?;
@@ -76,14 +76,16 @@ impl Periods {
 }
 
 /// Writes the STATUS payload: mode, last fault (0xFF: none), 2 reserved, frames
-/// accepted, updates run, noise bytes skipped by the decoder, then one u32 counter per
-/// [`Fault`] in [`Fault::ALL`] order.
+/// accepted, updates run, bytes skipped by the decoder, time re-synchronisations, then
+/// one u32 counter per [`Fault`] in [`Fault::ALL`] order. What each counts, and the
+/// identities between them: docs/telemetry.md, "Counters".
 pub fn encode_status(c: &Controller, skipped_bytes: u32, out: &mut [u8]) -> Option<usize> {
     let mut w = Writer::new(out);
     w.put(&[c.mode() as u8, c.last_fault.map_or(0xFF, |f| f as u8), 0, 0])?;
     w.put(&c.frames_accepted.to_le_bytes())?;
     w.put(&c.updates.to_le_bytes())?;
     w.put(&skipped_bytes.to_le_bytes())?;
+    w.put(&c.time_resyncs.to_le_bytes())?;
     for n in c.counters.as_array() {
         w.put(&n.to_le_bytes())?;
     }
@@ -97,6 +99,7 @@ pub struct Status {
     pub frames_accepted: u32,
     pub updates: u32,
     pub skipped_bytes: u32,
+    pub time_resyncs: u32,
     pub counts: [u32; Fault::COUNT],
 }
 
@@ -109,6 +112,7 @@ impl Status {
         let frames_accepted = r.u32()?;
         let updates = r.u32()?;
         let skipped_bytes = r.u32()?;
+        let time_resyncs = r.u32()?;
         let mut counts = [0u32; Fault::COUNT];
         for c in counts.iter_mut() {
             *c = r.u32()?;
@@ -120,6 +124,7 @@ impl Status {
             frames_accepted,
             updates,
             skipped_bytes,
+            time_resyncs,
             counts,
         })
     }

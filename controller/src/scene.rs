@@ -8,6 +8,11 @@ use crate::fault::Fault;
 
 /// Capacity of the segment table.
 pub const MAX_SEGMENTS: usize = 16;
+/// Largest TDI stage count a scene may configure. TDI sensors stop at 256 stages, and
+/// beyond it a segment's mismatch budget (0.35 / M at MTF 0.95) falls below the drift
+/// one update period allows during a manoeuvre (docs/controller.md, "The update rate"),
+/// so no scene could hold its MTF floor with more.
+pub const MAX_TDI_STAGES: u16 = 256;
 /// Fixed part of the SCENE payload, then [`SEGMENT_LEN`] bytes per segment.
 pub const SCENE_HEADER_LEN: usize = 36;
 pub const SEGMENT_LEN: usize = 12;
@@ -83,13 +88,25 @@ impl Scene {
         if !clock_ok || !roll_ok || StageRule::<f32>::new(f64::from(self.mtf_floor)).is_err() {
             return Err(Fault::InvalidScene);
         }
-        if self.count == 0 || usize::from(self.count) > MAX_SEGMENTS || self.max_stages == 0 {
+        if self.count == 0
+            || usize::from(self.count) > MAX_SEGMENTS
+            || self.max_stages == 0
+            || self.max_stages > MAX_TDI_STAGES
+            || self.active().next().is_none()
+        {
             return Err(Fault::InvalidScene);
         }
+        // Segments are chips of one array: in order along it, none overlapping another.
+        let mut previous_last: Option<i32> = None;
         for s in self.segments.iter().take(usize::from(self.count)) {
-            if s.first_px > s.last_px || s.tdi_stages == 0 || s.tdi_stages > self.max_stages {
+            if s.first_px > s.last_px
+                || previous_last.is_some_and(|p| s.first_px <= p)
+                || s.tdi_stages == 0
+                || s.tdi_stages > self.max_stages
+            {
                 return Err(Fault::InvalidScene);
             }
+            previous_last = Some(s.last_px);
             for n in [s.first_px, s.last_px] {
                 self.camera
                     .tan_field(f64::from(n))
@@ -110,17 +127,24 @@ impl Scene {
         let max_stages = r.u16().ok_or(bad)?;
         let count = r.u8().ok_or(bad)?;
         let _reserved = r.u8().ok_or(bad)?;
-        if usize::from(count) > MAX_SEGMENTS
-            || payload.len() != SCENE_HEADER_LEN + usize::from(count) * SEGMENT_LEN
-        {
+        // A length that matches its own count is well formed, even when the count is
+        // more than the table holds: that is a scene the camera cannot use.
+        if payload.len() != SCENE_HEADER_LEN + usize::from(count) * SEGMENT_LEN {
             return Err(Fault::BadLength);
+        }
+        if usize::from(count) > MAX_SEGMENTS {
+            return Err(Fault::InvalidScene);
         }
         let mut segments = [SegmentSpec::default(); MAX_SEGMENTS];
         for s in segments.iter_mut().take(usize::from(count)) {
             let first_px = r.i32().ok_or(bad)?;
             let last_px = r.i32().ok_or(bad)?;
             let tdi_stages = r.u16().ok_or(bad)?;
-            let active = r.u8().ok_or(bad)? != 0;
+            let active = match r.u8().ok_or(bad)? {
+                0 => false,
+                1 => true,
+                _ => return Err(Fault::InvalidScene),
+            };
             let _reserved = r.u8().ok_or(bad)?;
             *s = SegmentSpec {
                 first_px,

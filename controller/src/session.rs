@@ -23,6 +23,8 @@ pub struct Session {
     pub controller: Controller,
     sequence: u16,
     next_status_us: u64,
+    /// The controller's re-synchronisations already reported by a STATUS frame.
+    resyncs_reported: u32,
     end_requested: bool,
     ended: bool,
     /// Downlink frames that could not be encoded (never expected: the payloads are
@@ -37,6 +39,7 @@ impl Session {
             controller,
             sequence: 0,
             next_status_us: 0,
+            resyncs_reported: 0,
             end_requested: false,
             ended: false,
             encode_failures: 0,
@@ -80,6 +83,9 @@ impl Session {
             encode_failures,
             ..
         } = self;
+        // Only an accepted frame moves the clock, so only it can make an update or a
+        // STATUS due: a refused input sends nothing (docs/telemetry.md, "Faults").
+        let mut accepted = false;
         decoder.feed(&[byte], |event| {
             if *end_requested {
                 return;
@@ -89,18 +95,27 @@ impl Session {
                 Event::Frame(f) if f.kind == kind::END => {
                     if f.payload.is_empty() {
                         *end_requested = true;
+                        // Accepted like any frame, so that every frame received is
+                        // either accepted or refused (docs/telemetry.md, "Counters").
+                        controller.frames_accepted = controller.frames_accepted.saturating_add(1);
                     } else {
                         controller.reject(Fault::BadLength);
                     }
                 }
                 Event::Frame(f) => {
+                    let before = controller.frames_accepted;
                     controller.on_frame(&f);
-                    let now = controller.now_us();
-                    advance(controller, now, sink, sequence, encode_failures, send);
+                    if controller.frames_accepted != before {
+                        accepted = true;
+                        let now = controller.now_us();
+                        advance(controller, now, sink, sequence, encode_failures, send);
+                    }
                 }
             }
         });
-        self.status_if_due(send);
+        if accepted || self.end_requested {
+            self.status_if_due(send);
+        }
     }
 
     /// Moves the clock to `now_us` from a time source of the firmware's own (a board's
@@ -129,8 +144,12 @@ impl Session {
 
     fn status_if_due(&mut self, send: &mut impl FnMut(&[u8])) {
         let now = self.controller.now_us();
-        if self.end_requested || now >= self.next_status_us {
-            // Saturating: time tags come from the link, and any u64 is a valid one.
+        // A re-synchronisation is reported at once, and restarts the schedule (the
+        // clock may have gone back).
+        let resynced = self.controller.time_resyncs != self.resyncs_reported;
+        if self.end_requested || resynced || now >= self.next_status_us {
+            self.resyncs_reported = self.controller.time_resyncs;
+            // The clock is at most MAX_TIME_TAG_US: no overflow; saturating all the same.
             self.next_status_us = (now / STATUS_PERIOD_US + 1).saturating_mul(STATUS_PERIOD_US);
             self.send_status(send);
         }

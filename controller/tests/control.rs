@@ -353,16 +353,20 @@ fn periods_and_status_frames_round_trip() {
 }
 
 #[test]
-fn time_tags_near_the_end_of_the_clock_do_not_wrap_the_schedule() {
+fn time_tags_at_the_end_of_the_clock_do_not_wrap_the_schedule() {
     let mut c = Controller::new(Config::default(), Scene::paper_default()).unwrap();
     let mut regs = Registers::default();
-    let t = u64::MAX - 5;
+    // The largest tag the clock takes is accepted even as the first one.
+    let t = controller::control::MAX_TIME_TAG_US;
     feed(
         &mut c,
         &nav_frame(1, t, state(I0.to_radians(), 0.3, H), roll(0.2)),
     );
+    assert_eq!(c.nav().map(|n| n.time_us), Some(t));
     assert!(c.advance(t, &mut regs));
     assert_eq!(c.last_update_us(), Some(t - t % 20_000));
-    // The next update is due at u64::MAX (saturated), not at a wrapped small instant.
     assert!(!c.advance(t, &mut regs));
+    // A time source beyond it does not move the clock past it.
+    c.advance(u64::MAX, &mut regs);
+    assert_eq!(c.now_us(), t);
 }

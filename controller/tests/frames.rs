@@ -76,7 +76,7 @@ fn damage_costs_the_damaged_frame_only() {
     assert_eq!(got.len(), 2);
     // Unknown version and oversized length.
     let mut v2 = b.clone();
-    v2[2] = 2;
+    v2[2] = controller::frame::VERSION + 1;
     let mut big = b.clone();
     big[4..6].copy_from_slice(&((MAX_PAYLOAD + 1) as u16).to_le_bytes());
     let got = decode_all(&[&[v2, big, c].concat()]);

@@ -135,6 +135,84 @@ pub enum FaultSpec {
     Altitude { t_s: f64, altitude_m: f64 },
     /// No NAV frame strictly between `from_s` and `from_s + len_s` (TIME goes on).
     Gap { from_s: f64, len_s: f64 },
+    /// After the frame at `t_s`, a TIME frame (valid CRC) tagged `tag_us`: beyond the
+    /// time window, so refused as `time_jump` (issue 13's first defect).
+    TimeTag { t_s: f64, tag_us: u64 },
+    /// An extra SCENE frame at `t_s` that the camera cannot use: refused as
+    /// `invalid_scene` (issue 13's third defect).
+    BadScene { t_s: f64, probe: SceneProbe },
+}
+
+/// The SCENE uploads an outside client found accepted before issue 13.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum SceneProbe {
+    /// A segment's `active` byte is 2.
+    ActiveByte2,
+    /// Largest stage count and a segment's stages 65 535.
+    Stages65535,
+    /// Every segment inactive.
+    NoneActive,
+    /// Two segments overlap.
+    Overlap,
+    /// 17 segments (a length that matches the count).
+    Segments17,
+}
+
+impl SceneProbe {
+    pub const ALL: [SceneProbe; 5] = [
+        SceneProbe::ActiveByte2,
+        SceneProbe::Stages65535,
+        SceneProbe::NoneActive,
+        SceneProbe::Overlap,
+        SceneProbe::Segments17,
+    ];
+
+    pub fn label(&self) -> &'static str {
+        match self {
+            SceneProbe::ActiveByte2 => "active byte 2",
+            SceneProbe::Stages65535 => "65 535 TDI stages",
+            SceneProbe::NoneActive => "no active segment",
+            SceneProbe::Overlap => "overlapping segments",
+            SceneProbe::Segments17 => "17 segments",
+        }
+    }
+
+    /// The SCENE payload: the paper's scene, then the edit.
+    pub fn payload(&self) -> Vec<u8> {
+        use controller::scene::{SCENE_HEADER_LEN, SEGMENT_LEN};
+        let mut scene = controller::Scene::paper_default();
+        match self {
+            SceneProbe::Stages65535 => {
+                scene.max_stages = u16::MAX;
+                scene.segments[0].tdi_stages = u16::MAX;
+            }
+            SceneProbe::NoneActive => scene.segments.iter_mut().for_each(|s| s.active = false),
+            SceneProbe::Overlap => scene.segments[4].first_px = scene.segments[3].last_px - 999,
+            SceneProbe::ActiveByte2 | SceneProbe::Segments17 => {}
+        }
+        let mut p = vec![0u8; controller::frame::MAX_PAYLOAD];
+        let n = scene.encode(&mut p).unwrap_or(0);
+        p.truncate(n);
+        let seg = |k: usize| SCENE_HEADER_LEN + k * SEGMENT_LEN;
+        match self {
+            SceneProbe::ActiveByte2 => p[seg(3) + 10] = 2,
+            SceneProbe::Segments17 => {
+                // 17 chips of 3 529 pixels across the same array.
+                p[34] = 17;
+                let template = p[seg(0)..seg(1)].to_vec();
+                p.truncate(SCENE_HEADER_LEN);
+                for k in 0..17i32 {
+                    let mut s = template.clone();
+                    let first = -30_000 + 3_529 * k;
+                    s[0..4].copy_from_slice(&first.to_le_bytes());
+                    s[4..8].copy_from_slice(&(first + 3_528).to_le_bytes());
+                    p.extend_from_slice(&s);
+                }
+            }
+            _ => {}
+        }
+        p
+    }
 }
 
 impl FaultSpec {
@@ -151,6 +229,10 @@ impl FaultSpec {
                 format!("altitude {} km in NAV at {t_s} s", altitude_m / 1e3)
             }
             FaultSpec::Gap { from_s, len_s } => format!("{len_s} s NAV gap from {from_s} s"),
+            FaultSpec::TimeTag { t_s, tag_us } => format!("TIME tagged {tag_us} us at {t_s} s"),
+            FaultSpec::BadScene { t_s, probe } => {
+                format!("SCENE with {} at {t_s} s", probe.label())
+            }
         }
     }
 }
@@ -236,6 +318,29 @@ pub fn true_nav(orbit: &CircularOrbit, roll: &RollProfile, t_s: f64) -> Nav {
     }
 }
 
+/// The link probes of issue 13 from `t0_s` on: a TIME frame tagged 2^64 - 1, one an
+/// hour ahead, then each SCENE the camera cannot use; every one must be refused under
+/// its own counter and change nothing.
+pub fn link_probes(t0_s: f64) -> Vec<FaultSpec> {
+    let mut out = vec![
+        FaultSpec::TimeTag {
+            t_s: t0_s,
+            tag_us: u64::MAX,
+        },
+        FaultSpec::TimeTag {
+            t_s: t0_s + 0.5,
+            tag_us: us(t0_s + 0.5 + 3600.0),
+        },
+    ];
+    for (k, probe) in SceneProbe::ALL.into_iter().enumerate() {
+        out.push(FaultSpec::BadScene {
+            t_s: t0_s + 1.005 + 0.001 * k as f64,
+            probe,
+        });
+    }
+    out
+}
+
 /// The default pass: ten minutes of the paper's orbit; roll 0, then 0 -> 25 deg at
 /// 1 deg/s (60-85 s), held, and back at 1 deg/s (400-425 s); faults spread over it,
 /// none at a corner of the roll profile (a lost frame there would leave the controller
@@ -249,7 +354,7 @@ pub fn default_pass(earth_radius_m: f64, tick_us: u64) -> Pass {
             (425.0, 0.0),
         ],
     };
-    let faults = vec![
+    let mut faults = vec![
         FaultSpec::BitFlip { t_s: 30.0 },
         FaultSpec::BitFlip { t_s: 70.5 },
         FaultSpec::Truncate { t_s: 120.25 },
@@ -272,6 +377,7 @@ pub fn default_pass(earth_radius_m: f64, tick_us: u64) -> Pass {
             len_s: 2.0,
         },
     ];
+    faults.extend(link_probes(160.0));
     synthetic(
         "default pass (600 s)",
         paper_orbit(earth_radius_m),
@@ -293,7 +399,7 @@ pub fn short_pass(earth_radius_m: f64, tick_us: u64) -> Pass {
             (47.5, 0.0),
         ],
     };
-    let faults = vec![
+    let mut faults = vec![
         FaultSpec::BitFlip { t_s: 5.0 },
         FaultSpec::Truncate { t_s: 8.0 },
         FaultSpec::Noise {
@@ -315,6 +421,7 @@ pub fn short_pass(earth_radius_m: f64, tick_us: u64) -> Pass {
             len_s: 2.0,
         },
     ];
+    faults.extend(link_probes(28.0));
     synthetic(
         "short pass (60 s)",
         paper_orbit(earth_radius_m),

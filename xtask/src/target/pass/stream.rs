@@ -215,6 +215,28 @@ pub fn build(pass: &Pass) -> Result<Stream, String> {
             }
             // Cut out of the samples already: missing telemetry, in both runs.
             FaultSpec::Gap { .. } => Some(Fault::Stale),
+            FaultSpec::TimeTag { t_s, tag_us } => {
+                let bytes = frames.frame(kind::TIME, tag_us, &[]);
+                extra.push((
+                    after(us(t_s)),
+                    Item {
+                        bytes,
+                        fault: Some(k),
+                    },
+                ));
+                Some(Fault::TimeJump)
+            }
+            FaultSpec::BadScene { t_s, probe } => {
+                let bytes = frames.frame(kind::SCENE, us(t_s), &probe.payload());
+                extra.push((
+                    after(us(t_s)),
+                    Item {
+                        bytes,
+                        fault: Some(k),
+                    },
+                ));
+                Some(Fault::InvalidScene)
+            }
         };
         injected.push((f.label(), expect));
     }

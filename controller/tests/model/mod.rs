@@ -1,0 +1,917 @@
+//! A small reference model of the link's documented behaviour (docs/telemetry.md:
+//! frames, faults, time window, counters) and a harness that drives a real `Session`
+//! with random actions and checks it against the model after every action.
+//!
+//! Shared by the stateful property test (`tests/session_model.rs`, proptest) and the
+//! `session` fuzz target (`fuzz/fuzz_targets/session.rs`, libFuzzer): both turn their
+//! random input into [`Action`]s with [`Action::decode`] and run [`Harness::step`],
+//! which panics on the first divergence.
+#![allow(dead_code)]
+
+use controller::control::MAX_TIME_TAG_US;
+use controller::frame::{
+    encode, kind, Decoder, Event, FrameError, HEADER_LEN, MAX_FRAME, MAX_PAYLOAD, SYNC, VERSION,
+};
+use controller::nav::{Attitude, Nav};
+use controller::report::{Periods, Status};
+use controller::scene::{SCENE_HEADER_LEN, SEGMENT_LEN};
+use controller::session::Session;
+use controller::{Config, Controller, Fault, LinePeriodSink, Mode, Scene, SegmentOutput};
+use core_math::{StateVector, GM_M3_S2};
+
+const R_M: f64 = 6_371_000.0;
+
+/// One thing the ground (or the link) does.
+#[derive(Clone, Debug)]
+pub enum Action {
+    /// A valid NAV frame `dt_us` after the clock.
+    Nav {
+        dt_us: u64,
+        u_rad: f64,
+        h_m: f64,
+        i_rad: f64,
+        roll_rad: f32,
+    },
+    /// A NAV frame, in the window, whose content is refused with `fault`.
+    BadNav { dt_us: u64, what: u8 },
+    /// A TIME frame `dt_us` after the clock.
+    Time { dt_us: u64 },
+    /// The on-board timer moves the clock (`Session::tick`).
+    Tick { dt_us: u64 },
+    /// A SCENE frame, in the window: the paper's scene with one edit.
+    Scene { dt_us: u64, edit: u8, k: u8, x: u64 },
+    /// A TIME frame tagged `back_us` before (or at) the last accepted tag.
+    Backwards { back_us: u64 },
+    /// A TIME frame more than the allowed jump ahead of the clock.
+    Jump { beyond_us: u64 },
+    /// A TIME frame tagged past the largest tag (up to 2^64 - 1).
+    TimeMax { below_max: u64 },
+    /// Two TIME frames on a new time line `offset_us` away (a re-synchronisation).
+    Resync {
+        forward: bool,
+        offset_us: u64,
+        gap_us: u64,
+    },
+    /// A frame of a kind the camera does not take, or a TIME frame with a payload.
+    BadKind { kind: u8, len: u8 },
+    /// A TIME frame with one bit flipped (after its length field).
+    BitFlip { bit: u8, seed: u64 },
+    /// A NAV frame cut after `at` bytes, then a valid NAV frame.
+    Cut { at: u8, dt_us: u64 },
+    /// Line noise without the sync word's first byte.
+    Noise { len: u16, seed: u64 },
+    /// A header with a version this camera does not speak.
+    BadVersion { version: u8, seed: u64 },
+    /// A header announcing more than the largest payload.
+    Oversized { len: u16, seed: u64 },
+}
+
+/// Kinds the camera takes (and END, which ends a run): anything else is unknown.
+fn is_known_kind(k: u8) -> bool {
+    matches!(k, kind::NAV | kind::SCENE | kind::TIME | kind::END)
+}
+
+impl Action {
+    /// An action from a selector and three raw numbers (what proptest and libFuzzer
+    /// generate): the weights favour valid telemetry so that updates run.
+    pub fn decode(sel: u8, a: u64, b: u64, c: u64) -> Action {
+        let frac = |x: u64| (x % 1_000_001) as f64 / 1e6;
+        // Mostly one update period or two, sometimes up to the whole window.
+        let dt = |x: u64| {
+            if x % 8 == 0 {
+                1 + (x >> 3) % 5_000_000
+            } else {
+                1 + (x >> 3) % 60_000
+            }
+        };
+        match sel % 32 {
+            0..=7 => Action::Nav {
+                dt_us: dt(a),
+                u_rad: frac(b) * core::f64::consts::TAU,
+                // Inside the band, off its edges (the altitude is recomputed from r).
+                h_m: 501e3 + frac(b >> 20) * 298e3,
+                i_rad: frac(c) * core::f64::consts::PI,
+                roll_rad: (frac(c >> 20) as f32 - 0.5) * 0.8,
+            },
+            8..=12 => Action::Time { dt_us: dt(a) },
+            13 => Action::Tick { dt_us: dt(a) },
+            14..=16 => Action::Scene {
+                dt_us: dt(a),
+                edit: b as u8,
+                k: (b >> 8) as u8,
+                x: c,
+            },
+            17 => Action::BadNav {
+                dt_us: dt(a),
+                what: b as u8,
+            },
+            18 => Action::Backwards {
+                back_us: a % 3_000_000,
+            },
+            19 => Action::Jump {
+                beyond_us: 1 + a % (1 << 40),
+            },
+            20 => Action::TimeMax { below_max: a % 3 },
+            21 => Action::Resync {
+                forward: a % 2 == 0,
+                offset_us: 1 + (a >> 1) % 1_000_000_000,
+                gap_us: 1 + b % 5_000_000,
+            },
+            22 => Action::BadKind {
+                kind: a as u8,
+                len: b as u8,
+            },
+            23 | 24 => Action::BitFlip {
+                bit: a as u8,
+                seed: b,
+            },
+            25 | 26 => Action::Cut {
+                at: a as u8,
+                dt_us: dt(b),
+            },
+            27 | 28 => Action::Noise {
+                len: (a % 300) as u16 + 1,
+                seed: b,
+            },
+            29 => Action::BadVersion {
+                version: a as u8,
+                seed: b,
+            },
+            30 => Action::Oversized {
+                len: (a % 1000) as u16,
+                seed: b,
+            },
+            _ => Action::Time { dt_us: dt(a) },
+        }
+    }
+}
+
+/// What the documentation says the controller's link state is.
+#[derive(Clone, Debug, Default)]
+pub struct Model {
+    pub last_accepted_us: Option<u64>,
+    pub now_us: u64,
+    /// The tag of the previous frame, if it was refused for its time tag alone.
+    pub candidate_us: Option<u64>,
+    pub nav_time_us: Option<u64>,
+    pub counts: [u32; Fault::COUNT],
+    pub frames_accepted: u32,
+    pub time_resyncs: u32,
+    pub skipped_bytes: u32,
+    /// Frames the decoder delivers (accepted or refused for their content or time).
+    pub frames_delivered: u32,
+    pub delivered_bytes: u64,
+    pub max_jump_us: u64,
+}
+
+/// The model's verdict on one delivered frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Verdict {
+    Accepted { resync: bool },
+    Refused(Fault),
+}
+
+impl Model {
+    fn count(&mut self, f: Fault) {
+        self.counts[f as usize] += 1;
+    }
+
+    /// A frame of `len` bytes tagged `t_us` whose content alone would give `content`.
+    pub fn frame(&mut self, t_us: u64, len: usize, content: Result<(), Fault>) -> Verdict {
+        self.frames_delivered += 1;
+        self.delivered_bytes += len as u64;
+        let candidate = self.candidate_us.take();
+        let time = if t_us > MAX_TIME_TAG_US {
+            Err(Fault::TimeJump)
+        } else {
+            match self.last_accepted_us {
+                None => Ok(()),
+                Some(last) if t_us <= last => Err(Fault::TimeWentBackwards),
+                Some(_) if t_us > self.now_us + self.max_jump_us => Err(Fault::TimeJump),
+                Some(_) => Ok(()),
+            }
+        };
+        let resync = match time {
+            Ok(()) => false,
+            Err(f) => {
+                let confirms = t_us <= MAX_TIME_TAG_US
+                    && candidate.is_some_and(|c| t_us > c && t_us - c <= self.max_jump_us);
+                if !confirms {
+                    if t_us <= MAX_TIME_TAG_US {
+                        self.candidate_us = Some(t_us);
+                    }
+                    self.count(f);
+                    return Verdict::Refused(f);
+                }
+                true
+            }
+        };
+        if let Err(f) = content {
+            self.count(f);
+            return Verdict::Refused(f);
+        }
+        if resync {
+            self.time_resyncs += 1;
+            self.now_us = t_us;
+            self.nav_time_us = None;
+        }
+        self.frames_accepted += 1;
+        self.last_accepted_us = Some(t_us);
+        self.now_us = self.now_us.max(t_us);
+        Verdict::Accepted { resync }
+    }
+}
+
+/// Records every period written; [`check_writes`] holds them to the scene in force
+/// after the byte that caused them (a SCENE frame's last byte changes the scene, then
+/// the update after it writes).
+#[derive(Default)]
+pub struct Recorder {
+    pub writes: Vec<(u8, u32)>,
+}
+
+impl LinePeriodSink for Recorder {
+    type Error = ();
+    fn write_period(&mut self, index: u8, ticks: u32) -> Result<(), ()> {
+        self.writes.push((index, ticks));
+        Ok(())
+    }
+}
+
+/// Every write inside the physical bounds, to an active segment of the scene.
+pub fn check_writes(c: &Controller, writes: &[(u8, u32)]) {
+    let (lo, hi) = c.period_bounds_s();
+    let clock = c.scene().line_clock_hz;
+    let (lo, hi) = (f64::from(lo) * clock, f64::from(hi) * clock);
+    for &(index, ticks) in writes {
+        let t = f64::from(ticks);
+        assert!(
+            t >= lo * (1.0 - 1e-6) - 1.0 && t <= hi * (1.0 + 1e-6) + 1.0,
+            "period {ticks} ticks outside [{lo}, {hi}]"
+        );
+        assert!(
+            c.scene().active().any(|(k, _)| k == usize::from(index)),
+            "write to inactive segment {index}"
+        );
+    }
+}
+
+/// ECI state on a circular orbit.
+fn state(i: f64, u: f64, h: f64) -> StateVector {
+    let a = R_M + h;
+    let speed = (GM_M3_S2 / a).sqrt();
+    let (si, ci) = i.sin_cos();
+    let (su, cu) = u.sin_cos();
+    let (sn, cn) = 0.4f64.sin_cos();
+    let p = [cn, sn, 0.0];
+    let q = [-sn * ci, cn * ci, si];
+    StateVector {
+        position_m: core::array::from_fn(|k| a * (cu * p[k] + su * q[k])),
+        velocity_mps: core::array::from_fn(|k| speed * (-su * p[k] + cu * q[k])),
+    }
+}
+
+fn nav_payload(sv: StateVector, attitude: Attitude) -> Vec<u8> {
+    let mut p = [0u8; 128];
+    let n = Nav {
+        state: sv,
+        attitude,
+    }
+    .encode(&mut p)
+    .unwrap();
+    p[..n].to_vec()
+}
+
+fn splitmix(x: &mut u64) -> u64 {
+    *x = x.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    let mut z = *x;
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
+
+/// An edit of the encoded bytes, for what `Scene::encode` cannot express.
+type RawEdit = Box<dyn Fn(&mut Vec<u8>)>;
+
+/// A SCENE payload: the paper's scene with edit `edit` (on segment `k`, value `x`), and
+/// the verdict the documented rules give it.
+pub fn scene_case(edit: u8, k: u8, x: u64) -> (Vec<u8>, Result<(), Fault>, Option<Scene>) {
+    let mut scene = Scene::paper_default();
+    let k = usize::from(k % 10);
+    let mut raw: Option<RawEdit> = None;
+    let verdict = match edit % 20 {
+        // Valid edits: fewer segments, some inactive, other stage counts.
+        0 | 1 => {
+            scene.count = 1 + (x % 10) as u8;
+            Ok(())
+        }
+        2 | 3 => {
+            for (j, s) in scene.segments.iter_mut().take(10).enumerate() {
+                s.active = (x >> j) & 1 == 1 || j == k;
+            }
+            Ok(())
+        }
+        4 | 5 => {
+            scene.max_stages = 1 + (x % 256) as u16;
+            for (j, s) in scene.segments.iter_mut().take(10).enumerate() {
+                s.tdi_stages = 1 + ((x >> (8 + j)) % u64::from(scene.max_stages)) as u16;
+            }
+            Ok(())
+        }
+        // Refused: an active byte outside {0, 1}.
+        6 => {
+            let v = 2 + (x % 254) as u8;
+            raw = Some(Box::new(move |p: &mut Vec<u8>| {
+                p[SCENE_HEADER_LEN + k * SEGMENT_LEN + 10] = v
+            }));
+            Err(Fault::InvalidScene)
+        }
+        // Stage counts above the scene's largest, or above what the MTF formula takes.
+        7 => {
+            scene.segments[k].tdi_stages = scene.max_stages + 1 + (x % 1000) as u16;
+            Err(Fault::InvalidScene)
+        }
+        8 => {
+            scene.max_stages = 257 + (x % 65_279) as u16;
+            Err(Fault::InvalidScene)
+        }
+        9 => {
+            for s in scene.segments.iter_mut() {
+                s.active = false;
+            }
+            Err(Fault::InvalidScene)
+        }
+        // Overlapping, then unordered segments.
+        10 => {
+            let j = 1 + k % 9;
+            scene.segments[j].first_px = scene.segments[j - 1].last_px - (x % 3000) as i32;
+            Err(Fault::InvalidScene)
+        }
+        11 => {
+            let j = (k + 1 + (x % 9) as usize) % 10;
+            scene.segments.swap(k, j);
+            Err(Fault::InvalidScene)
+        }
+        // More segments than the table holds, with a length that matches the count.
+        12 => {
+            let n = 17 + (x % 8) as usize;
+            raw = Some(Box::new(move |p: &mut Vec<u8>| {
+                p[34] = n as u8;
+                let seg = p[SCENE_HEADER_LEN..SCENE_HEADER_LEN + SEGMENT_LEN].to_vec();
+                p.truncate(SCENE_HEADER_LEN);
+                for _ in 0..n {
+                    p.extend_from_slice(&seg);
+                }
+            }));
+            Err(Fault::InvalidScene)
+        }
+        // A pixel that never sees the Earth, even at nadir.
+        13 => {
+            scene.segments[9].last_px = 90_000 + (x % 1_000_000) as i32;
+            Err(Fault::InvalidScene)
+        }
+        14 => {
+            scene.mtf_floor = 1.0 + (x % 100) as f32 / 10.0;
+            Err(Fault::InvalidScene)
+        }
+        15 => {
+            scene.segments[k].tdi_stages = 0;
+            Err(Fault::InvalidScene)
+        }
+        16 => {
+            scene.camera.focal_m = f64::NAN;
+            Err(Fault::NonFinite)
+        }
+        17 => {
+            let cut = 1 + (x % 11) as usize;
+            raw = Some(Box::new(move |p: &mut Vec<u8>| p.truncate(p.len() - cut)));
+            Err(Fault::BadLength)
+        }
+        18 => {
+            scene.max_roll_rad = 1.3 + (x % 100) as f32;
+            Err(Fault::InvalidScene)
+        }
+        _ => {
+            scene.count = 0;
+            Err(Fault::InvalidScene)
+        }
+    };
+    let mut p = vec![0u8; 400];
+    let n = scene.encode(&mut p).unwrap();
+    p.truncate(n);
+    if let Some(f) = raw {
+        f(&mut p);
+    }
+    // The decoder leaves the table beyond the count empty.
+    for s in scene.segments.iter_mut().skip(usize::from(scene.count)) {
+        *s = Default::default();
+    }
+    let accepted = verdict.is_ok().then_some(scene);
+    (p, verdict, accepted)
+}
+
+/// What the session sent during one action.
+#[derive(Default, Debug)]
+struct Sent {
+    periods: Vec<(u64, Periods)>,
+    status: Vec<Status>,
+}
+
+/// A `Session` and the model, stepped together.
+pub struct Harness {
+    pub session: Session,
+    pub model: Model,
+    seq: u16,
+    fed_bytes: u64,
+    periods_frames: u32,
+    /// PERIODS frames in mode stale whose predecessor was not (one per stale episode).
+    stale_entries: u32,
+    last_periods_mode: Option<u8>,
+    pub steps: u32,
+}
+
+impl Default for Harness {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl Harness {
+    pub fn new() -> Harness {
+        Harness::with(Controller::new(Config::default(), Scene::paper_default()).unwrap())
+    }
+
+    /// A harness around `c`, a controller fresh from `Controller::new` (the fuzz target
+    /// clones one, which saves planning the default scene per input).
+    pub fn with(c: Controller) -> Harness {
+        let config = c.config;
+        Harness {
+            session: Session::new(c),
+            model: Model {
+                max_jump_us: config.max_time_jump_us,
+                ..Model::default()
+            },
+            seq: 0,
+            fed_bytes: 0,
+            periods_frames: 0,
+            stale_entries: 0,
+            last_periods_mode: None,
+            steps: 0,
+        }
+    }
+
+    fn frame(&mut self, kind: u8, t_us: u64, payload: &[u8]) -> Vec<u8> {
+        let mut buf = [0u8; MAX_FRAME];
+        let n = encode(kind, self.seq, t_us, payload, &mut buf).unwrap();
+        self.seq = self.seq.wrapping_add(1);
+        buf[..n].to_vec()
+    }
+
+    /// A frame of which no byte after the first is the sync word's first byte (so that
+    /// a rescan after damaging it skips all of it): the sequence number is varied.
+    fn clean_frame(&mut self, kind: u8, t_us: u64, payload: &[u8]) -> Option<Vec<u8>> {
+        for _ in 0..64 {
+            let f = self.frame(kind, t_us, payload);
+            if !f[1..].contains(&SYNC[0]) {
+                return Some(f);
+            }
+        }
+        None
+    }
+
+    fn feed(&mut self, bytes: &[u8]) -> Sent {
+        let mut out = Vec::new();
+        let mut sink = Recorder::default();
+        for &b in bytes {
+            self.session
+                .feed(&[b], &mut sink, |f| out.extend_from_slice(f));
+            check_writes(&self.session.controller, &sink.writes);
+            sink.writes.clear();
+        }
+        self.fed_bytes += bytes.len() as u64;
+        self.decode_downlink(&out)
+    }
+
+    fn decode_downlink(&mut self, out: &[u8]) -> Sent {
+        let mut sent = Sent::default();
+        let mut d = Decoder::new();
+        d.feed(out, |e| match e {
+            Event::Frame(f) if f.kind == kind::PERIODS => sent
+                .periods
+                .push((f.time_us, Periods::decode(f.payload).expect("PERIODS"))),
+            Event::Frame(f) if f.kind == kind::STATUS => {
+                sent.status.push(Status::decode(f.payload).expect("STATUS"))
+            }
+            other => panic!("unexpected downlink event {other:?}"),
+        });
+        assert_eq!(d.skipped_bytes, 0, "stray downlink bytes");
+        for (_, p) in &sent.periods {
+            self.periods_frames += 1;
+            if p.mode == Mode::Stale as u8 && self.last_periods_mode != Some(p.mode) {
+                self.stale_entries += 1;
+            }
+            self.last_periods_mode = Some(p.mode);
+            for r in p.records() {
+                assert!((0.0..=1.0).contains(&r.mtf), "MTF {} outside [0, 1]", r.mtf);
+            }
+        }
+        sent
+    }
+
+    fn snapshot(&self) -> (Option<u64>, Scene, Vec<SegmentOutput>, u32) {
+        let c = &self.session.controller;
+        (
+            c.nav().map(|n| n.time_us),
+            *c.scene(),
+            c.outputs().copied().collect(),
+            c.updates,
+        )
+    }
+
+    /// One frame through the session and the model; checks the verdict's effect.
+    fn one_frame(
+        &mut self,
+        kind: u8,
+        t_us: u64,
+        payload: &[u8],
+        content: Result<(), Fault>,
+        scene: Option<Scene>,
+    ) {
+        let bytes = self.frame(kind, t_us, payload);
+        self.deliver(&bytes, t_us, content, scene);
+    }
+
+    fn deliver(
+        &mut self,
+        bytes: &[u8],
+        t_us: u64,
+        content: Result<(), Fault>,
+        scene: Option<Scene>,
+    ) {
+        let before = self.snapshot();
+        let verdict = self.model.frame(t_us, bytes.len(), content);
+        let sent = self.feed(bytes);
+        let c = &self.session.controller;
+        match verdict {
+            Verdict::Refused(f) => {
+                assert_eq!(
+                    c.last_fault,
+                    Some(f),
+                    "refusal of kind {kind_of:?}",
+                    kind_of = bytes.get(3)
+                );
+                assert_eq!(
+                    self.snapshot(),
+                    before,
+                    "a refused frame ({f:?}) changed the state"
+                );
+                assert!(
+                    sent.periods.is_empty() && sent.status.is_empty(),
+                    "a refused frame sent {sent:?}"
+                );
+            }
+            Verdict::Accepted { resync } => {
+                assert_eq!(c.now_us(), self.model.now_us, "clock");
+                match bytes.get(3) {
+                    Some(&kind::NAV) => {
+                        self.model.nav_time_us = Some(t_us);
+                        assert_eq!(c.nav().map(|n| n.time_us), Some(t_us), "NAV not taken");
+                    }
+                    Some(&kind::SCENE) => {
+                        assert_eq!(Some(*c.scene()), scene, "SCENE not taken");
+                    }
+                    _ => {}
+                }
+                if resync {
+                    assert_eq!(
+                        sent.status.len(),
+                        1,
+                        "a re-synchronisation is reported at once"
+                    );
+                }
+            }
+        }
+    }
+
+    /// Checks everything the model knows, and the counter identities.
+    pub fn check(&self) {
+        let c = &self.session.controller;
+        let m = &self.model;
+        for f in Fault::ALL {
+            if matches!(
+                f,
+                Fault::Stale | Fault::BeyondLimb | Fault::PeriodOutOfRange
+            ) {
+                continue;
+            }
+            assert_eq!(
+                c.counters.get(f),
+                m.counts[f as usize],
+                "counter {}",
+                f.name()
+            );
+        }
+        assert_eq!(c.frames_accepted, m.frames_accepted, "frames accepted");
+        assert_eq!(c.time_resyncs, m.time_resyncs, "re-synchronisations");
+        assert_eq!(c.now_us(), m.now_us, "clock");
+        assert_eq!(c.nav().map(|n| n.time_us), m.nav_time_us, "NAV in force");
+        assert_eq!(
+            self.session.decoder.buffered(),
+            0,
+            "bytes left in the decoder"
+        );
+        assert_eq!(
+            self.session.decoder.skipped_bytes, m.skipped_bytes,
+            "skipped bytes"
+        );
+        // The identities of docs/telemetry.md, "Counters".
+        assert_eq!(
+            self.fed_bytes,
+            m.delivered_bytes + u64::from(self.session.decoder.skipped_bytes),
+            "bytes received = delivered frames' bytes + skipped"
+        );
+        let frame_faults: u32 = [
+            Fault::UnknownKind,
+            Fault::BadLength,
+            Fault::NonFinite,
+            Fault::OutOfRange,
+            Fault::TimeWentBackwards,
+            Fault::AttitudeOutsideModel,
+            Fault::InvalidScene,
+            Fault::TimeJump,
+        ]
+        .iter()
+        .map(|&f| c.counters.get(f))
+        .sum();
+        // Only NAV frames make out_of_range, and the model generates none that the
+        // update could refuse; so every out_of_range here is a refused frame.
+        assert_eq!(
+            c.frames_accepted + frame_faults,
+            m.frames_delivered,
+            "frames delivered"
+        );
+        assert_eq!(c.updates, self.periods_frames, "updates = PERIODS frames");
+        assert_eq!(
+            c.counters.get(Fault::Stale),
+            self.stale_entries,
+            "stale episodes"
+        );
+        assert!(c.now_us() <= MAX_TIME_TAG_US);
+    }
+
+    /// Runs one action, then checks.
+    pub fn step(&mut self, a: &Action) {
+        self.steps += 1;
+        let now = self.model.now_us;
+        let last = self.model.last_accepted_us;
+        match *a {
+            Action::Nav {
+                dt_us,
+                u_rad,
+                h_m,
+                i_rad,
+                roll_rad,
+            } => {
+                let p = nav_payload(
+                    state(i_rad, u_rad, h_m),
+                    Attitude {
+                        roll_rad,
+                        ..Attitude::default()
+                    },
+                );
+                self.one_frame(kind::NAV, now + dt_us, &p, Ok(()), None);
+            }
+            Action::BadNav { dt_us, what } => {
+                let good = state(1.7, 0.3, 645e3);
+                let (sv, att, f) = match what % 5 {
+                    0 => {
+                        let mut s = good;
+                        s.velocity_mps[1] = f64::NAN;
+                        (s, Attitude::default(), Fault::NonFinite)
+                    }
+                    1 => (
+                        state(1.7, 0.3, 100e3),
+                        Attitude::default(),
+                        Fault::OutOfRange,
+                    ),
+                    2 => (
+                        good,
+                        Attitude {
+                            pitch_rad: 0.02,
+                            ..Attitude::default()
+                        },
+                        Fault::AttitudeOutsideModel,
+                    ),
+                    3 => (
+                        good,
+                        Attitude {
+                            roll_rad: 0.9,
+                            ..Attitude::default()
+                        },
+                        Fault::OutOfRange,
+                    ),
+                    _ => (
+                        good,
+                        Attitude {
+                            roll_rad: f32::INFINITY,
+                            ..Attitude::default()
+                        },
+                        Fault::NonFinite,
+                    ),
+                };
+                self.one_frame(kind::NAV, now + dt_us, &nav_payload(sv, att), Err(f), None);
+            }
+            Action::Time { dt_us } => self.one_frame(kind::TIME, now + dt_us, &[], Ok(()), None),
+            Action::Tick { dt_us } => {
+                let mut out = Vec::new();
+                let mut sink = Recorder::default();
+                self.session
+                    .tick(now + dt_us, &mut sink, |f| out.extend_from_slice(f));
+                check_writes(&self.session.controller, &sink.writes);
+                self.model.now_us = (now + dt_us).min(MAX_TIME_TAG_US).max(now);
+                self.decode_downlink(&out);
+            }
+            Action::Scene { dt_us, edit, k, x } => {
+                let (p, verdict, scene) = scene_case(edit, k, x);
+                self.one_frame(kind::SCENE, now + dt_us, &p, verdict, scene);
+            }
+            Action::Backwards { back_us } => {
+                let t = last.unwrap_or(0).saturating_sub(back_us);
+                self.one_frame(kind::TIME, t, &[], Ok(()), None);
+            }
+            Action::Jump { beyond_us } => {
+                let t = now + self.model.max_jump_us + beyond_us;
+                self.one_frame(kind::TIME, t, &[], Ok(()), None);
+            }
+            Action::TimeMax { below_max } => {
+                let t = [u64::MAX, u64::MAX - 1, MAX_TIME_TAG_US + 1][below_max as usize % 3];
+                self.one_frame(kind::TIME, t, &[], Ok(()), None);
+            }
+            Action::Resync {
+                forward,
+                offset_us,
+                gap_us,
+            } => {
+                let t = if forward {
+                    (now + self.model.max_jump_us + offset_us).min(MAX_TIME_TAG_US - gap_us)
+                } else {
+                    last.unwrap_or(0).saturating_sub(offset_us)
+                };
+                self.one_frame(kind::TIME, t, &[], Ok(()), None);
+                self.one_frame(kind::TIME, t + gap_us, &[], Ok(()), None);
+            }
+            Action::BadKind { kind: k, len } => {
+                let (k, verdict) = if is_known_kind(k) {
+                    (kind::TIME, Err(Fault::BadLength))
+                } else {
+                    (k, Err(Fault::UnknownKind))
+                };
+                let len = if k == kind::TIME {
+                    1 + len % 40
+                } else {
+                    len % 40
+                };
+                let payload = vec![0x5A; usize::from(len)];
+                self.one_frame(k, now + 1, &payload, verdict, None);
+            }
+            Action::BitFlip { bit, seed } => {
+                let mut s = seed;
+                let Some(mut f) = self.clean_frame(kind::TIME, splitmix(&mut s) & 0xFFFF_FFFF, &[])
+                else {
+                    return self.check();
+                };
+                // After the length field: sequence, time tag, CRC.
+                let bit = usize::from(bit) % ((f.len() - 6) * 8);
+                f[6 + bit / 8] ^= 1 << (bit % 8);
+                if f[1..].contains(&SYNC[0]) {
+                    return self.check();
+                }
+                self.model.counts[Fault::BadCrc as usize] += 1;
+                self.model.skipped_bytes += f.len() as u32;
+                let before = self.snapshot();
+                let sent = self.feed(&f);
+                assert_eq!(self.snapshot(), before, "a damaged frame changed the state");
+                assert!(sent.periods.is_empty() && sent.status.is_empty());
+            }
+            Action::Cut { at, dt_us } => {
+                let p = nav_payload(state(1.7, 0.3, 645e3), Attitude::default());
+                let good = nav_payload(
+                    state(1.7, 0.3 + dt_us as f64 * 1e-9, 645e3),
+                    Attitude::default(),
+                );
+                let next = self.frame(kind::NAV, now + dt_us, &good);
+                // The cut frame's tag and content do not matter (it is lost); its bytes
+                // after the first must hold no sync byte, so that the rescan skips them,
+                // and the cut frame with the next one's start must not pass the CRC by
+                // chance (1 in 65 536: the fuzzer found one).
+                let mut cut = None;
+                for s in 0..64u64 {
+                    let f = self.frame(kind::NAV, 0x0102_0304 + s, &p);
+                    let clean = 1 + f[1..].iter().position(|&b| b == SYNC[0]).unwrap_or(f.len());
+                    // At least the header; at least 3 bytes of the next frame in its span.
+                    let n = (HEADER_LEN + usize::from(at) % 72)
+                        .min(clean)
+                        .min(f.len() - 3);
+                    if n < HEADER_LEN {
+                        continue;
+                    }
+                    let mut both = f[..n].to_vec();
+                    both.extend_from_slice(&next);
+                    let mut events = Vec::new();
+                    Decoder::new().feed(&both, |e| {
+                        events.push(matches!(e, Event::Rejected(FrameError::Truncated)))
+                    });
+                    if events == [true, false] {
+                        cut = Some(f[..n].to_vec());
+                        break;
+                    }
+                }
+                let Some(cut) = cut else {
+                    return self.check();
+                };
+                self.model.counts[Fault::Truncated as usize] += 1;
+                self.model.skipped_bytes += cut.len() as u32;
+                let before = self.snapshot();
+                // The decoder holds the cut frame until the next one shows it was cut.
+                let sent = self.feed(&cut);
+                assert_eq!(self.snapshot(), before);
+                assert!(sent.periods.is_empty() && sent.status.is_empty());
+                self.deliver(&next, now + dt_us, Ok(()), None);
+            }
+            Action::Noise { len, seed } => {
+                let mut s = seed;
+                let noise: Vec<u8> = (0..len)
+                    .map(|_| match splitmix(&mut s) as u8 {
+                        b if b == SYNC[0] => 0x55,
+                        b => b,
+                    })
+                    .collect();
+                self.model.skipped_bytes += noise.len() as u32;
+                let before = self.snapshot();
+                let sent = self.feed(&noise);
+                assert_eq!(self.snapshot(), before);
+                assert!(
+                    sent.periods.is_empty() && sent.status.is_empty(),
+                    "noise sent {sent:?}"
+                );
+            }
+            Action::BadVersion { version, seed } => {
+                let version = if version == VERSION {
+                    VERSION + 1
+                } else {
+                    version
+                };
+                let mut s = seed;
+                let Some(mut f) = self.clean_frame(kind::TIME, splitmix(&mut s) & 0xFFFF_FFFF, &[])
+                else {
+                    return self.check();
+                };
+                f[2] = version;
+                if f[1..].contains(&SYNC[0]) {
+                    return self.check();
+                }
+                self.model.counts[Fault::UnknownVersion as usize] += 1;
+                self.model.skipped_bytes += f.len() as u32;
+                let sent = self.feed(&f);
+                assert!(sent.periods.is_empty() && sent.status.is_empty());
+            }
+            Action::Oversized { len, seed } => {
+                let mut s = seed;
+                let Some(f) = self.clean_frame(kind::TIME, splitmix(&mut s) & 0xFFFF_FFFF, &[])
+                else {
+                    return self.check();
+                };
+                let mut h = f[..HEADER_LEN].to_vec();
+                let n = (MAX_PAYLOAD + 1 + usize::from(len)) as u16;
+                h[4..6].copy_from_slice(&n.to_le_bytes());
+                if h[1..].contains(&SYNC[0]) {
+                    return self.check();
+                }
+                self.model.counts[Fault::Oversized as usize] += 1;
+                self.model.skipped_bytes += h.len() as u32;
+                let sent = self.feed(&h);
+                assert!(sent.periods.is_empty() && sent.status.is_empty());
+            }
+        }
+        self.check();
+    }
+
+    /// END: the final STATUS carries every counter, and they reconcile.
+    pub fn finish(&mut self) {
+        let t = self.model.now_us;
+        let end = self.frame(kind::END, t, &[]);
+        self.model.frames_delivered += 1;
+        self.model.delivered_bytes += end.len() as u64;
+        self.model.frames_accepted += 1;
+        let sent = self.feed(&end);
+        assert!(self.session.is_ended());
+        let s = sent.status.last().expect("a final STATUS");
+        let c = &self.session.controller;
+        assert_eq!(s.frames_accepted, c.frames_accepted);
+        assert_eq!(s.updates, self.periods_frames);
+        assert_eq!(s.skipped_bytes, self.model.skipped_bytes);
+        assert_eq!(s.time_resyncs, self.model.time_resyncs);
+        assert_eq!(&s.counts, c.counters.as_array());
+        self.check();
+    }
+}
