@@ -32,12 +32,20 @@ static BOOT: std::sync::OnceLock<controller::Controller> = std::sync::OnceLock::
 
 fuzz_target!(|data: &[u8]| {
     let boot = BOOT.get_or_init(|| {
-        controller::Controller::new(controller::Config::default(), controller::Scene::paper_default())
-            .expect("the default scene")
+        controller::Controller::new(
+            controller::Config::default(),
+            controller::Scene::paper_default(),
+        )
+        .expect("the default scene")
     });
     let mut h = Harness::with(boot.clone());
     for chunk in data.chunks_exact(ACTION_LEN).take(MAX_ACTIONS) {
-        let a = Action::decode(chunk[0], u64_at(chunk, 1), u64_at(chunk, 9), u64_at(chunk, 17));
+        let a = Action::decode(
+            chunk[0],
+            u64_at(chunk, 1),
+            u64_at(chunk, 9),
+            u64_at(chunk, 17),
+        );
         h.step(&a);
     }
     h.finish();
