@@ -44,3 +44,20 @@ pub fn roll(rad: f32) -> Attitude {
         ..Attitude::default()
     }
 }
+
+/// A period sink that takes every write.
+pub struct Accept;
+
+impl controller::LinePeriodSink for Accept {
+    type Error = ();
+    fn write_period(&mut self, _index: u8, _ticks: u32) -> Result<(), ()> {
+        Ok(())
+    }
+}
+
+/// One frame of `kind`, as the ground would send it.
+pub fn frame(kind: u8, seq: u16, time_us: u64, payload: &[u8]) -> Vec<u8> {
+    let mut buf = [0u8; MAX_FRAME];
+    let n = encode(kind, seq, time_us, payload, &mut buf).unwrap();
+    buf[..n].to_vec()
+}

@@ -3,26 +3,11 @@
 
 mod common;
 
-use common::{nav_frame, roll, state};
-use controller::frame::{encode, kind, Decoder, Event, MAX_FRAME};
+use common::{frame, nav_frame, roll, state, Accept};
+use controller::frame::{kind, Decoder, Event};
 use controller::report::{Periods, Status};
 use controller::session::Session;
-use controller::{Config, Controller, Fault, LinePeriodSink, Scene};
-
-struct Accept;
-
-impl LinePeriodSink for Accept {
-    type Error = ();
-    fn write_period(&mut self, _index: u8, _ticks: u32) -> Result<(), ()> {
-        Ok(())
-    }
-}
-
-fn frame(kind: u8, seq: u16, time_us: u64, payload: &[u8]) -> Vec<u8> {
-    let mut buf = [0u8; MAX_FRAME];
-    let n = encode(kind, seq, time_us, payload, &mut buf).unwrap();
-    buf[..n].to_vec()
-}
+use controller::{Config, Controller, Fault, Scene};
 
 /// Two seconds: NAV at 4 Hz, TIME at every other 20 ms tick, a bad CRC, END.
 fn uplink() -> Vec<u8> {

@@ -648,36 +648,6 @@ mod tests {
     /// the 1e-9 bound (either may report hit or miss there).
     const LIMB_BAND_RAD: f64 = 0.5 * std::f64::consts::PI / 180.0;
 
-    /// Moves the roll, between 0 and `side` x 45 deg, so that the line of sight lies
-    /// `margin_rad` inside the limb (negative: outside), by bisection; None when the
-    /// margin is not bracketed there.
-    fn roll_at_margin(
-        g: &EarthGeometry<f64>,
-        cam: &EarthCamera,
-        n: f64,
-        margin_rad: f64,
-        side: f64,
-    ) -> Option<f64> {
-        let at = |roll: f64| {
-            let mut h = *g;
-            h.attitude.roll_rad = roll;
-            limb_margin_rad(&h, cam, n).ok()
-        };
-        let (mut lo, mut hi) = (0.0, side * 45f64.to_radians());
-        if !(at(lo)? > margin_rad && at(hi)? < margin_rad) {
-            return None;
-        }
-        for _ in 0..60 {
-            let mid = 0.5 * (lo + hi);
-            if at(mid)? > margin_rad {
-                lo = mid;
-            } else {
-                hi = mid;
-            }
-        }
-        Some(0.5 * (lo + hi))
-    }
-
     /// What one run of the two-route comparison found.
     #[derive(Debug, Default)]
     struct TwoRoute {
@@ -717,7 +687,12 @@ mod tests {
                 } else {
                     -1.0
                 };
-                if let Some(roll) = roll_at_margin(&g, &cam, n, m, side) {
+                let case = core_math::sample::EarthCase {
+                    camera: cam,
+                    geometry: g,
+                    n_px: n,
+                };
+                if let Some(roll) = core_math::sample::roll_at_limb_margin(&case, m, side) {
                     g.attitude.roll_rad = roll;
                 }
             }
