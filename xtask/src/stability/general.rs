@@ -421,32 +421,12 @@ pub fn sweep(spec: &'static GSpec, nx: usize, ny: usize, sub: usize) -> GMap {
         }
         c
     };
-    let workers = std::thread::available_parallelism().map_or(1, |n| n.get());
-    let mut rows: Vec<Vec<GCell>> = vec![Vec::new(); ny];
-    std::thread::scope(|scope| {
-        let handles: Vec<_> = (0..workers)
-            .map(|w| {
-                let cell = &cell;
-                scope.spawn(move || {
-                    (w..ny)
-                        .step_by(workers)
-                        .map(|iy| (iy, (0..nx).map(|ix| cell(ix, iy)).collect::<Vec<_>>()))
-                        .collect::<Vec<_>>()
-                })
-            })
-            .collect();
-        for h in handles {
-            for (iy, row) in h.join().expect("sweep worker panicked") {
-                rows[iy] = row;
-            }
-        }
-    });
     GMap {
         spec,
         nx,
         ny,
         sub,
-        cells: rows.into_iter().flatten().collect(),
+        cells: super::maps::sweep_rows(nx, ny, cell),
     }
 }
 

@@ -264,8 +264,24 @@ pub fn sweep(spec: &'static MapSpec, nx: usize, ny: usize, sub: usize) -> Map {
         }
         c
     };
+    Map {
+        spec,
+        nx,
+        ny,
+        sub,
+        cells: sweep_rows(nx, ny, cell),
+    }
+}
+
+/// `cell(ix, iy)` over an nx x ny grid, rows spread over the available threads, in
+/// row-major order (the same result for any number of threads).
+pub(crate) fn sweep_rows<C: Clone + Send>(
+    nx: usize,
+    ny: usize,
+    cell: impl Fn(usize, usize) -> C + Sync,
+) -> Vec<C> {
     let workers = std::thread::available_parallelism().map_or(1, |n| n.get());
-    let mut rows: Vec<Vec<Cell>> = vec![Vec::new(); ny];
+    let mut rows: Vec<Vec<C>> = vec![Vec::new(); ny];
     std::thread::scope(|scope| {
         let handles: Vec<_> = (0..workers)
             .map(|w| {
@@ -284,11 +300,5 @@ pub fn sweep(spec: &'static MapSpec, nx: usize, ny: usize, sub: usize) -> Map {
             }
         }
     });
-    Map {
-        spec,
-        nx,
-        ny,
-        sub,
-        cells: rows.into_iter().flatten().collect(),
-    }
+    rows.into_iter().flatten().collect()
 }
