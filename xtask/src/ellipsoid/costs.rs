@@ -170,6 +170,14 @@ fn period_err(truth: &ImageMotion<f64>, model: &ImageMotion<f64>) -> f64 {
     truth.v1_mps.abs() / model.v1_mps.abs() - 1.0
 }
 
+/// How a row compares the model's motion with the truth's.
+type ErrFn = fn(&ImageMotion<f64>, &ImageMotion<f64>) -> f64;
+
+/// T_model / T_truth - 1 with Eq. 16's period T = pixel / |v_P|.
+fn speed_err(truth: &ImageMotion<f64>, model: &ImageMotion<f64>) -> f64 {
+    truth.speed_mps() / model.speed_mps() - 1.0
+}
+
 /// Eq. 16's period pixel / |v_P| against the contract's pixel / |v1|, same motion.
 fn eq16_err(m: &ImageMotion<f64>) -> f64 {
     m.v1_mps.abs() / m.speed_mps() - 1.0
@@ -406,61 +414,47 @@ pub fn costs(grid: Grid) -> Costs {
             c.u_rad,
         )
     };
-    rows.push(Row {
-        label: "(c) e = 0.05 -> the circular model of the same instant",
-        truth:
+    let variants: [(&str, &str, &str, &str, ErrFn); 2] = [
+        (
+            "(c) e = 0.05 -> the circular model of the same instant",
             "sphere R = 6371 km, e = 0.05 (645 km at the instant, perigee at the node), roll only",
-        model: "paper's round Earth from the state vector (`OrbitState::from_state`)",
-        default: Some(over_default(
-            &cases,
-            |c, s| {
-                let mut g = wgs(*s, roll_only(c.roll_rad), 0.0);
+            "paper's round Earth from the state vector (`OrbitState::from_state`)",
+            "sphere, roll only, p1 = 0, h = 0, e 0-0.05 as drawn",
+            period_err,
+        ),
+        (
+            "(c) the same, in the Eq. 16 period pixel / |v_P| of both",
+            "as above",
+            "as above",
+            "as above",
+            speed_err,
+        ),
+    ];
+    for (label, truth_text, model_text, envelope_note, err) in variants {
+        rows.push(Row {
+            label,
+            truth: truth_text,
+            model: model_text,
+            default: Some(over_default(
+                &cases,
+                |c, s| {
+                    let mut g = wgs(*s, roll_only(c.roll_rad), 0.0);
+                    g.ellipsoid = sphere;
+                    let t = truth(&g, &cam, c.n)?;
+                    Some(err(&t, &paper(s, c.roll_rad, &cam, c.n)?))
+                },
+                ecc,
+            )),
+            envelope: Some(over_envelope(draws, |g, cam, n| {
+                paper_case(g, cam);
+                g.ground_h_m = 0.0;
                 g.ellipsoid = sphere;
-                let t = truth(&g, &cam, c.n)?;
-                Some(period_err(&t, &paper(s, c.roll_rad, &cam, c.n)?))
-            },
-            ecc,
-        )),
-        envelope: Some(over_envelope(draws, |g, cam, n| {
-            paper_case(g, cam);
-            g.ground_h_m = 0.0;
-            g.ellipsoid = sphere;
-            let t = truth(g, cam, n)?;
-            Some(period_err(
-                &t,
-                &paper(&g.state, g.attitude.roll_rad, cam, n)?,
-            ))
-        })),
-        envelope_note: "sphere, roll only, p1 = 0, h = 0, e 0-0.05 as drawn",
-    });
-    let speed_err =
-        |t: &ImageMotion<f64>, m: &ImageMotion<f64>| t.speed_mps() / m.speed_mps() - 1.0;
-    rows.push(Row {
-        label: "(c) the same, in the Eq. 16 period pixel / |v_P| of both",
-        truth: "as above",
-        model: "as above",
-        default: Some(over_default(
-            &cases,
-            |c, s| {
-                let mut g = wgs(*s, roll_only(c.roll_rad), 0.0);
-                g.ellipsoid = sphere;
-                let t = truth(&g, &cam, c.n)?;
-                Some(speed_err(&t, &paper(s, c.roll_rad, &cam, c.n)?))
-            },
-            ecc,
-        )),
-        envelope: Some(over_envelope(draws, |g, cam, n| {
-            paper_case(g, cam);
-            g.ground_h_m = 0.0;
-            g.ellipsoid = sphere;
-            let t = truth(g, cam, n)?;
-            Some(speed_err(
-                &t,
-                &paper(&g.state, g.attitude.roll_rad, cam, n)?,
-            ))
-        })),
-        envelope_note: "as above",
-    });
+                let t = truth(g, cam, n)?;
+                Some(err(&t, &paper(&g.state, g.attitude.roll_rad, cam, n)?))
+            })),
+            envelope_note,
+        });
+    }
 
     // (d) Pitch and yaw ignored.
     for (k, &pitch_deg) in PITCHES_DEG.iter().enumerate() {
