@@ -5,14 +5,16 @@
 //! the satellite, u = (p1, p2, -f), and c(t) = M(t)^T (G(t) - r(t)):
 //!
 //! ```text
-//! c'/s = -W x u - V / s,      W = w_B - omega z_B   (camera's angular velocity relative
-//!                                                    to the Earth, in B)
+//! c'/s = -W x u - V / s,      W = w_B - omega n_B   (camera's angular velocity relative
+//!                                                    to the Earth, in B; n_B the spin
+//!                                                    axis in B)
 //!                             V = M^T (v - omega z x r)   (satellite's velocity relative
 //!                                                         to the Earth, in B)
 //! v1 = g1 + (p1/f) g3,  v2 = g2 + (p2/f) g3,   g = c'/s
 //! ```
 //!
-//! Per update (once per NAV state; three sine/cosine pairs, one division):
+//! Per update (once per NAV state; three sine/cosine pairs, three divisions: 1/(|h||r|),
+//! 1/B^2, 1/C):
 //! - in L: n = z in L = (x_L,z, y_L,z, z_L,z), the orbit rate nu = |r x v| / |r|^2 (the
 //!   L frame turns about y_L at nu for any central force), V_L = (|h|/|r| - omega |r| n2,
 //!   omega |r| n1, r.v/|r|), W_L = (0, nu, 0) - omega n;
@@ -105,7 +107,7 @@ impl<T: Real> Backend<Earth> for General<T> {
         let (r64, v64) = (g.state.position_m, g.state.velocity_mps);
         let r = r64.map(T::from_f64);
         let v = v64.map(T::from_f64);
-        let r2 = check_state(r, v)?;
+        let (r2, h) = check_state(r, v)?;
         // |r|^2 - A^2 is the one difference of nearly equal terms (a factor up to 16 at
         // 200 km): formed in f64 from the f64 state (eight soft-f64 operations on the
         // target), then rounded. Everything else is a product or a sum of like signs.
@@ -120,18 +122,10 @@ impl<T: Real> Backend<Earth> for General<T> {
         let c_m2 = r2_minus_a2 + k2m1 * r[2] * r[2];
         check_altitude(c_m2, r2, eq_m)?;
         let w = T::from_f64(g.earth_rate_rad_s);
-        let zero = T::ZERO;
 
         let rn = r2.sqrt();
-        let h = [
-            r[1] * v[2] - r[2] * v[1],
-            r[2] * v[0] - r[0] * v[2],
-            r[0] * v[1] - r[1] * v[0],
-        ];
+        // |h| > 0: check_state refused any state with |h|^2 <= 1e-12 |r|^2 |v|^2.
         let hn = dot3(h, h).sqrt();
-        if !(hn > zero) {
-            return Err(ModelError::DegenerateState);
-        }
         // n = z in L: x_L,z = (y_L x z_L)_z, y_L,z = h_z/|h|, z_L,z = r_z/|r|.
         let inv_hr = T::ONE / (hn * rn);
         let n_l = [

@@ -322,7 +322,7 @@ impl<T: Real> EarthGeometry<T> {
     pub fn validate(&self) -> Result<Ground, ModelError> {
         let (eq_m, polar_m) = self.check_inputs()?;
         let (r, v) = (self.state.position_m, self.state.velocity_mps);
-        let r2 = check_state(r, v)?;
+        let (r2, _) = check_state(r, v)?;
         let a = self.ellipsoid.a_m;
         let k2m1 = (a * self.ellipsoid.flattening) * (eq_m + polar_m) / (polar_m * polar_m);
         let c_m2 = (r2 - eq_m * eq_m) + k2m1 * r[2] * r[2];
@@ -338,8 +338,9 @@ impl<T: Real> EarthGeometry<T> {
 
 /// The state-vector checks, in any scalar: |r| and |v| within the domain, an orbital
 /// plane (r x v not below 1e-6 |r| |v|: a flight path within a microradian of the
-/// vertical is degenerate for every scalar, so f32 and f64 agree on it). Returns |r|^2.
-pub fn check_state<S: Real>(r: [S; 3], v: [S; 3]) -> Result<S, ModelError> {
+/// vertical is degenerate for every scalar, so f32 and f64 agree on it). Returns |r|^2
+/// and the angular momentum r x v (never zero after the check).
+pub fn check_state<S: Real>(r: [S; 3], v: [S; 3]) -> Result<(S, [S; 3]), ModelError> {
     let dot = |a: [S; 3], b: [S; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
     let (r2, v2) = (dot(r, r), dot(v, v));
     // Squared bounds: no square root.
@@ -357,7 +358,7 @@ pub fn check_state<S: Real>(r: [S; 3], v: [S; 3]) -> Result<S, ModelError> {
     if !(dot(h, h) > S::from_f64(MIN_SIN2_FLIGHT_PATH) * (r2 * v2)) {
         return Err(ModelError::DegenerateState);
     }
-    Ok(r2)
+    Ok((r2, h))
 }
 
 /// The satellite against the ground ellipsoid from C = |K r|^2 - A^2, in any scalar:
