@@ -1,20 +1,30 @@
 //! The line-rate controller: accepts frames, keeps the last good state, and at every
-//! update instant computes each active segment's line period, its MTF and TDI stage
-//! limit and its drift angle, writing the periods through a [`LinePeriodSink`].
+//! update instant computes each active segment's line period, its MTF (mismatch times
+//! drift smear) and TDI stage limit, its drift angles, and the yaw steering request,
+//! writing the periods through a [`LinePeriodSink`].
+//!
+//! The model is the general real-Earth form of core-math (`GENERAL_F32`): WGS 84
+//! ([`EARTH`]), the NAV state propagated on a two-body orbit to the update instant
+//! ([`crate::nav::Propagator`]), the full attitude at its rates, each segment's ground
+//! at its own height (SCENE, TERRAIN).
 //!
 //! Faults never reach the registers: a refused frame leaves the state as it was, a
 //! refused computation leaves that segment's last good period in force, and nothing
 //! outside the physically possible period range is ever written.
 
-use core_math::{
-    line_period_ticks, mtf_mismatch, Backend, Geometry, OrbitState, CLOSED_F32, EARTH_RATE_RAD_S,
-};
+use core_math::earth::{Attitude, GeneralUpdate};
+use core_math::{line_period_ticks, sinc, Backend, Ellipsoid, GENERAL_F32};
 
 use crate::fault::{Counters, Fault};
 use crate::frame::{kind, Frame};
-use crate::nav::{Attitude, Nav};
-use crate::plan::{Envelope, Plan, SegmentPlan};
-use crate::scene::{Scene, MAX_SEGMENTS};
+use crate::nav::{attitude_at, Nav, Propagator};
+use crate::plan::{Plan, SegmentPlan, MAX_SPEED2_RATIO, MIN_SPEED2_RATIO};
+use crate::scene::{AttitudeEnvelope, Scene, Terrain, MAX_SEGMENTS};
+
+/// The Earth of the model: WGS 84, a = 6 378 137 m, f = 1/298.257223563.
+pub const EARTH: Ellipsoid = Ellipsoid::WGS84;
+/// The Earth's rotation rate (rad/s): 7.292 115 9e-5 (IERS), core-math's.
+pub const EARTH_RATE_RAD_S: f64 = core_math::EARTH_RATE_RAD_S;
 
 /// Where line periods go: the period registers of the camera's line clock (one per
 /// segment), in the spirit of embedded-hal: small, and the only way out.
@@ -24,40 +34,23 @@ pub trait LinePeriodSink {
     fn write_period(&mut self, index: u8, ticks: u32) -> Result<(), Self::Error>;
 }
 
-/// Controller settings (defaults: `Config::default()`; rationale in docs/telemetry.md).
+/// Controller settings (defaults: `Config::default()`; rationale in docs/controller.md).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Config {
-    /// Time between updates (us). Default 20 ms: a 1 deg/s roll manoeuvre changes the
-    /// image speed by up to 8.8 %/s (far point, 800 km), and the drift between updates
-    /// may use a tenth of a 16-stage segment's budget (2.2e-3): at most 24.9 ms
-    /// (`cargo test -p controller --release --test update_rate -- --nocapture`).
+    /// Time between updates (us). Default 20 ms (docs/controller.md, "The update rate").
     pub update_period_us: u64,
-    /// No valid NAV frame for longer than this (us) is a [`Fault::Stale`] and stops updates.
+    /// No valid NAV frame for longer than this (us) is a [`Fault::Stale`] and stops
+    /// updates. It is also how far ahead a NAV frame's attitude is propagated when it
+    /// is checked against the scene's envelope.
     pub stale_after_us: u64,
     /// Largest step (us) a time tag may take ahead of the controller's clock. A tag
     /// further ahead is refused ([`Fault::TimeJump`]) unless the next frame confirms
     /// the new time line (a re-synchronisation, docs/telemetry.md "Time").
     pub max_time_jump_us: u64,
-    /// Round-Earth radius of the model (m).
-    pub earth_radius_m: f64,
-    /// The mission's altitude band (m): NAV frames outside it are refused, and scenes
-    /// are planned and the period guard set for it. The model itself holds over
-    /// 200-2000 km; a narrower band lets the planner sample less and the guard be tighter.
+    /// The mission's altitude band above the ellipsoid (m): NAV frames whose |r| is
+    /// outside b + low ..= a + high are refused, and scenes are planned and the period
+    /// guard set for it.
     pub altitude_range_m: (f64, f64),
-    /// Largest |pitch| and |yaw| for the roll-only model (rad).
-    pub pitch_yaw_tolerance_rad: f32,
-    /// Largest |pitch rate| and |yaw rate| for the roll-only model (rad/s).
-    pub pitch_yaw_rate_tolerance_rad_s: f32,
-}
-
-impl Config {
-    /// The orbits a plan must hold for.
-    pub fn envelope(&self) -> Envelope {
-        Envelope {
-            earth_radius_m: self.earth_radius_m,
-            altitude_range_m: self.altitude_range_m,
-        }
-    }
 }
 
 impl Default for Config {
@@ -66,24 +59,22 @@ impl Default for Config {
             update_period_us: 20_000,
             stale_after_us: 1_000_000,
             max_time_jump_us: 5_000_000,
-            earth_radius_m: 6_371_000.0,
             altitude_range_m: (500e3, 800e3),
-            pitch_yaw_tolerance_rad: 0.5f32.to_radians(),
-            pitch_yaw_rate_tolerance_rad_s: 1.0e-6,
         }
     }
 }
 
 /// Largest time tag the clock takes (us, 2^53: 285 years). Up to it every tag is exact
-/// in f64 (the propagation's `dt`), and the schedule's sums cannot overflow.
+/// in f64, and the schedule's sums cannot overflow.
 pub const MAX_TIME_TAG_US: u64 = 1 << 53;
 
 /// The last accepted NAV state.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct NavState {
     pub time_us: u64,
-    pub orbit: OrbitState,
-    pub attitude: Attitude,
+    pub propagator: Propagator,
+    /// The attitude, yaw wrapped to [-pi, pi].
+    pub attitude: Attitude<f32>,
 }
 
 /// One segment's output at one update.
@@ -91,14 +82,25 @@ pub struct NavState {
 pub struct SegmentOutput {
     pub index: u8,
     pub ticks: u32,
-    /// Worst relative mismatch |v_line / v - 1| over the segment's samples.
+    /// Bound on the worst relative mismatch |v_line / |v1| - 1| over every pixel of the
+    /// segment: the samples' extremes widened by the plan's interpolation bound.
+    /// f32::MAX when the image is too slow for any bound (the MTF is then 0).
     pub worst_mismatch: f32,
-    /// MTF_mismatch at the worst sample with the segment's configured stages.
+    /// MTF at Nyquist with the segment's stages: mismatch MTF at `worst_mismatch` times
+    /// drift-smear MTF at `worst_drift_rad`, each clamped to [0, 1].
     pub mtf: f32,
-    /// Largest TDI stage count meeting the scene's MTF floor.
+    /// Largest TDI stage count whose combined MTF meets the scene's floor.
     pub max_stages: u16,
-    /// atan(v2 / v1) at the segment's centre sample (rad).
+    /// atan(v2 / v1) at the segment's centre pixel (rad).
     pub drift_rad: f32,
+    /// Largest |atan(v2 / v1)| over the segment's samples and centre (rad).
+    pub worst_drift_rad: f32,
+    /// The centre pixel's drift once the yaw steering request is applied (rad); the
+    /// unsteered drift when no request could be formed.
+    pub residual_drift_rad: f32,
+    /// The image moves towards +P1, against the forward-flight direction (-P1): the TDI
+    /// transfer must run the other way (flying backwards, yaw near 180 deg).
+    pub reversed: bool,
     /// True when this is the last good value held over a fault.
     pub held: bool,
 }
@@ -119,6 +121,8 @@ pub struct Controller {
     pub config: Config,
     scene: Scene,
     plan: Plan,
+    /// Ground height of each table entry (m): from the scene, then TERRAIN frames.
+    heights_m: [f32; MAX_SEGMENTS],
     nav: Option<NavState>,
     /// Time tag of the last accepted frame of any kind (us).
     last_time_us: Option<u64>,
@@ -135,7 +139,9 @@ pub struct Controller {
     pub time_resyncs: u32,
     outputs: [SegmentOutput; MAX_SEGMENTS],
     has_output: [bool; MAX_SEGMENTS],
-    period_bounds_s: (f32, f32),
+    /// The yaw correction (rad) that zeroes the drift at the array centre, from the
+    /// last update; `None` when that update could not form it.
+    yaw_request_rad: Option<f32>,
     /// Update instants run, whatever they computed: one PERIODS frame each.
     pub updates: u32,
     /// The mode an update ran in (the one its PERIODS frame reports).
@@ -145,10 +151,22 @@ pub struct Controller {
 impl Controller {
     /// A controller with `scene` in force (normally [`Scene::paper_default`]).
     pub fn new(config: Config, scene: Scene) -> Result<Controller, Fault> {
-        let plan = Plan::new(&scene, &config.envelope())?;
-        let period_bounds_s = period_bounds_s(&scene, &config);
-        Ok(Controller {
+        let plan = Plan::new(&scene, &config)?;
+        Ok(Controller::with_plan(config, scene, plan))
+    }
+
+    /// A controller on the evaluate-everything plan ([`Plan::exhaustive`]): every
+    /// segment, the most samples. The baseline the planner is measured against
+    /// (`cargo xtask bench`); not for flight.
+    pub fn evaluate_everything(config: Config, scene: Scene) -> Result<Controller, Fault> {
+        let plan = Plan::exhaustive(&scene, &config)?;
+        Ok(Controller::with_plan(config, scene, plan))
+    }
+
+    fn with_plan(config: Config, scene: Scene, plan: Plan) -> Controller {
+        Controller {
             config,
+            heights_m: scene.segments.map(|s| s.ground_h_m),
             scene,
             plan,
             nav: None,
@@ -163,19 +181,10 @@ impl Controller {
             time_resyncs: 0,
             outputs: [SegmentOutput::default(); MAX_SEGMENTS],
             has_output: [false; MAX_SEGMENTS],
-            period_bounds_s,
+            yaw_request_rad: None,
             updates: 0,
             update_mode: Mode::WaitingForNav,
-        })
-    }
-
-    /// A controller on the evaluate-everything plan ([`Plan::exhaustive`]): every
-    /// segment, the most samples, every term. The baseline the planner is measured
-    /// against (`cargo xtask bench`); not for flight.
-    pub fn evaluate_everything(config: Config, scene: Scene) -> Result<Controller, Fault> {
-        let mut c = Controller::new(config, scene)?;
-        c.plan = Plan::exhaustive(&c.scene, &c.config.envelope())?;
-        Ok(c)
+        }
     }
 
     pub fn scene(&self) -> &Scene {
@@ -187,6 +196,10 @@ impl Controller {
     pub fn nav(&self) -> Option<&NavState> {
         self.nav.as_ref()
     }
+    /// The ground height in force for each entry of the scene's table (m).
+    pub fn heights_m(&self) -> &[f32] {
+        &self.heights_m[..usize::from(self.scene.count).min(MAX_SEGMENTS)]
+    }
     pub fn now_us(&self) -> u64 {
         self.now_us
     }
@@ -196,7 +209,12 @@ impl Controller {
     }
     /// The smallest and largest line period (s) any register may receive.
     pub fn period_bounds_s(&self) -> (f32, f32) {
-        self.period_bounds_s
+        self.plan.period_bounds_s
+    }
+    /// The yaw steering request of the last update (rad): turn the camera by this
+    /// about its boresight (add it to the yaw) to zero the drift at the array centre.
+    pub fn yaw_request_rad(&self) -> Option<f32> {
+        self.yaw_request_rad
     }
 
     /// The mode at the controller's clock (STATUS).
@@ -299,8 +317,9 @@ impl Controller {
         match frame.kind {
             kind::NAV => self.check_nav(frame).map(|_| ()),
             kind::SCENE => Scene::decode(frame.payload)
-                .and_then(|s| Plan::new(&s, &self.config.envelope()))
+                .and_then(|s| Plan::new(&s, &self.config))
                 .map(|_| ()),
+            kind::TERRAIN => Terrain::decode(frame.payload, &self.scene).map(|_| ()),
             kind::TIME if frame.payload.is_empty() => Ok(()),
             kind::TIME => Err(Fault::BadLength),
             _ => Err(Fault::UnknownKind),
@@ -323,6 +342,11 @@ impl Controller {
         match frame.kind {
             kind::NAV => self.accept_nav(frame),
             kind::SCENE => self.accept_scene(frame.payload),
+            kind::TERRAIN => {
+                let terrain = Terrain::decode(frame.payload, &self.scene)?;
+                self.heights_m = terrain.heights_m;
+                Ok(())
+            }
             kind::TIME if frame.payload.is_empty() => Ok(()),
             kind::TIME => Err(Fault::BadLength),
             _ => Err(Fault::UnknownKind),
@@ -334,37 +358,46 @@ impl Controller {
         Ok(())
     }
 
+    /// A NAV frame's checks: finite; an orbital frame; |r| in the altitude band and a
+    /// speed of an imaging orbit ([`MIN_SPEED2_RATIO`]..[`MAX_SPEED2_RATIO`] of the
+    /// circular speed squared) (`out_of_range`); the attitude inside the scene's
+    /// envelope at the frame's instant and propagated at its rates over every update it
+    /// may serve, one update period back (an update instant precedes the frame's tag by
+    /// up to that) to `stale_after` ahead (`attitude_outside_model`).
     fn check_nav(&self, frame: &Frame<'_>) -> Result<NavState, Fault> {
         let nav = Nav::decode(frame.payload)?;
-        let orbit = nav.orbit(self.config.earth_radius_m)?;
+        let r_m = nav.check_state()?;
         let (h_lo, h_hi) = self.config.altitude_range_m;
-        if !(orbit.altitude_m >= h_lo && orbit.altitude_m <= h_hi) {
+        if !(r_m >= EARTH.b_m() + h_lo && r_m <= EARTH.a_m + h_hi) {
             return Err(Fault::OutOfRange);
         }
-        let a = nav.attitude;
-        if a.roll_rad.abs() > self.plan.max_roll_rad + 1e-3 {
+        let v = nav.state.velocity_mps;
+        let speed2_ratio = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) * r_m / core_math::GM_M3_S2;
+        if !(MIN_SPEED2_RATIO..=MAX_SPEED2_RATIO).contains(&speed2_ratio) {
             return Err(Fault::OutOfRange);
         }
-        let tol = self.config.pitch_yaw_tolerance_rad;
-        let rate_tol = self.config.pitch_yaw_rate_tolerance_rad_s;
-        if a.pitch_rad.abs() > tol
-            || a.yaw_rad.abs() > tol
-            || a.pitch_rate_rad_s.abs() > rate_tol
-            || a.yaw_rate_rad_s.abs() > rate_tol
-        {
+        let back_s = self.config.update_period_us as f32 * 1e-6;
+        let ahead_s = self.config.stale_after_us as f32 * 1e-6;
+        if !inside_envelope(&nav.attitude, &self.plan.envelope, back_s, ahead_s) {
             return Err(Fault::AttitudeOutsideModel);
         }
+        // Any yaw is allowed: wrapped once here (in f64: an f32 yaw of any size), the
+        // per-update trigonometry then works near zero.
+        let yaw = libm::remainder(f64::from(nav.attitude.yaw_rad), 2.0 * core::f64::consts::PI);
         Ok(NavState {
             time_us: frame.time_us,
-            orbit,
-            attitude: a,
+            propagator: Propagator::new(&nav.state),
+            attitude: Attitude {
+                yaw_rad: yaw as f32,
+                ..nav.attitude
+            },
         })
     }
 
     fn accept_scene(&mut self, payload: &[u8]) -> Result<(), Fault> {
         let scene = Scene::decode(payload)?;
-        let plan = Plan::new(&scene, &self.config.envelope())?;
-        self.period_bounds_s = period_bounds_s(&scene, &self.config);
+        let plan = Plan::new(&scene, &self.config)?;
+        self.heights_m = scene.segments.map(|s| s.ground_h_m);
         self.scene = scene;
         self.plan = plan;
         // A new focal plane: nothing of the old one's outputs applies.
@@ -401,42 +434,51 @@ impl Controller {
     }
 
     fn update_at<S: LinePeriodSink>(&mut self, t_us: u64, sink: &mut S) {
+        self.yaw_request_rad = None;
         let Some(nav) = self.nav else { return };
         if self.update_mode == Mode::Stale {
             self.hold_all();
             return;
         }
-        // Propagate from the frame to this instant: the argument of latitude at the orbit
-        // rate, the roll at its rate (a manoeuvre moves the far point fast).
-        let dt_s = (t_us as f64 - nav.time_us as f64) * 1e-6;
-        let o = nav.orbit;
-        let roll =
-            f64::from(nav.attitude.roll_rad) + f64::from(nav.attitude.roll_rate_rad_s) * dt_s;
-        let geometry = Geometry {
-            roll_rad: roll,
-            inclination_rad: o.inclination_rad,
-            arg_latitude_rad: o.arg_latitude_rad + o.orbit_rate_rad_s * dt_s,
-            altitude_m: o.altitude_m,
-            earth_radius_m: self.config.earth_radius_m,
-            earth_rate_rad_s: EARTH_RATE_RAD_S,
-            orbit_rate_rad_s: o.orbit_rate_rad_s,
-        }
-        .to::<f32>();
-        let update = match CLOSED_F32.update(&geometry) {
-            Ok(u) => u,
+        // Not stale: t - t_nav lies in [-update period, stale_after], both < 2^53 us:
+        // the difference is exact in i64 and small in f32.
+        let dt_s = (t_us as i64).wrapping_sub(nav.time_us as i64) as f32 * 1e-6;
+        let state = nav.propagator.at(dt_s);
+        let attitude = attitude_at(&nav.attitude, dt_s);
+        let instant = match GENERAL_F32.instant(&state, &attitude, &EARTH, EARTH_RATE_RAD_S) {
+            Ok(i) => i,
             Err(e) => {
                 self.reject(Fault::from(e));
                 self.hold_all();
                 return;
             }
         };
+        // The yaw steering request: at the boresight a turn about it turns (v1, v2) by
+        // the turn and changes nothing else, so atan(v2/v1) there zeroes its drift.
+        let boresight_h = self.height(self.plan.boresight_segment);
+        let steer = GENERAL_F32
+            .ground(&instant, &EARTH, boresight_h)
+            .and_then(|u| GENERAL_F32.motion(&u, &self.plan.boresight))
+            .ok()
+            .and_then(|m| {
+                let speed = libm::sqrtf(m.v1_mps * m.v1_mps + m.v2_mps * m.v2_mps);
+                let sign = if m.v1_mps < 0.0 { -1.0 } else { 1.0 };
+                let (sin, cos) = (sign * m.v2_mps / speed, sign * m.v1_mps / speed);
+                (sin.is_finite() && cos.is_finite())
+                    .then(|| (sin, cos, drift_angle_rad(m.v2_mps / m.v1_mps)))
+            });
+        self.yaw_request_rad = steer.map(|(_, _, rad)| rad);
         // Indices by `get` (`count` <= MAX_SEGMENTS and `index` < MAX_SEGMENTS by
         // construction of the plan): no panic path (docs/no-panic.md).
         for k in 0..usize::from(self.plan.count) {
             let Some(seg) = self.plan.segments.get(k) else {
                 break;
             };
-            let (index, result) = (seg.index, self.segment(&update, seg));
+            let index = seg.index;
+            let result = GENERAL_F32
+                .ground(&instant, &EARTH, self.height(index))
+                .map_err(Fault::from)
+                .and_then(|update| self.segment(&update, seg, steer));
             let slot = usize::from(index);
             match result {
                 Ok(out) => {
@@ -464,6 +506,10 @@ impl Controller {
         }
     }
 
+    fn height(&self, index: u8) -> f32 {
+        self.heights_m.get(usize::from(index)).copied().unwrap_or(0.0)
+    }
+
     fn hold_all(&mut self) {
         for o in self.outputs.iter_mut() {
             o.held = true;
@@ -472,106 +518,106 @@ impl Controller {
 
     fn segment(
         &self,
-        update: &core_math::closed_form::UpdateConst<f32>,
+        update: &GeneralUpdate<f32>,
         seg: &SegmentPlan,
+        steer: Option<(f32, f32, f32)>,
     ) -> Result<SegmentOutput, Fault> {
-        // One monomorphisation per plan: the terms are chosen once, not per sample.
-        let (v_min, v_max) = match (self.plan.terms.limb, self.plan.terms.drift) {
-            (true, true) => extremes::<true, true>(update, seg.samples())?,
-            (true, false) => extremes::<true, false>(update, seg.samples())?,
-            (false, true) => extremes::<false, true>(update, seg.samples())?,
-            (false, false) => extremes::<false, false>(update, seg.samples())?,
-        };
-        // The drift angle needs v2 at one point, whatever the plan left out.
-        let centre = seg
-            .samples()
-            .get(seg.samples().len() / 2)
-            .ok_or(Fault::InvalidScene)?;
-        let m = CLOSED_F32.motion(update, centre)?;
-        let drift_rad = libm::atanf(m.v2_mps / m.v1_mps);
+        // |v1| extremes and the largest |v2/v1| over the samples and the centre; every
+        // one must move the same way along P1 (one transfer direction per segment). In
+        // forward flight the image moves towards -P1 (the ground runs backwards under
+        // the camera); towards +P1 is the reversed transfer.
+        let centre = GENERAL_F32.motion(update, &seg.centre)?;
+        let reversed = centre.v1_mps > 0.0;
+        let tan_centre = centre.v2_mps / centre.v1_mps;
+        let (mut v_min, mut v_max, mut tan_max) = (f32::INFINITY, 0.0f32, tan_centre.abs());
+        for p in seg.samples() {
+            let m = GENERAL_F32.motion(update, p)?;
+            if (m.v1_mps > 0.0) != reversed {
+                return Err(Fault::PeriodOutOfRange);
+            }
+            let v = m.v1_mps.abs();
+            v_min = v_min.min(v);
+            v_max = v_max.max(v);
+            tan_max = tan_max.max((m.v2_mps / m.v1_mps).abs());
+        }
         // The period minimising the worst relative mismatch over [v_min, v_max]: the
         // line speed equal to the harmonic mean of the extremes, i.e. the mean of the
         // extremes' periods.
         let a = self.plan.pixel_m;
         let period_s = 0.5 * (a / v_min + a / v_max);
-        let (lo, hi) = self.period_bounds_s;
+        let (lo, hi) = self.plan.period_bounds_s;
         if !(period_s >= lo && period_s <= hi) {
             return Err(Fault::PeriodOutOfRange);
         }
         let ticks = line_period_ticks(period_s, self.plan.line_clock_hz).map_err(Fault::from)?;
-        // The mismatch of the period actually programmed, rounding to ticks included.
+        // The mismatch of the period actually programmed, rounding to ticks included,
+        // against the range v1 may take between the samples.
         let v_line = a * self.plan.line_clock_hz / ticks.ticks as f32;
-        let worst_mismatch = (v_line / v_min - 1.0)
-            .abs()
-            .max((1.0 - v_line / v_max).abs());
-        // Past the sinc's first zero no contrast is left; its negative lobe is a phase
-        // reversal, not an MTF below 0.
-        let mtf = mtf_mismatch(u32::from(seg.tdi_stages), worst_mismatch)
-            .map_err(Fault::from)?
-            .clamp(0.0, 1.0);
-        let max_stages = self
-            .plan
-            .stage_rule
-            .max_stages(worst_mismatch, u32::from(self.plan.max_stages))
-            .map_err(Fault::from)?;
+        let (v_lo, v_hi) = (v_min - seg.interpolation_mps, v_max + seg.interpolation_mps);
+        let stages = u32::from(seg.tdi_stages);
+        let (worst_mismatch, mtf, max_stages) = if v_lo > 0.0 {
+            let worst = (v_line / v_lo - 1.0).abs().max((1.0 - v_line / v_hi).abs());
+            let half_pi_m = core::f32::consts::FRAC_PI_2 * stages as f32;
+            // Past the sinc's first zero no contrast is left; its negative lobe is a
+            // phase reversal, not an MTF below 0.
+            let mtf = sinc(half_pi_m * worst).clamp(0.0, 1.0)
+                * sinc(half_pi_m * tan_max).clamp(0.0, 1.0);
+            let m = self
+                .plan
+                .stage_rule
+                .max_stages_with_drift(worst, tan_max, u32::from(self.plan.max_stages))
+                .map_err(Fault::from)?;
+            (worst, mtf, m as u16)
+        } else {
+            // The image is slower than the interpolation bound: no bound on the
+            // mismatch, no contrast promised.
+            (f32::MAX, 0.0, 0)
+        };
+        let drift_rad = drift_angle_rad(tan_centre);
+        let residual_drift_rad = match steer {
+            Some((sin, cos, _)) => {
+                let m = GENERAL_F32.motion(&update.yawed(sin, cos), &seg.centre)?;
+                drift_angle_rad(m.v2_mps / m.v1_mps)
+            }
+            None => drift_rad,
+        };
         Ok(SegmentOutput {
             index: seg.index,
             ticks: ticks.ticks,
             worst_mismatch,
             mtf,
-            max_stages: max_stages as u16,
+            max_stages,
             drift_rad,
+            worst_drift_rad: drift_angle_rad(tan_max),
+            residual_drift_rad,
+            reversed,
             held: false,
         })
     }
 }
 
-/// Smallest and largest |v_P| over a segment's samples, with the plan's terms.
-fn extremes<const LIMB: bool, const DRIFT: bool>(
-    update: &core_math::closed_form::UpdateConst<f32>,
-    samples: &[core_math::closed_form::PixelConst<f32>],
-) -> Result<(f32, f32), Fault> {
-    let mut v_min = f32::INFINITY;
-    let mut v_max = 0.0f32;
-    for p in samples {
-        let m = CLOSED_F32.motion_terms::<LIMB, DRIFT>(update, p)?;
-        let v = if DRIFT { m.speed_mps() } else { m.v1_mps.abs() };
-        v_min = v_min.min(v);
-        v_max = v_max.max(v);
-    }
-    Ok((v_min, v_max))
+/// Whether `a` and its propagation at its rates `back_s` before and `ahead_s` after its
+/// instant stay inside `env` (linear in time: the ends are the extremes).
+fn inside_envelope(a: &Attitude<f32>, env: &AttitudeEnvelope, back_s: f32, ahead_s: f32) -> bool {
+    let rates = [a.roll_rate_rad_s, a.pitch_rate_rad_s, a.yaw_rate_rad_s];
+    let angle_ok = |x: f32, rate: f32, max: f32| {
+        [x, x - rate * back_s, x + rate * ahead_s]
+            .iter()
+            .all(|y| y.abs() <= max)
+    };
+    // Yaw is free (finite: `Nav::check_state`).
+    rates.iter().all(|r| r.abs() <= env.max_rate_rad_s)
+        && angle_ok(a.roll_rad, a.roll_rate_rad_s, env.max_roll_rad)
+        && angle_ok(a.pitch_rad, a.pitch_rate_rad_s, env.max_pitch_rad)
 }
 
-/// The physically possible line periods for `scene` over the configured altitudes, from
-/// bounds on |v_P| that hold for any roll, orbit position and Earth rotation:
-/// - fastest: the ground point moves at most (Omega + omega) R relative to the orbital
-///   frame, at a depth of at least H cos(alpha) and magnified by f / cos(alpha), so
-///   |v_P| <= f (Omega(H_min) + omega) R / (H_min cos^2 alpha_max);
-/// - slowest: |v1| >= f (|Omega - omega| cos(theta) - omega sin(theta)) / (rho / R) with
-///   the limb's theta and slant range rho at H_max (the worst case of each term).
-///
-/// The bounds are proved against the reference over the envelope by the controller's tests.
-pub fn period_bounds_s(scene: &Scene, config: &Config) -> (f32, f32) {
-    let r = config.earth_radius_m;
-    let (h_lo, h_hi) = config.altitude_range_m;
-    let w = EARTH_RATE_RAD_S;
-    let f = scene.camera.focal_m;
-    let a = scene.camera.pixel_m;
-    // Widest field angle among the segments' ends.
-    let mut tan_max = 0.0f64;
-    for s in scene.segments.iter().take(usize::from(scene.count)) {
-        for n in [s.first_px, s.last_px] {
-            tan_max = tan_max.max((f64::from(n) * a / f).abs());
-        }
+/// atan(t) (rad): the odd series to t^9 where drift angles live (|t| <= 0.2: error
+/// below 0.2^11/11 = 1.9e-9 rad, under f32's rounding of the result), libm beyond.
+pub fn drift_angle_rad(t: f32) -> f32 {
+    if t.abs() <= 0.2 {
+        let t2 = t * t;
+        t * (1.0 - t2 * (1.0 / 3.0 - t2 * (0.2 - t2 * (1.0 / 7.0 - t2 * (1.0 / 9.0)))))
+    } else {
+        libm::atanf(t)
     }
-    let cos2 = 1.0 / (1.0 + tan_max * tan_max);
-    let omega_hi = core_math::orbital_rate_rad_s(r, h_lo);
-    let v_fast = f * (omega_hi + w) * r / (h_lo * cos2);
-    let omega_lo = core_math::orbital_rate_rad_s(r, h_hi);
-    let k = (r + h_hi) / r;
-    let cos_theta = 1.0 / k;
-    let sin_theta = libm::sqrt(1.0 - cos_theta * cos_theta);
-    let rho_over_r = libm::sqrt(k * k - 1.0);
-    let v_slow = f * ((omega_lo - w) * cos_theta - w * sin_theta) / rho_over_r;
-    ((a / v_fast) as f32, (a / v_slow) as f32)
 }

@@ -8,13 +8,15 @@
 use crate::crc;
 
 pub const SYNC: [u8; 2] = [0xEB, 0x90];
-/// 2 since issue 13: STATUS carries the re-synchronisation count and the `time_jump`
-/// counter (docs/telemetry.md, "Versions").
-pub const VERSION: u8 = 2;
+/// 3 since issue 12: the real-Earth controller's SCENE (attitude envelope, stagger,
+/// ground heights), the TERRAIN frame, PERIODS with drift and the yaw steering request
+/// (docs/telemetry.md, "Versions").
+pub const VERSION: u8 = 3;
 /// sync (2) + version (1) + kind (1) + length (2) + sequence (2) + time tag (8).
 pub const HEADER_LEN: usize = 16;
 pub const CRC_LEN: usize = 2;
-pub const MAX_PAYLOAD: usize = 328;
+/// The longest payload: a PERIODS frame of 16 segments (8 + 16 x 28 bytes).
+pub const MAX_PAYLOAD: usize = 456;
 pub const MAX_FRAME: usize = HEADER_LEN + MAX_PAYLOAD + CRC_LEN;
 
 /// Frame kinds. Ground/bus to camera below 0x80, camera to ground from 0x80.
@@ -30,6 +32,9 @@ pub mod kind {
     /// and for the program to stop. Handled by [`crate::session::Session`], never
     /// passed to the controller; a flight build may ignore it.
     pub const END: u8 = 0x04;
+    /// Ground heights of the scene's segments (payload: `scene::Terrain`), in force
+    /// from the frame's time tag.
+    pub const TERRAIN: u8 = 0x05;
     /// Line periods, one record per active segment.
     pub const PERIODS: u8 = 0x81;
     /// Fault counters and state.

@@ -2,8 +2,8 @@
 //! scene and its plan, per-segment TDI line periods out. `no_std`, no allocation, no
 //! hardware: the firmware feeds it bytes and a clock, and gives it a [`LinePeriodSink`].
 //!
-//! telemetry in ([`frame`], [`nav`]) -> scene ([`scene`], [`plan`]) -> math (core-math)
-//! -> line periods out ([`control`], [`status`]).
+//! telemetry in ([`frame`], [`nav`]) -> scene ([`scene`], [`plan`]) -> math (core-math's
+//! general real-Earth form) -> line periods out ([`control`], [`report`]).
 #![no_std]
 #![forbid(unsafe_code)]
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
@@ -13,13 +13,15 @@ pub mod control;
 pub mod crc;
 pub mod fault;
 pub mod frame;
+#[cfg(feature = "reference")]
+pub mod golden;
 pub mod nav;
 pub mod plan;
 pub mod report;
 pub mod scene;
 pub mod session;
 
-pub use control::{Config, Controller, LinePeriodSink, Mode, SegmentOutput};
+pub use control::{Config, Controller, LinePeriodSink, Mode, SegmentOutput, EARTH};
 pub use fault::{Counters, Fault};
 pub use frame::{Decoder, Event, Frame, FrameError};
-pub use scene::Scene;
+pub use scene::{Scene, Terrain};

@@ -1,7 +1,11 @@
-//! The NAV frame: orbit state from the on-board navigation and attitude relative to the
-//! local orbital frame, checked field by field.
+//! The NAV frame: the satellite's inertial state (ECI, f64) from the on-board navigation
+//! and the camera's attitude relative to the local orbital frame (f32 angles and their
+//! rates), checked field by field; and the two-body propagation of that state to the
+//! update instants it serves.
 
-use core_math::{OrbitState, StateVector};
+pub use core_math::earth::Attitude;
+use core_math::earth::check_state;
+use core_math::{StateVector, GM_M3_S2};
 
 use crate::bytes::{Reader, Writer};
 use crate::fault::Fault;
@@ -9,36 +13,11 @@ use crate::fault::Fault;
 /// Payload length: 6 f64 (r, v) + 6 f32 (roll, pitch, yaw and their rates).
 pub const NAV_LEN: usize = 6 * 8 + 6 * 4;
 
-/// Attitude of the spacecraft relative to the local orbital frame (rad, rad/s).
-#[derive(Clone, Copy, Debug, PartialEq, Default)]
-pub struct Attitude {
-    pub roll_rad: f32,
-    pub pitch_rad: f32,
-    pub yaw_rad: f32,
-    pub roll_rate_rad_s: f32,
-    pub pitch_rate_rad_s: f32,
-    pub yaw_rate_rad_s: f32,
-}
-
-impl Attitude {
-    /// The six values in payload order: roll, pitch, yaw, then their rates.
-    pub fn values(&self) -> [f32; 6] {
-        [
-            self.roll_rad,
-            self.pitch_rad,
-            self.yaw_rad,
-            self.roll_rate_rad_s,
-            self.pitch_rate_rad_s,
-            self.yaw_rate_rad_s,
-        ]
-    }
-}
-
 /// A NAV payload as sent.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Nav {
     pub state: StateVector,
-    pub attitude: Attitude,
+    pub attitude: Attitude<f32>,
 }
 
 impl Nav {
@@ -75,18 +54,87 @@ impl Nav {
         for x in self.state.position_m.iter().chain(&self.state.velocity_mps) {
             w.put(&x.to_le_bytes())?;
         }
-        for x in self.attitude.values() {
+        for (x, _) in self.attitude.values() {
             w.put(&x.to_le_bytes())?;
         }
         Some(w.len())
     }
 
-    /// Orbit quantities, with every value checked: finite, above the ground, in the
-    /// controller's envelope.
-    pub fn orbit(&self, earth_radius_m: f64) -> Result<OrbitState, Fault> {
-        if !self.attitude.values().iter().all(|x| x.is_finite()) {
+    /// Every value finite, and a state vector that defines an orbital frame (the
+    /// model's own state checks, in f64). Returns |r| (m).
+    pub fn check_state(&self) -> Result<f64, Fault> {
+        let (r, v) = (self.state.position_m, self.state.velocity_mps);
+        let finite = r.iter().chain(&v).all(|x| x.is_finite())
+            && self.attitude.values().iter().all(|(x, _)| x.is_finite());
+        if !finite {
             return Err(Fault::NonFinite);
         }
-        OrbitState::from_state(&self.state, earth_radius_m).map_err(Fault::from)
+        let (r2, _) = check_state(r, v).map_err(|_| Fault::OutOfRange)?;
+        Ok(libm::sqrt(r2))
+    }
+}
+
+/// A NAV state ready to propagate: the state, and the two-body acceleration and jerk
+/// at it (formed once per NAV frame, in f64, rounded to f32).
+///
+/// Propagation to dt is the Taylor series to the jerk: r + v dt + a dt^2/2 + j dt^3/6,
+/// v + a dt + j dt^2/2. Its error is the snap's term, |s| ~ |a| n^2 (n the mean motion):
+/// at 645 km, 4e-7 m and 1.7e-6 m/s (2e-10 of the speed) after 1 s, 2e-5 of the speed
+/// only after 100 s. The increments are formed in f32 (0.5 mm for a 7.5 km step) and
+/// added to the f64 state, so nothing of the state's own precision is lost.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Propagator {
+    pub state: StateVector,
+    velocity_mps: [f32; 3],
+    half_accel_mps2: [f32; 3],
+    sixth_jerk_mps3: [f32; 3],
+}
+
+impl Propagator {
+    pub fn new(state: &StateVector) -> Propagator {
+        let (r, v) = (state.position_m, state.velocity_mps);
+        let r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+        let rn = libm::sqrt(r2);
+        // a = -mu r / |r|^3; j = da/dt = -mu (v - 3 (r.v / |r|^2) r) / |r|^3.
+        let mu_r3 = GM_M3_S2 / (r2 * rn);
+        let rv_r2 = (r[0] * v[0] + r[1] * v[1] + r[2] * v[2]) / r2;
+        Propagator {
+            state: *state,
+            velocity_mps: v.map(|x| x as f32),
+            half_accel_mps2: r.map(|x| (-0.5 * mu_r3 * x) as f32),
+            sixth_jerk_mps3: core::array::from_fn(|k| {
+                (-mu_r3 * (v[k] - 3.0 * rv_r2 * r[k]) / 6.0) as f32
+            }),
+        }
+    }
+
+    /// The state `dt_s` after the NAV instant (dt may be negative: an update instant
+    /// up to one update period before the frame's tag).
+    pub fn at(&self, dt_s: f32) -> StateVector {
+        let (v, a2, j6) = (
+            self.velocity_mps,
+            self.half_accel_mps2,
+            self.sixth_jerk_mps3,
+        );
+        let r0 = self.state.position_m;
+        let v0 = self.state.velocity_mps;
+        StateVector {
+            position_m: core::array::from_fn(|k| {
+                r0[k] + f64::from(dt_s * (v[k] + dt_s * (a2[k] + dt_s * j6[k])))
+            }),
+            velocity_mps: core::array::from_fn(|k| {
+                v0[k] + f64::from(dt_s * (2.0 * a2[k] + dt_s * (3.0 * j6[k])))
+            }),
+        }
+    }
+}
+
+/// The attitude `dt_s` after its NAV instant: each angle at its own rate.
+pub fn attitude_at(a: &Attitude<f32>, dt_s: f32) -> Attitude<f32> {
+    Attitude {
+        roll_rad: a.roll_rad + a.roll_rate_rad_s * dt_s,
+        pitch_rad: a.pitch_rad + a.pitch_rate_rad_s * dt_s,
+        yaw_rad: a.yaw_rad + a.yaw_rate_rad_s * dt_s,
+        ..*a
     }
 }

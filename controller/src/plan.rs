@@ -1,24 +1,29 @@
 //! The scene plan: built once when a scene arrives, so that per update only what the
 //! scene needs is evaluated. Inactive segments have no entry at all. Each active segment
-//! is sampled at the fewest equally spaced field points that bound the error of its
-//! velocity extremes to a tenth of its mismatch budget.
+//! is sampled at the fewest equally spaced pixels whose interpolation error stays within
+//! a tenth of its mismatch budget, and that error is carried into every update's
+//! reported worst mismatch, so the report bounds the truth over every pixel.
 //!
-//! The bound: between samples h pixels apart, a smooth |v|(n) exceeds the samples'
-//! extremes by at most h^2/8 max|v''| (the error of linear interpolation), so the
-//! relative error of the segment's v_min and v_max is at most c h^2 / 8 with
-//! c = max |v''| / v. The planner estimates c by second differences of the shipped f32
-//! model on a probe grid over the envelope (every roll the scene allows, the configured
-//! altitudes, orbit positions and inclinations), doubles it for safety, and takes the
-//! smallest sample count meeting the budget. The controller's tests check the result
-//! against dense evaluations of the f64 reference.
+//! The bound: between samples H pixels apart, a smooth v1(n) leaves the samples' range
+//! by at most H^2/8 max|v1''| (the error of linear interpolation). In the general model
+//! the attitude rates add to v1 a term linear in the pixel offset (-W x u, projected),
+//! so |v1''| does not depend on them: it depends on the attitude angles, the orbit, the
+//! ellipsoid and the terrain. The planner bounds it by second differences of the
+//! shipped f32 model on a probe grid over the envelope (roll and pitch to the scene's
+//! limits, yaw steering angles, the highest and lowest orbits at the equator and near
+//! the pole, the lowest and highest ground), doubled for safety; the per-update bound
+//! is then H^2/8 of that over the smallest sampled |v1|, which grows honestly when an
+//! attitude rate slows the image. The controller's tests check it against dense
+//! evaluations of the f64 reference (1 000 pixels a segment) over the envelope.
 
-use core_math::closed_form::{PixelConst, UpdateConst, LIMB_BRANCH_RAD};
-use core_math::{Backend, Geometry, StageRule, CLOSED_F32, EARTH_RATE_RAD_S};
+use core_math::earth::{circular_state, Attitude, GeneralPixel, GeneralUpdate};
+use core_math::{Backend, StageRule, GENERAL_F32};
 
+use crate::control::{Config, EARTH, EARTH_RATE_RAD_S};
 use crate::fault::Fault;
-use crate::scene::{Scene, SegmentSpec, MAX_SEGMENTS};
+use crate::scene::{AttitudeEnvelope, Scene, SegmentSpec, MAX_GROUND_H_M, MAX_SEGMENTS, MIN_GROUND_H_M};
 
-/// Most field points one segment may be sampled at.
+/// Most pixels one segment may be sampled at.
 pub const MAX_SAMPLES: usize = 9;
 /// Share of a segment's mismatch budget the sampling error may use.
 pub const SAMPLING_SHARE: f64 = 0.1;
@@ -26,13 +31,9 @@ pub const SAMPLING_SHARE: f64 = 0.1;
 pub const CURVATURE_SAFETY: f64 = 2.0;
 /// Probe points across a segment for the curvature estimate.
 const PROBES: usize = 9;
-
-/// The orbits the plan must hold for: round-Earth radius and the altitude range.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Envelope {
-    pub earth_radius_m: f64,
-    pub altitude_range_m: (f64, f64),
-}
+/// Yaw angles of the probe grid (rad): unsteered, and steered either way by more than
+/// the largest drift a yaw steering law asks for (4.6 deg, docs/derivation.md).
+const PROBE_YAWS_RAD: [f64; 3] = [-0.1, 0.0, 0.1];
 
 /// One active segment, ready to evaluate.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -40,21 +41,26 @@ pub struct SegmentPlan {
     /// Index in the scene's segment table.
     pub index: u8,
     pub tdi_stages: u16,
-    pub samples: [PixelConst<f32>; MAX_SAMPLES],
+    pub samples: [GeneralPixel<f32>; MAX_SAMPLES],
     pub n_samples: u8,
     /// Pixel offsets of the samples.
     pub sample_px: [i32; MAX_SAMPLES],
+    /// The segment's centre pixel (its drift is reported there).
+    pub centre: GeneralPixel<f32>,
     /// Relative error allowed on the segment's velocity extremes.
     pub sampling_budget: f32,
-    /// Relative error bound of the chosen sampling (at most the budget unless even
-    /// [`MAX_SAMPLES`] points could not meet it, e.g. close to the limb).
+    /// Largest amount v1 may leave the samples' range between two samples (m/s):
+    /// (bound on |v1''|) x spacing^2 / 8.
+    pub interpolation_mps: f32,
+    /// Relative sampling error at the slowest image of the probe grid (at most the
+    /// budget unless even [`MAX_SAMPLES`] pixels could not meet it).
     pub sampling_bound: f32,
 }
 
 impl SegmentPlan {
     // `n_samples` <= MAX_SAMPLES in every plan `Plan::build` makes; the `min` proves it
     // to the optimiser (no panic path, docs/no-panic.md).
-    pub fn samples(&self) -> &[PixelConst<f32>] {
+    pub fn samples(&self) -> &[GeneralPixel<f32>] {
         &self.samples[..usize::from(self.n_samples).min(MAX_SAMPLES)]
     }
     pub fn sample_px(&self) -> &[i32] {
@@ -62,72 +68,66 @@ impl SegmentPlan {
     }
 }
 
-/// Which optional terms of the closed form a plan evaluates.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Terms {
-    /// The limb-distance form (needed only within [`LIMB_BRANCH_RAD`] of the limb).
-    pub limb: bool,
-    /// v2 in |v_P| (its share of |v_P| is (v2/v1)^2 / 2).
-    pub drift: bool,
-}
-
-impl Terms {
-    pub const ALL: Terms = Terms {
-        limb: true,
-        drift: true,
-    };
-}
-
-/// Share of a segment's mismatch budget that left-out terms may use.
-pub const TERM_SHARE: f64 = 0.1;
-
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Plan {
     pub segments: [SegmentPlan; MAX_SEGMENTS],
-    /// The terms every update evaluates.
-    pub terms: Terms,
-    /// Smallest angular distance from any sample's line of sight to the limb over the
-    /// envelope (rad), computed from the lowest limb angle (highest altitude) and the
-    /// largest roll plus field angle. The limb form is left out when it is at least
-    /// [`LIMB_BRANCH_RAD`].
-    pub limb_margin_rad: f32,
-    /// Largest relative change of |v_P| from leaving v2 out, (v2/v1)^2 / 2 over the
-    /// probe grid at every sample, doubled. v2 is left out when it is under
-    /// [`TERM_SHARE`] of the smallest segment budget.
-    pub drift_bound: f32,
     /// Number of active segments (entries in `segments`).
     pub count: u8,
+    /// The array centre: the boresight pixel (p1 = p2 = 0), where a yaw turn turns the
+    /// image motion and nothing else (the yaw steering request zeroes its drift).
+    pub boresight: GeneralPixel<f32>,
+    /// The table index of the segment whose ground the boresight sees (the one
+    /// containing pixel 0, or the nearest).
+    pub boresight_segment: u8,
     pub pixel_m: f32,
     pub line_clock_hz: f32,
     pub stage_rule: StageRule<f32>,
     pub max_stages: u16,
-    pub max_roll_rad: f32,
+    pub envelope: AttitudeEnvelope,
+    /// The physically possible line periods (s): see [`period_bounds_s`].
+    pub period_bounds_s: (f32, f32),
 }
 
-/// Per-update constants of the probe grid: rolls across the scene's range, both ends
-/// of the altitude range, equatorial and polar planes, four orbit positions.
-fn probe_updates(scene: &Scene, env: &Envelope) -> [Option<UpdateConst<f32>>; 80] {
-    let mut out = [None; 80];
+/// Per-update constants of the probe grid at `ground_h_m`.
+fn probe_updates(
+    env: &AttitudeEnvelope,
+    config: &Config,
+    ground_h_m: f32,
+) -> [Option<GeneralUpdate<f32>>; 216] {
+    let mut out = [None; 216];
     let mut k = 0;
-    let r = f64::from(scene.max_roll_rad);
-    for roll in [-r, -0.5 * r, 0.0, 0.5 * r, r] {
-        for h in [env.altitude_range_m.0, env.altitude_range_m.1] {
-            for i0 in [0.0, core::f64::consts::FRAC_PI_2] {
-                for q in 0..4 {
-                    let g0 = f64::from(q) * core::f64::consts::FRAC_PI_2;
-                    let g = Geometry {
-                        roll_rad: roll,
-                        inclination_rad: i0,
-                        arg_latitude_rad: g0,
-                        altitude_m: h,
-                        earth_radius_m: env.earth_radius_m,
-                        earth_rate_rad_s: EARTH_RATE_RAD_S,
-                        orbit_rate_rad_s: core_math::orbital_rate_rad_s(env.earth_radius_m, h),
-                    };
-                    if let Some(slot) = out.get_mut(k) {
-                        *slot = CLOSED_F32.update(&g.to::<f32>()).ok();
+    let (r, p) = (
+        f64::from(env.max_roll_rad),
+        f64::from(env.max_pitch_rad),
+    );
+    let (h_lo, h_hi) = config.altitude_range_m;
+    let inclination = 98f64.to_radians();
+    // Equator (radius a + h) and 82 deg latitude (nearly b + h).
+    let places = [
+        (0.0, EARTH.a_m),
+        (core::f64::consts::FRAC_PI_2, EARTH.b_m()),
+    ];
+    for roll in [-r, 0.0, r] {
+        for pitch in [-p, 0.0, p] {
+            for yaw in PROBE_YAWS_RAD {
+                for h in [h_lo, h_hi] {
+                    for (u, radius) in places {
+                        let state = circular_state(radius + h, inclination, u);
+                        let attitude = Attitude {
+                            roll_rad: roll,
+                            pitch_rad: pitch,
+                            yaw_rad: yaw,
+                            ..Attitude::default()
+                        }
+                        .to::<f32>();
+                        let update = GENERAL_F32
+                            .instant(&state, &attitude, &EARTH, EARTH_RATE_RAD_S)
+                            .and_then(|i| GENERAL_F32.ground(&i, &EARTH, ground_h_m));
+                        if let Some(slot) = out.get_mut(k) {
+                            *slot = update.ok();
+                        }
+                        k += 1;
                     }
-                    k += 1;
                 }
             }
         }
@@ -135,33 +135,32 @@ fn probe_updates(scene: &Scene, env: &Envelope) -> [Option<UpdateConst<f32>>; 80
     out
 }
 
-/// max |v''| / v over the segment (per pixel^2), by second differences on the probes.
+/// (max |v1''| per pixel^2, min |v1|) over the segment and the probe grid, by second
+/// differences at the probe spacing.
 fn curvature(
     scene: &Scene,
     spec: &SegmentSpec,
-    updates: &[Option<UpdateConst<f32>>],
-) -> Result<f64, Fault> {
+    updates: &[Option<GeneralUpdate<f32>>],
+) -> Result<(f64, f64), Fault> {
+    let camera = scene.earth_camera(spec);
     let width = f64::from(spec.last_px) - f64::from(spec.first_px);
-    if width <= 0.0 {
-        return Ok(0.0);
-    }
     let h = width / (PROBES - 1) as f64;
     let mut probes = [None; PROBES];
     for (j, p) in probes.iter_mut().enumerate() {
         let n = f64::from(spec.first_px) + h * j as f64;
         *p = Some(
-            CLOSED_F32
-                .pixel(&scene.camera, n)
+            GENERAL_F32
+                .pixel(&camera, n)
                 .map_err(|_| Fault::InvalidScene)?,
         );
     }
-    let mut c = 0.0f64;
+    let (mut c, mut v_min) = (0.0f64, f64::INFINITY);
     for u in updates.iter().flatten() {
         let mut v = [0.0f64; PROBES];
         let mut ok = true;
         for (vj, p) in v.iter_mut().zip(probes.iter().flatten()) {
-            match CLOSED_F32.motion(u, p) {
-                Ok(m) => *vj = f64::from(m.speed_mps()),
+            match GENERAL_F32.motion(u, p) {
+                Ok(m) => *vj = f64::from(m.v1_mps),
                 Err(_) => ok = false,
             }
         }
@@ -169,100 +168,79 @@ fn curvature(
         if !ok {
             continue;
         }
-        for w in v.windows(3) {
-            c = c.max((w[0] - 2.0 * w[1] + w[2]).abs() / (w[1] * h * h));
+        for vj in v {
+            v_min = v_min.min(libm::fabs(vj));
         }
-    }
-    Ok(c)
-}
-
-/// (limb margin, drift bound) of a plan's samples over the envelope; see [`Plan`].
-fn term_bounds(
-    scene: &Scene,
-    env: &Envelope,
-    segments: &[SegmentPlan],
-    updates: &[Option<UpdateConst<f32>>],
-) -> (f64, f64) {
-    let r = env.earth_radius_m;
-    let limb = libm::asin(r / (r + env.altitude_range_m.1));
-    let mut widest = 0.0f64;
-    let mut drift = 0.0f64;
-    for seg in segments {
-        for (&n, p) in seg.sample_px().iter().zip(seg.samples()) {
-            let tan = f64::from(n) * scene.camera.pixel_m / scene.camera.focal_m;
-            widest = widest.max(libm::fabs(libm::atan(tan)));
-            for u in updates.iter().flatten() {
-                if let Ok(m) = CLOSED_F32.motion(u, p) {
-                    let ratio = f64::from(m.v2_mps) / f64::from(m.v1_mps);
-                    drift = drift.max(ratio * ratio / 2.0);
-                }
+        if width > 0.0 {
+            for w in v.windows(3) {
+                c = c.max(libm::fabs(w[0] - 2.0 * w[1] + w[2]) / (h * h));
             }
         }
     }
-    (limb - f64::from(scene.max_roll_rad) - widest, 2.0 * drift)
+    if !(v_min > 0.0 && v_min.is_finite()) {
+        // Not one probe condition images this segment.
+        return Err(Fault::InvalidScene);
+    }
+    Ok((c, v_min))
 }
 
 impl Plan {
-    /// The plan of `scene`: active segments only, the fewest samples, the terms needed.
-    pub fn new(scene: &Scene, env: &Envelope) -> Result<Plan, Fault> {
-        Plan::build(scene, env, false)
+    /// The plan of `scene`: active segments only, the fewest samples.
+    pub fn new(scene: &Scene, config: &Config) -> Result<Plan, Fault> {
+        Plan::build(scene, config, false)
     }
 
     /// The evaluate-everything plan, the baseline the planner is measured against:
-    /// every segment of the table whether active or not, [`MAX_SAMPLES`] samples each,
-    /// every term.
-    pub fn exhaustive(scene: &Scene, env: &Envelope) -> Result<Plan, Fault> {
-        Plan::build(scene, env, true)
+    /// every segment of the table whether active or not, [`MAX_SAMPLES`] samples each.
+    pub fn exhaustive(scene: &Scene, config: &Config) -> Result<Plan, Fault> {
+        Plan::build(scene, config, true)
     }
 
-    fn build(scene: &Scene, env: &Envelope, exhaustive: bool) -> Result<Plan, Fault> {
-        scene.validate()?;
-        // The focal plane the scene describes must see the Earth: a pixel whose field
-        // angle is past the limb at the highest altitude, even at nadir, images nothing.
-        let r = env.earth_radius_m;
-        let limb = libm::asin(r / (r + env.altitude_range_m.1));
-        for spec in scene.segments.iter().take(usize::from(scene.count)) {
-            for n in [spec.first_px, spec.last_px] {
-                let alpha =
-                    libm::atan((f64::from(n) * scene.camera.pixel_m / scene.camera.focal_m).abs());
-                if !(alpha < limb) {
-                    return Err(Fault::InvalidScene);
-                }
-            }
-        }
+    fn build(scene: &Scene, config: &Config, exhaustive: bool) -> Result<Plan, Fault> {
+        scene.validate(&EARTH, config.altitude_range_m.1)?;
         let stage_rule =
             StageRule::<f32>::new(f64::from(scene.mtf_floor)).map_err(|_| Fault::InvalidScene)?;
-        let updates = probe_updates(scene, env);
-        let blank_pixel = CLOSED_F32
-            .pixel(&scene.camera, 0.0)
+        let low = probe_updates(&scene.envelope, config, MIN_GROUND_H_M);
+        let high = probe_updates(&scene.envelope, config, MAX_GROUND_H_M);
+        let boresight_camera = core_math::EarthCamera {
+            focal_m: scene.camera.focal_m,
+            pixel_m: scene.camera.pixel_m,
+            p1_m: 0.0,
+        };
+        let boresight = GENERAL_F32
+            .pixel(&boresight_camera, 0.0)
             .map_err(|_| Fault::InvalidScene)?;
         let blank = SegmentPlan {
             index: 0,
             tdi_stages: 1,
-            samples: [blank_pixel; MAX_SAMPLES],
+            samples: [boresight; MAX_SAMPLES],
             n_samples: 0,
             sample_px: [0; MAX_SAMPLES],
+            centre: boresight,
             sampling_budget: 0.0,
+            interpolation_mps: 0.0,
             sampling_bound: 0.0,
         };
         let mut segments = [blank; MAX_SEGMENTS];
         let mut count = 0usize;
-        let table = scene
-            .segments
-            .iter()
-            .take(usize::from(scene.count))
-            .enumerate();
+        let table = scene.table().iter().enumerate();
         for (index, spec) in table.filter(|(_, s)| exhaustive || s.active) {
             let slot = segments.get_mut(count).ok_or(Fault::InvalidScene)?;
+            let camera = scene.earth_camera(spec);
             let budget = SAMPLING_SHARE * f64::from(stage_rule.mismatch_budget())
                 / f64::from(spec.tdi_stages);
-            let c = CURVATURE_SAFETY * curvature(scene, spec, &updates)?;
+            let (c_low, v_low) = curvature(scene, spec, &low)?;
+            let (c_high, v_high) = curvature(scene, spec, &high)?;
+            let c = CURVATURE_SAFETY * c_low.max(c_high);
+            let v_min = v_low.min(v_high);
             let width = f64::from(spec.last_px) - f64::from(spec.first_px);
-            // Smallest K >= 2 with c (width / (K - 1))^2 / 8 <= budget.
+            let error = |k: usize| {
+                let spacing = width / (k - 1) as f64;
+                c * spacing * spacing / 8.0
+            };
+            // Smallest K >= 2 with c (width / (K - 1))^2 / 8 <= budget x v_min.
             let mut k = if exhaustive { MAX_SAMPLES } else { 2usize };
-            while k < MAX_SAMPLES
-                && c * (width / (k - 1) as f64) * (width / (k - 1) as f64) / 8.0 > budget
-            {
+            while k < MAX_SAMPLES && error(k) > budget * v_min {
                 k += 1;
             }
             let spacing = width / (k - 1) as f64;
@@ -270,47 +248,99 @@ impl Plan {
             slot.tdi_stages = spec.tdi_stages;
             slot.n_samples = k as u8;
             slot.sampling_budget = budget as f32;
-            slot.sampling_bound = (c * spacing * spacing / 8.0) as f32;
+            slot.interpolation_mps = error(k) as f32;
+            slot.sampling_bound = (error(k) / v_min) as f32;
+            slot.centre = GENERAL_F32
+                .pixel(&camera, spec.centre_px())
+                .map_err(|_| Fault::InvalidScene)?;
             for j in 0..k {
                 // Rounded to whole pixels; the ends are exact.
                 let n = libm::round(f64::from(spec.first_px) + spacing * j as f64) as i32;
                 slot.sample_px[j] = n;
-                slot.samples[j] = CLOSED_F32
-                    .pixel(&scene.camera, f64::from(n))
+                slot.samples[j] = GENERAL_F32
+                    .pixel(&camera, f64::from(n))
                     .map_err(|_| Fault::InvalidScene)?;
             }
             count += 1;
         }
-        // count <= MAX_SEGMENTS (each slot came from `get_mut`); the `min` says so.
-        let active = &segments[..count.min(MAX_SEGMENTS)];
-        let (limb_margin_rad, drift_bound) = term_bounds(scene, env, active, &updates);
-        let smallest_budget = active
-            .iter()
-            .map(|s| f64::from(s.sampling_budget) / SAMPLING_SHARE)
-            .fold(f64::INFINITY, f64::min);
-        let terms = if exhaustive {
-            Terms::ALL
-        } else {
-            Terms {
-                limb: limb_margin_rad < LIMB_BRANCH_RAD,
-                drift: drift_bound > TERM_SHARE * smallest_budget,
+        // The segment the boresight falls in, else the one nearest to it.
+        let distance = |s: &SegmentSpec| {
+            if s.first_px > 0 {
+                i64::from(s.first_px)
+            } else if s.last_px < 0 {
+                -i64::from(s.last_px)
+            } else {
+                0
             }
         };
+        let boresight_segment = scene
+            .table()
+            .iter()
+            .enumerate()
+            .min_by_key(|(_, s)| distance(s))
+            .map_or(0, |(k, _)| k as u8);
         Ok(Plan {
             segments,
-            terms,
-            limb_margin_rad: limb_margin_rad as f32,
-            drift_bound: drift_bound as f32,
             count: count as u8,
+            boresight,
+            boresight_segment,
             pixel_m: scene.camera.pixel_m as f32,
             line_clock_hz: scene.line_clock_hz as f32,
             stage_rule,
             max_stages: scene.max_stages,
-            max_roll_rad: scene.max_roll_rad,
+            envelope: scene.envelope,
+            period_bounds_s: period_bounds_s(scene, config),
         })
     }
 
     pub fn active(&self) -> &[SegmentPlan] {
         &self.segments[..usize::from(self.count).min(MAX_SEGMENTS)]
     }
+}
+
+/// Largest speed/circular-speed ratio squared a NAV state may have, |v|^2 |r| / mu:
+/// 1.2 is an apogee-to-perigee ratio of about 1.5, far beyond any imaging orbit, and
+/// bounds the speed the period guard must allow.
+pub const MAX_SPEED2_RATIO: f64 = 1.2;
+/// And the smallest.
+pub const MIN_SPEED2_RATIO: f64 = 0.8;
+
+/// The physically possible line periods (s) for `scene` over the configured orbits and
+/// the scene's attitude envelope, from bounds on |v1| that hold for any attitude in the
+/// envelope, any orbit position, the ellipsoid and any terrain:
+/// - fastest: |v1| <= |g| sqrt(1 + t1^2) with |g| <= |W| |u| + |V| |u| / d, where
+///   |W| <= nu + omega + 3 max_rate (orbit rate nu <= |v| / |r|), |V| <= |v| + omega |r|,
+///   and d, the distance to any ground point, at least |r| - (a + 9 km);
+/// - slowest: an attitude rate can cancel the image motion (the envelope's rates reach
+///   the orbit's angular rate for any agile imager), so no bound holds from the
+///   geometry: the longest period the line clock can count (u32::MAX ticks).
+///
+/// The bounds are proved against the reference over the envelope by the controller's
+/// tests.
+pub fn period_bounds_s(scene: &Scene, config: &Config) -> (f32, f32) {
+    let mu = core_math::GM_M3_S2;
+    let (h_lo, h_hi) = config.altitude_range_m;
+    let r_min = EARTH.b_m() + h_lo;
+    let r_max = EARTH.a_m + h_hi;
+    let w = EARTH_RATE_RAD_S;
+    let v_max = libm::sqrt(MAX_SPEED2_RATIO * mu / r_min);
+    let nu_max = v_max / r_min;
+    let rates = 3.0 * f64::from(scene.envelope.max_rate_rad_s);
+    let d_min = r_min - (EARTH.a_m + f64::from(MAX_GROUND_H_M));
+    let f = scene.camera.focal_m;
+    // The largest |u| and |t1| over the segments' ends.
+    let (mut u_max, mut t1_max) = (f, 0.0f64);
+    for s in scene.table() {
+        for n in [s.first_px, s.last_px] {
+            let p1 = f64::from(s.p1_m);
+            let p2 = f64::from(n) * scene.camera.pixel_m;
+            u_max = u_max.max(libm::sqrt(p1 * p1 + p2 * p2 + f * f));
+            t1_max = t1_max.max(libm::fabs(p1 / f));
+        }
+    }
+    let g_max = (nu_max + w + rates) * u_max + (v_max + w * r_max) * u_max / d_min;
+    let v_fast = g_max * libm::sqrt(1.0 + t1_max * t1_max);
+    let fastest = scene.camera.pixel_m / v_fast;
+    let slowest = f64::from(u32::MAX) / scene.line_clock_hz;
+    (fastest as f32, slowest as f32)
 }

@@ -6,28 +6,39 @@ use crate::control::{Controller, Mode, SegmentOutput};
 use crate::fault::Fault;
 use crate::scene::MAX_SEGMENTS;
 
-/// PERIODS payload: mode, count, 2 reserved, then one [`RECORD_LEN`]-byte record per
-/// segment in force.
-pub const PERIODS_HEADER_LEN: usize = 4;
-pub const RECORD_LEN: usize = 20;
+/// PERIODS payload: mode, count, flags, 1 reserved, the yaw steering request (f32, rad),
+/// then one [`RECORD_LEN`]-byte record per segment in force.
+pub const PERIODS_HEADER_LEN: usize = 8;
+pub const RECORD_LEN: usize = 28;
 /// STATUS payload length.
 pub const STATUS_LEN: usize = 20 + 4 * Fault::COUNT;
 
 /// Flag bit of a record: the value is the last good one, held over a fault.
 pub const FLAG_HELD: u8 = 1;
+/// Flag bit of a record: the image moves towards +P1, against forward flight (reverse
+/// the TDI transfer).
+pub const FLAG_REVERSED: u8 = 2;
+/// Flag bit of the header: the yaw steering request is valid (the update formed it).
+pub const FLAG_YAW_REQUEST: u8 = 1;
 
 /// Writes the PERIODS payload of the outputs in force.
 pub fn encode_periods(c: &Controller, out: &mut [u8]) -> Option<usize> {
     let mut w = Writer::new(out);
     let count = c.outputs().count() as u8;
-    w.put(&[c.update_mode() as u8, count, 0, 0])?;
+    let yaw = c.yaw_request_rad();
+    let flags = if yaw.is_some() { FLAG_YAW_REQUEST } else { 0 };
+    w.put(&[c.update_mode() as u8, count, flags, 0])?;
+    w.put(&yaw.unwrap_or(0.0).to_le_bytes())?;
     for o in c.outputs() {
-        w.put(&[o.index, if o.held { FLAG_HELD } else { 0 }])?;
+        let flags = if o.held { FLAG_HELD } else { 0 } | if o.reversed { FLAG_REVERSED } else { 0 };
+        w.put(&[o.index, flags])?;
         w.put(&o.max_stages.to_le_bytes())?;
         w.put(&o.ticks.to_le_bytes())?;
         w.put(&o.mtf.to_le_bytes())?;
-        w.put(&o.drift_rad.to_le_bytes())?;
         w.put(&o.worst_mismatch.to_le_bytes())?;
+        w.put(&o.drift_rad.to_le_bytes())?;
+        w.put(&o.worst_drift_rad.to_le_bytes())?;
+        w.put(&o.residual_drift_rad.to_le_bytes())?;
     }
     Some(w.len())
 }
@@ -37,6 +48,8 @@ pub fn encode_periods(c: &Controller, out: &mut [u8]) -> Option<usize> {
 pub struct Periods {
     pub mode: u8,
     pub count: u8,
+    /// The yaw steering request (rad), when the update formed one.
+    pub yaw_request_rad: Option<f32>,
     pub records: [SegmentOutput; MAX_SEGMENTS],
 }
 
@@ -45,7 +58,9 @@ impl Periods {
         let mut r = Reader::new(payload);
         let mode = r.u8()?;
         let count = r.u8()?;
-        r.u16()?;
+        let flags = r.u8()?;
+        r.u8()?;
+        let yaw = r.f32()?;
         if usize::from(count) > MAX_SEGMENTS {
             return None;
         }
@@ -56,16 +71,20 @@ impl Periods {
             *rec = SegmentOutput {
                 index,
                 held: flags & FLAG_HELD != 0,
+                reversed: flags & FLAG_REVERSED != 0,
                 max_stages: r.u16()?,
                 ticks: r.u32()?,
                 mtf: r.f32()?,
-                drift_rad: r.f32()?,
                 worst_mismatch: r.f32()?,
+                drift_rad: r.f32()?,
+                worst_drift_rad: r.f32()?,
+                residual_drift_rad: r.f32()?,
             };
         }
         r.is_done().then_some(Periods {
             mode,
             count,
+            yaw_request_rad: (flags & FLAG_YAW_REQUEST != 0).then_some(yaw),
             records,
         })
     }

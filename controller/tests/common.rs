@@ -25,7 +25,7 @@ pub fn state(i: f64, u: f64, h: f64) -> StateVector {
     }
 }
 
-pub fn nav_frame(seq: u16, time_us: u64, sv: StateVector, attitude: Attitude) -> Vec<u8> {
+pub fn nav_frame(seq: u16, time_us: u64, sv: StateVector, attitude: Attitude<f32>) -> Vec<u8> {
     let mut payload = [0u8; 128];
     let n = Nav {
         state: sv,
@@ -38,7 +38,7 @@ pub fn nav_frame(seq: u16, time_us: u64, sv: StateVector, attitude: Attitude) ->
     buf[..len].to_vec()
 }
 
-pub fn roll(rad: f32) -> Attitude {
+pub fn roll(rad: f32) -> Attitude<f32> {
     Attitude {
         roll_rad: rad,
         ..Attitude::default()

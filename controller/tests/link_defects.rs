@@ -132,7 +132,7 @@ fn scene_payload(count: u8, edit: impl Fn(&mut Vec<u8>)) -> Vec<u8> {
     let mut p = vec![0u8; 400];
     let n = base.encode(&mut p).unwrap();
     p.truncate(n);
-    p[34] = count;
+    p[42] = count;
     let seg = p[SCENE_HEADER_LEN..SCENE_HEADER_LEN + SEGMENT_LEN].to_vec();
     p.truncate(SCENE_HEADER_LEN);
     for k in 0..i32::from(count) {
@@ -165,13 +165,13 @@ fn unusable_scenes_are_refused_as_invalid_scene() {
         (
             "65 535 stages",
             scene_payload(10, |p| {
-                p[32..34].copy_from_slice(&u16::MAX.to_le_bytes());
+                p[40..42].copy_from_slice(&u16::MAX.to_le_bytes());
                 segment(p, 0)[8..10].copy_from_slice(&u16::MAX.to_le_bytes());
             }),
         ),
         (
             "largest stage count beyond the MTF formula's range",
-            scene_payload(10, |p| p[32..34].copy_from_slice(&u16::MAX.to_le_bytes())),
+            scene_payload(10, |p| p[40..42].copy_from_slice(&u16::MAX.to_le_bytes())),
         ),
         (
             "no active segment",

@@ -28,6 +28,8 @@ pub enum Param {
     SemiMajorAxis,
     Flattening,
     FocalPlaneP1,
+    /// The drift tangent v2 / v1 of the drift-smear MTF.
+    Drift,
 }
 
 impl Param {
@@ -57,6 +59,7 @@ impl Param {
             Param::SemiMajorAxis => "semi_major_axis",
             Param::Flattening => "flattening",
             Param::FocalPlaneP1 => "p1",
+            Param::Drift => "drift",
         }
     }
 }

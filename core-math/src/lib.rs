@@ -66,7 +66,7 @@ pub use model::{
     domain, orbital_rate_rad_s, Backend, Camera, Geometry, ImageMotion, Model, Sphere,
     EARTH_RATE_RAD_S, GM_M3_S2,
 };
-pub use mtf::{mtf_mismatch, sinc, StageRule};
+pub use mtf::{mtf_drift, mtf_mismatch, sinc, StageRule};
 #[cfg(feature = "naive")]
 pub use naive::NaiveF32;
 pub use orbit::{OrbitState, StateVector};

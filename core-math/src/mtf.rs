@@ -57,6 +57,17 @@ pub fn mtf_mismatch<T: Real>(stages: u32, rel_mismatch: T) -> Result<T, ModelErr
     ))
 }
 
+/// MTF of the drift smear at Nyquist (`../shared/EARTH-MODEL.md`, derived outputs): over
+/// `stages` TDI stages an image moving at `tan_drift` across the line smears by
+/// d = M |tan drift| pixels, and MTF = sinc(pi d / 2) (sinc(x) = sin(x)/x). The same
+/// function of M x as [`mtf_mismatch`]; negative values are returned as they are.
+pub fn mtf_drift<T: Real>(stages: u32, tan_drift: T) -> Result<T, ModelError> {
+    if !tan_drift.is_finite() {
+        return Err(ModelError::NonFinite(Param::Drift));
+    }
+    Ok(sinc(T::from_f64(HALF_PI) * T::from_u32(stages) * tan_drift))
+}
+
 /// Smallest and largest MTF floor a [`StageRule`] accepts.
 pub const MIN_MTF_FLOOR: f64 = 0.25;
 pub const MAX_MTF_FLOOR: f64 = 0.9999;
@@ -139,6 +150,57 @@ impl<T: Real> StageRule<T> {
             }
         }
         Ok(m)
+    }
+
+    /// The largest M in 0..=min(`stage_limit`, [`MAX_STAGE_LIMIT`]) whose combined MTF,
+    /// mismatch times drift smear, sinc(pi/2 M e) sinc(pi/2 M t), meets the floor, for a
+    /// relative mismatch e and a drift tangent t.
+    ///
+    /// Bracketed, then bisected: the product is at most either factor, so M is at most
+    /// the one-factor limit of max(e, t); and sinc(x) sinc(y) >= sinc(sqrt(x^2 + y^2)) on
+    /// the main lobe, so it is at least the one-factor limit of hypot(e, t). On that
+    /// bracket both arguments stay inside the main lobe, where the product falls
+    /// strictly, so bisection finds the largest M that meets the floor. Every M returned
+    /// is checked against the product itself.
+    pub fn max_stages_with_drift(
+        &self,
+        rel_mismatch: T,
+        tan_drift: T,
+        stage_limit: u32,
+    ) -> Result<u32, ModelError> {
+        if !tan_drift.is_finite() {
+            return Err(ModelError::NonFinite(Param::Drift));
+        }
+        let e = rel_mismatch.abs();
+        let t = tan_drift.abs();
+        let larger = if e > t { e } else { t };
+        let mut hi = self.max_stages(larger, stage_limit)?;
+        let mut lo = self.max_stages((e * e + t * t).sqrt(), stage_limit)?.min(hi);
+        let half_pi = T::from_f64(HALF_PI);
+        let meets = |m: u32| {
+            let x = half_pi * T::from_u32(m);
+            sinc(x * e) * sinc(x * t) >= self.mtf_floor
+        };
+        // The lower end's own check (rounding may put it a stage over); M = 0 always
+        // meets (the product is 1), the fallback should the bound ever fail.
+        for _ in 0..2 {
+            if lo > 0 && !meets(lo) {
+                lo -= 1;
+            }
+        }
+        if !meets(lo) {
+            lo = 0;
+        }
+        // Invariant: meets(lo), and nothing above hi meets.
+        while lo < hi {
+            let mid = lo + (hi - lo).div_ceil(2);
+            if meets(mid) {
+                lo = mid;
+            } else {
+                hi = mid - 1;
+            }
+        }
+        Ok(lo)
     }
 
     pub fn mtf_floor(&self) -> T {

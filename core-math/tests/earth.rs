@@ -451,3 +451,61 @@ fn a_general_case_against_fifty_digits() {
         rel(&s, &golden)
     );
 }
+
+/// Turning the camera about its boresight by `delta` (`GeneralUpdate::yawed`, the yaw
+/// steering request's route) is the update at yaw + delta: checked against the
+/// reference evaluated at the turned attitude, over the envelope.
+#[test]
+fn a_yawed_update_is_the_update_at_the_turned_yaw() {
+    let mut rng = SplitMix64(0x7A3D_2026_1124_0001);
+    let (mut compared, mut worst64, mut worst32) = (0, 0f64, 0f64);
+    for _ in 0..5_000 {
+        let Some(c) = rng.earth_case() else { continue };
+        let delta = rng.uniform(-0.2, 0.2);
+        let mut turned = c.geometry;
+        turned.attitude.yaw_rad += delta;
+        // Turning the frame moves the pixel's ground point: near the limb it may fall
+        // off; only cases at least 0.01 deg inside the limb both ways compare.
+        let inside = |g: &EarthGeometry<f64>| {
+            limb_margin_rad(g, &c.camera, c.n_px).is_ok_and(|m| m >= 0.01f64.to_radians())
+        };
+        if !inside(&c.geometry) || !inside(&turned) {
+            continue;
+        }
+        let r = EarthReference
+            .evaluate(&c.camera, &turned, c.n_px)
+            .unwrap();
+        let (s, co) = libm::sincos(delta);
+        let u64_ = GENERAL_F64.update(&c.geometry).unwrap().yawed(s, co);
+        let p64 = GENERAL_F64.pixel(&c.camera, c.n_px).unwrap();
+        let g = GENERAL_F64.motion(&u64_, &p64).unwrap();
+        worst64 = worst64.max(rel(&g, &r));
+        let g32 = c.geometry.to::<f32>();
+        let u32_ = GENERAL_F32
+            .update(&g32)
+            .unwrap()
+            .yawed(s as f32, co as f32);
+        let p32 = GENERAL_F32.pixel(&c.camera, c.n_px).unwrap();
+        let m32 = GENERAL_F32.motion(&u32_, &p32).unwrap();
+        let m32 = ImageMotion {
+            v1_mps: m32.v1_mps as f64,
+            v2_mps: m32.v2_mps as f64,
+        };
+        let kappa = earth_kappa(&c.camera, &turned, c.n_px).unwrap_or(f64::INFINITY);
+        let e32 = rel(&m32, &r);
+        // The f32 route's bound of the turned problem (as in the f32 test), with one
+        // more rounding of each turned component.
+        assert!(
+            e32 <= EARTH_F32_KAPPA_C * (kappa + 4.0) * U32 || e32 <= EARTH_F32_NEAR_LIMB_TOLERANCE,
+            "f32 {e32:e} (kappa {kappa:.1}) at {c:?}, delta {delta}"
+        );
+        worst32 = worst32.max(e32);
+        compared += 1;
+    }
+    assert!(compared > 3_000, "only {compared} cases compared");
+    assert!(
+        worst64 <= 10.0 * EARTH_F64_REL_TOLERANCE,
+        "f64 yawed vs reference: {worst64:e}"
+    );
+    println!("yawed update: {compared} cases, f64 {worst64:.2e}, f32 {worst32:.2e}");
+}

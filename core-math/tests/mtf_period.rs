@@ -169,3 +169,55 @@ fn dual_numbers_differentiate_exactly() {
     assert!((f.du - expect).abs() < 1e-15, "{} vs {}", f.du, expect);
     assert!((f.re - num / (2.0 + t0)).abs() < 1e-16);
 }
+
+/// The stage limit of the combined MTF (mismatch x drift smear) against a brute-force
+/// search in f64 with libm's sine: the count returned meets the floor and the next one
+/// does not (or the limit is reached), over mismatches and drifts from none to large.
+#[test]
+fn stage_limit_with_drift_is_the_largest_count_meeting_the_floor() {
+    let product = |m: u32, e: f64, t: f64| {
+        let s = |x: f64| if x == 0.0 { 1.0 } else { libm::sin(x) / x };
+        let h = std::f64::consts::FRAC_PI_2 * m as f64;
+        s(h * e) * s(h * t)
+    };
+    let mut state = 0x5EED_u64;
+    let mut next = || {
+        state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let mut checked = 0;
+    for floor in [0.25, 0.5, 0.8, 0.9, 0.95, 0.99] {
+        let rule = StageRule::<f64>::new(floor).unwrap();
+        let rule32 = StageRule::<f32>::new(floor).unwrap();
+        for _ in 0..2_000 {
+            let e = 10f64.powf(-6.0 + 5.0 * next()) * if next() < 0.1 { 0.0 } else { 1.0 };
+            let t = 10f64.powf(-6.0 + 5.0 * next()) * if next() < 0.1 { 0.0 } else { 1.0 };
+            let limit = 1 + (next() * 300.0) as u32;
+            // Brute force: the largest M meeting the floor (the product falls on the
+            // main lobe, and nothing past its first failure comes back above 0.25).
+            let mut expect = 0;
+            while expect < limit && product(expect + 1, e, t) >= floor {
+                expect += 1;
+            }
+            let got = rule.max_stages_with_drift(e, t, limit).unwrap();
+            assert_eq!(got, expect, "floor {floor}, e {e:e}, t {t:e}, limit {limit}");
+            // f32: meets the floor in f64 to its own rounding, and at most one stage
+            // from the f64 answer.
+            let got32 = rule32
+                .max_stages_with_drift(e as f32, t as f32, limit)
+                .unwrap();
+            assert!(got32.abs_diff(expect) <= 1, "f32 {got32} vs {expect}");
+            assert!(got32 == 0 || product(got32, e, t) >= floor - 1e-6);
+            checked += 1;
+        }
+    }
+    assert_eq!(checked, 12_000);
+    // No drift: the same as the mismatch-only rule.
+    let rule = StageRule::<f64>::new(0.95).unwrap();
+    for e in [0.0, 1e-4, 3.7e-3, 0.02] {
+        assert_eq!(
+            rule.max_stages_with_drift(e, 0.0, 256).unwrap(),
+            rule.max_stages(e, 256).unwrap()
+        );
+    }
+}

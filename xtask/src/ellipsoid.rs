@@ -7,7 +7,6 @@
 //! reproduces `core_math::Reference` (its tests, and the validation line of the output).
 
 mod costs;
-mod kepler;
 mod motion;
 
 use std::time::Instant;

@@ -68,7 +68,7 @@ pub enum Action {
 
 /// Kinds the camera takes (and END, which ends a run): anything else is unknown.
 fn is_known_kind(k: u8) -> bool {
-    matches!(k, kind::NAV | kind::SCENE | kind::TIME | kind::END)
+    matches!(k, kind::NAV | kind::SCENE | kind::TERRAIN | kind::TIME | kind::END)
 }
 
 impl Action {
@@ -271,7 +271,7 @@ fn state(i: f64, u: f64, h: f64) -> StateVector {
     }
 }
 
-fn nav_payload(sv: StateVector, attitude: Attitude) -> Vec<u8> {
+fn nav_payload(sv: StateVector, attitude: Attitude<f32>) -> Vec<u8> {
     let mut p = [0u8; 128];
     let n = Nav {
         state: sv,
@@ -354,9 +354,9 @@ pub fn scene_case(edit: u8, k: u8, x: u64) -> (Vec<u8>, Result<(), Fault>, Optio
         }
         // More segments than the table holds, with a length that matches the count.
         12 => {
-            let n = 17 + (x % 8) as usize;
+            let n = 17 + (x % 4) as usize;
             raw = Some(Box::new(move |p: &mut Vec<u8>| {
-                p[34] = n as u8;
+                p[42] = n as u8;
                 let seg = p[SCENE_HEADER_LEN..SCENE_HEADER_LEN + SEGMENT_LEN].to_vec();
                 p.truncate(SCENE_HEADER_LEN);
                 for _ in 0..n {
@@ -388,7 +388,7 @@ pub fn scene_case(edit: u8, k: u8, x: u64) -> (Vec<u8>, Result<(), Fault>, Optio
             Err(Fault::BadLength)
         }
         18 => {
-            scene.max_roll_rad = 1.3 + (x % 100) as f32;
+            scene.envelope.max_roll_rad = 1.3 + (x % 100) as f32;
             Err(Fault::InvalidScene)
         }
         _ => {
@@ -697,7 +697,7 @@ impl Harness {
                     2 => (
                         good,
                         Attitude {
-                            pitch_rad: 0.02,
+                            pitch_rad: 0.6,
                             ..Attitude::default()
                         },
                         Fault::AttitudeOutsideModel,
@@ -708,7 +708,7 @@ impl Harness {
                             roll_rad: 0.9,
                             ..Attitude::default()
                         },
-                        Fault::OutOfRange,
+                        Fault::AttitudeOutsideModel,
                     ),
                     _ => (
                         good,

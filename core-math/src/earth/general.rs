@@ -31,9 +31,12 @@
 
 use core::marker::PhantomData;
 
-use crate::earth::{check_altitude, check_state, Earth, EarthCamera, EarthGeometry, MIN_V1_MPS};
+use crate::earth::{
+    check_altitude, check_state, Attitude, Earth, EarthCamera, EarthGeometry, Ellipsoid, MIN_V1_MPS,
+};
 use crate::error::ModelError;
 use crate::model::{Backend, ImageMotion};
+use crate::orbit::StateVector;
 use crate::real::Real;
 
 /// The general real-Earth backend in scalar `T` (`f64` or `f32`).
@@ -85,43 +88,47 @@ fn at_mul<T: Real>(cols: &[[T; 3]; 3], x: [T; 3]) -> [T; 3] {
     [dot3(cols[0], x), dot3(cols[1], x), dot3(cols[2], x)]
 }
 
-impl<T: Real> Backend<Earth> for General<T> {
-    type Real = T;
-    type Pixel = GeneralPixel<T>;
-    type Update = GeneralUpdate<T>;
+/// The height-independent constants of one instant: what [`GeneralUpdate`] holds before
+/// the ground is chosen. One per update; [`General::ground`] then makes the update of
+/// each ground height from it (a segment's terrain) for a few operations.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GeneralInstant<T> {
+    /// The spin axis z in B.
+    pub n_b: [T; 3],
+    /// |r| A^T z_L (m): rho_B without the ellipsoid's stretch term.
+    pub rho0_b_m: [T; 3],
+    /// r_z (m), |r|^2 (m^2), and |r|^2 - a^2 (m^2, formed in f64).
+    pub r_z_m: T,
+    pub r2_m2: T,
+    pub r2_minus_a2_m2: T,
+    /// W_B (rad/s) and V_B (m/s), as in [`GeneralUpdate`].
+    pub w_b_rad_s: [T; 3],
+    pub v_b_mps: [T; 3],
+}
 
-    /// Boot-time work in f64, rounded once.
-    fn pixel(&self, camera: &EarthCamera, n_px: f64) -> Result<GeneralPixel<T>, ModelError> {
-        let (p1, p2) = camera.focal_plane_m(n_px)?;
-        let f = camera.focal_m;
-        Ok(GeneralPixel {
-            u_m: [T::from_f64(p1), T::from_f64(p2), T::from_f64(-f)],
-            uu_m2: T::from_f64(p1 * p1 + p2 * p2 + f * f),
-            t1: T::from_f64(p1 / f),
-            t2: T::from_f64(p2 / f),
-        })
-    }
-
-    fn update(&self, g: &EarthGeometry<T>) -> Result<GeneralUpdate<T>, ModelError> {
-        let (eq_m, polar_m) = g.check_inputs()?;
-        let (r64, v64) = (g.state.position_m, g.state.velocity_mps);
+impl<T: Real> General<T> {
+    /// The per-instant half of [`Backend::update`]: the state checks of [`check_state`]
+    /// in `T`, the orbital frame, the attitude, W_B and V_B. It makes none of the f64
+    /// input checks of [`EarthGeometry::check_inputs`]: a caller that takes this route
+    /// (the controller, whose inputs were checked when they arrived) answers for them.
+    pub fn instant(
+        &self,
+        state: &StateVector,
+        attitude: &Attitude<T>,
+        ellipsoid: &Ellipsoid,
+        earth_rate_rad_s: f64,
+    ) -> Result<GeneralInstant<T>, ModelError> {
+        let (r64, v64) = (state.position_m, state.velocity_mps);
         let r = r64.map(T::from_f64);
         let v = v64.map(T::from_f64);
         let (r2, h) = check_state(r, v)?;
-        // |r|^2 - A^2 is the one difference of nearly equal terms (a factor up to 16 at
+        // |r|^2 - a^2 is the one difference of nearly equal terms (a factor up to 16 at
         // 200 km): formed in f64 from the f64 state (eight soft-f64 operations on the
         // target), then rounded. Everything else is a product or a sum of like signs.
+        let a_m = ellipsoid.a_m;
         let r2_minus_a2 =
-            T::from_f64((r64[0] * r64[0] + r64[1] * r64[1] + r64[2] * r64[2]) - eq_m * eq_m);
-        // kappa^2 - 1 = (A - B)(A + B)/B^2 with A - B = a f, in T.
-        let b = T::from_f64(polar_m);
-        let k2m1 = T::from_f64(g.ellipsoid.a_m)
-            * T::from_f64(g.ellipsoid.flattening)
-            * (T::from_f64(eq_m) + b)
-            / (b * b);
-        let c_m2 = r2_minus_a2 + k2m1 * r[2] * r[2];
-        check_altitude(c_m2, r2, eq_m)?;
-        let w = T::from_f64(g.earth_rate_rad_s);
+            T::from_f64((r64[0] * r64[0] + r64[1] * r64[1] + r64[2] * r64[2]) - a_m * a_m);
+        let w = T::from_f64(earth_rate_rad_s);
 
         let rn = r2.sqrt();
         // |h| > 0: check_state refused any state with |h|^2 <= 1e-12 |r|^2 |v|^2.
@@ -141,13 +148,8 @@ impl<T: Real> Backend<Earth> for General<T> {
         let wr = w * rn;
         let v_l = [v_fwd - wr * n_l[1], wr * n_l[0], rdot];
         let w_l = [-w * n_l[0], nu - w * n_l[1], -w * n_l[2]];
-        let rho_l = [
-            k2m1 * r[2] * n_l[0],
-            k2m1 * r[2] * n_l[1],
-            rn + k2m1 * r[2] * n_l[2],
-        ];
 
-        let at = &g.attitude;
+        let at = attitude;
         let (sp, cp) = at.roll_rad.sin_cos();
         let (st, ct) = at.pitch_rad.sin_cos();
         let (sy, cy) = at.yaw_rad.sin_cos();
@@ -163,16 +165,100 @@ impl<T: Real> Backend<Earth> for General<T> {
             at.roll_rate_rad_s * st + at.yaw_rate_rad_s,
         ];
         let w_b0 = at_mul(&cols, w_l);
-
-        Ok(GeneralUpdate {
+        Ok(GeneralInstant {
             n_b: at_mul(&cols, n_l),
-            rho_b_m: at_mul(&cols, rho_l),
-            stretch2_minus_1: k2m1,
-            c_m2,
-            inv_c_per_m2: T::ONE / c_m2,
+            // A^T (0, 0, |r|): the third row of A, i.e. each column's z, times |r|.
+            rho0_b_m: [cols[0][2] * rn, cols[1][2] * rn, cols[2][2] * rn],
+            r_z_m: r[2],
+            r2_m2: r2,
+            r2_minus_a2_m2: r2_minus_a2,
             w_b_rad_s: [w_b0[0] + w_a[0], w_b0[1] + w_a[1], w_b0[2] + w_a[2]],
             v_b_mps: at_mul(&cols, v_l),
         })
+    }
+
+    /// The update for the ground ellipsoid raised by `ground_h_m` (semi-axes A = a + h,
+    /// B = b + h) from the instant's constants: the quadratic's terms, no trigonometry,
+    /// two divisions.
+    pub fn ground(
+        &self,
+        inst: &GeneralInstant<T>,
+        ellipsoid: &Ellipsoid,
+        ground_h_m: T,
+    ) -> Result<GeneralUpdate<T>, ModelError> {
+        let a = T::from_f64(ellipsoid.a_m);
+        let eq = a + ground_h_m;
+        let b = T::from_f64(ellipsoid.b_m()) + ground_h_m;
+        // kappa^2 - 1 = (A - B)(A + B)/B^2 with A - B = a f.
+        let k2m1 = a * T::from_f64(ellipsoid.flattening) * (eq + b) / (b * b);
+        // C = (|r|^2 - a^2) - (2a + h) h + (kappa^2 - 1) r_z^2: |r|^2 - A^2 without
+        // forming A^2 (C is at least 1e-6 A^2, the terrain term at most 3e-3 A^2).
+        let z = inst.r_z_m;
+        let c_m2 = inst.r2_minus_a2_m2 - (a + eq) * ground_h_m + k2m1 * z * z;
+        check_altitude(c_m2, inst.r2_m2, eq)?;
+        let kz = k2m1 * z;
+        let (n, rho0) = (inst.n_b, inst.rho0_b_m);
+        Ok(GeneralUpdate {
+            n_b: n,
+            rho_b_m: [
+                rho0[0] + kz * n[0],
+                rho0[1] + kz * n[1],
+                rho0[2] + kz * n[2],
+            ],
+            stretch2_minus_1: k2m1,
+            c_m2,
+            inv_c_per_m2: T::ONE / c_m2,
+            w_b_rad_s: inst.w_b_rad_s,
+            v_b_mps: inst.v_b_mps,
+        })
+    }
+}
+
+impl<T: Real> GeneralUpdate<T> {
+    /// The update of the same instant with the camera turned by a further yaw `delta`
+    /// (given by its sine and cosine): A becomes A Rz(delta), a turn about the boresight
+    /// z_B, so every B-frame vector turns by Rz(delta)^T and nothing else changes (the
+    /// attitude rates' part w_A turns with them). Exact, and the cost of the yaw
+    /// steering request's residual drifts (no second update).
+    pub fn yawed(&self, sin_delta: T, cos_delta: T) -> GeneralUpdate<T> {
+        let turn = |x: [T; 3]| {
+            [
+                cos_delta * x[0] + sin_delta * x[1],
+                cos_delta * x[1] - sin_delta * x[0],
+                x[2],
+            ]
+        };
+        GeneralUpdate {
+            n_b: turn(self.n_b),
+            rho_b_m: turn(self.rho_b_m),
+            w_b_rad_s: turn(self.w_b_rad_s),
+            v_b_mps: turn(self.v_b_mps),
+            ..*self
+        }
+    }
+}
+
+impl<T: Real> Backend<Earth> for General<T> {
+    type Real = T;
+    type Pixel = GeneralPixel<T>;
+    type Update = GeneralUpdate<T>;
+
+    /// Boot-time work in f64, rounded once.
+    fn pixel(&self, camera: &EarthCamera, n_px: f64) -> Result<GeneralPixel<T>, ModelError> {
+        let (p1, p2) = camera.focal_plane_m(n_px)?;
+        let f = camera.focal_m;
+        Ok(GeneralPixel {
+            u_m: [T::from_f64(p1), T::from_f64(p2), T::from_f64(-f)],
+            uu_m2: T::from_f64(p1 * p1 + p2 * p2 + f * f),
+            t1: T::from_f64(p1 / f),
+            t2: T::from_f64(p2 / f),
+        })
+    }
+
+    fn update(&self, g: &EarthGeometry<T>) -> Result<GeneralUpdate<T>, ModelError> {
+        g.check_inputs()?;
+        let inst = self.instant(&g.state, &g.attitude, &g.ellipsoid, g.earth_rate_rad_s)?;
+        self.ground(&inst, &g.ellipsoid, T::from_f64(g.ground_h_m))
     }
 
     #[inline]

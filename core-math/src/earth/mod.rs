@@ -26,9 +26,11 @@ use crate::real::{Real, Scalar};
 
 pub mod general;
 #[cfg(feature = "reference")]
+pub mod kepler;
+#[cfg(feature = "reference")]
 pub mod reference;
 
-pub use general::General;
+pub use general::{General, GeneralInstant, GeneralPixel, GeneralUpdate};
 #[cfg(feature = "reference")]
 pub use reference::EarthReference;
 
@@ -364,11 +366,11 @@ pub fn check_state<S: Real>(r: [S; 3], v: [S; 3]) -> Result<(S, [S; 3]), ModelEr
 /// The satellite against the ground ellipsoid from C = |K r|^2 - A^2, in any scalar:
 /// inside or on it, refused as such; within [`MIN_ALTITUDE_RATIO`] A^2 above it or
 /// beyond [`MAX_RADIUS_RATIO`] A, out of the domain.
-pub fn check_altitude<S: Real>(c_m2: S, r2: S, eq_m: f64) -> Result<(), ModelError> {
+pub fn check_altitude<S: Real>(c_m2: S, r2: S, eq_m: S) -> Result<(), ModelError> {
     if !(c_m2 > S::ZERO) {
         return Err(ModelError::SatelliteNotAboveGround);
     }
-    let a2 = S::from_f64(eq_m) * S::from_f64(eq_m);
+    let a2 = eq_m * eq_m;
     if c_m2 < S::from_f64(MIN_ALTITUDE_RATIO) * a2
         || r2 > S::from_f64(MAX_RADIUS_RATIO * MAX_RADIUS_RATIO) * a2
     {

@@ -289,7 +289,7 @@ fn envelope_at(g: &EarthGeometry<f64>, cam: &EarthCamera, n: f64) -> String {
     let s = &g.state;
     let lat = lat_deg(s);
     let alt = norm(s.position_m) - Spheroid::WGS84.geocentric_radius_m(lat.to_radians());
-    let e = super::kepler::Kepler::new(s.position_m, s.velocity_mps, GM_M3_S2)
+    let e = core_math::earth::kepler::Kepler::new(s.position_m, s.velocity_mps, GM_M3_S2)
         .map_or(f64::NAN, |k| k.eccentricity());
     let a = &g.attitude;
     let d = f64::to_degrees;

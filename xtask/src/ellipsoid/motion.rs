@@ -39,7 +39,7 @@ use core_math::sample::SplitMix64;
 use core_math::{Camera, EarthCamera, EarthGeometry, ImageMotion, StateVector, GM_M3_S2};
 use core_math::{Ellipsoid, EARTH_RATE_RAD_S};
 
-use super::kepler::Kepler;
+use core_math::earth::kepler::Kepler;
 
 pub type V3 = [f64; 3];
 

@@ -198,7 +198,7 @@ impl SceneProbe {
             SceneProbe::ActiveByte2 => p[seg(3) + 10] = 2,
             SceneProbe::Segments17 => {
                 // 17 chips of 3 529 pixels across the same array.
-                p[34] = 17;
+                p[42] = 17;
                 let template = p[seg(0)..seg(1)].to_vec();
                 p.truncate(SCENE_HEADER_LEN);
                 for k in 0..17i32 {
