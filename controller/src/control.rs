@@ -507,7 +507,10 @@ impl Controller {
     }
 
     fn height(&self, index: u8) -> f32 {
-        self.heights_m.get(usize::from(index)).copied().unwrap_or(0.0)
+        self.heights_m
+            .get(usize::from(index))
+            .copied()
+            .unwrap_or(0.0)
     }
 
     fn hold_all(&mut self) {
@@ -560,8 +563,8 @@ impl Controller {
             let half_pi_m = core::f32::consts::FRAC_PI_2 * stages as f32;
             // Past the sinc's first zero no contrast is left; its negative lobe is a
             // phase reversal, not an MTF below 0.
-            let mtf = sinc(half_pi_m * worst).clamp(0.0, 1.0)
-                * sinc(half_pi_m * tan_max).clamp(0.0, 1.0);
+            let mtf =
+                sinc(half_pi_m * worst).clamp(0.0, 1.0) * sinc(half_pi_m * tan_max).clamp(0.0, 1.0);
             let m = self
                 .plan
                 .stage_rule

@@ -3,8 +3,8 @@
 //! rates), checked field by field; and the two-body propagation of that state to the
 //! update instants it serves.
 
-pub use core_math::earth::Attitude;
 use core_math::earth::check_state;
+pub use core_math::earth::Attitude;
 use core_math::{StateVector, GM_M3_S2};
 
 use crate::bytes::{Reader, Writer};

@@ -21,7 +21,9 @@ use core_math::{Backend, StageRule, GENERAL_F32};
 
 use crate::control::{Config, EARTH, EARTH_RATE_RAD_S};
 use crate::fault::Fault;
-use crate::scene::{AttitudeEnvelope, Scene, SegmentSpec, MAX_GROUND_H_M, MAX_SEGMENTS, MIN_GROUND_H_M};
+use crate::scene::{
+    AttitudeEnvelope, Scene, SegmentSpec, MAX_GROUND_H_M, MAX_SEGMENTS, MIN_GROUND_H_M,
+};
 
 /// Most pixels one segment may be sampled at.
 pub const MAX_SAMPLES: usize = 9;
@@ -96,10 +98,7 @@ fn probe_updates(
 ) -> [Option<GeneralUpdate<f32>>; 216] {
     let mut out = [None; 216];
     let mut k = 0;
-    let (r, p) = (
-        f64::from(env.max_roll_rad),
-        f64::from(env.max_pitch_rad),
-    );
+    let (r, p) = (f64::from(env.max_roll_rad), f64::from(env.max_pitch_rad));
     let (h_lo, h_hi) = config.altitude_range_m;
     let inclination = 98f64.to_radians();
     // Equator (radius a + h) and 82 deg latitude (nearly b + h).

@@ -155,8 +155,7 @@ impl Scene {
             && angle_ok(e.max_pitch_rad)
             && e.max_rate_rad_s.is_finite()
             && (0.0..=MAX_ENVELOPE_RATE_RAD_S).contains(&e.max_rate_rad_s);
-        if !clock_ok || !envelope_ok || StageRule::<f32>::new(f64::from(self.mtf_floor)).is_err()
-        {
+        if !clock_ok || !envelope_ok || StageRule::<f32>::new(f64::from(self.mtf_floor)).is_err() {
             return Err(Fault::InvalidScene);
         }
         if self.count == 0

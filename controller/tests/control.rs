@@ -102,7 +102,12 @@ fn periods_match_the_reference_and_follow_the_orbit_and_the_attitude() {
     feed(&mut c, &nav_frame(1, nav.time_us, nav.state, nav.attitude));
     let heights: Vec<f32> = (0..10).map(|k| 8_000.0 - 750.0 * k as f32).collect();
     let mut worst = (0.0f64, 0.0f64, 0.0f64);
-    for (dt_us, terrain) in [(0u64, false), (200_000, false), (400_000, true), (900_000, true)] {
+    for (dt_us, terrain) in [
+        (0u64, false),
+        (200_000, false),
+        (400_000, true),
+        (900_000, true),
+    ] {
         if terrain && c.heights_m()[0] == 0.0 {
             feed(&mut c, &terrain_frame(2, 1_300_000, &heights));
             assert_eq!(c.counters.total(), 0);
@@ -141,17 +146,37 @@ fn periods_match_the_reference_and_follow_the_orbit_and_the_attitude() {
     for o in c.outputs() {
         // Pitched, the far segments' drift (the keystone: tan(pitch) tan(field)) smears
         // beyond the sinc's first zero: an MTF of 0 is the truth there.
-        assert!(!o.held && !o.reversed && (0.0..=1.0).contains(&o.mtf), "{o:?}");
+        assert!(
+            !o.held && !o.reversed && (0.0..=1.0).contains(&o.mtf),
+            "{o:?}"
+        );
         let product = |m: u32| {
             let h = std::f64::consts::FRAC_PI_2 * f64::from(m);
             // Each factor clamped at its first zero (no contrast, not a negative one).
-            let s = |x: f64| if x == 0.0 { 1.0 } else { (x.sin() / x).max(0.0) };
+            let s = |x: f64| {
+                if x == 0.0 {
+                    1.0
+                } else {
+                    (x.sin() / x).max(0.0)
+                }
+            };
             s(h * f64::from(o.worst_mismatch)) * s(h * f64::from(o.worst_drift_rad).tan())
         };
         let m = u32::from(o.max_stages);
-        assert!(product(m) >= floor - 1e-6, "stage limit {m} misses the floor");
-        assert!(m == 96 || product(m + 1) < floor + 1e-6, "stage limit {m} not the largest");
-        assert!((product(16) - f64::from(o.mtf)).abs() < 1e-5, "MTF {} vs {}", o.mtf, product(16));
+        assert!(
+            product(m) >= floor - 1e-6,
+            "stage limit {m} misses the floor"
+        );
+        assert!(
+            m == 96 || product(m + 1) < floor + 1e-6,
+            "stage limit {m} not the largest"
+        );
+        assert!(
+            (product(16) - f64::from(o.mtf)).abs() < 1e-5,
+            "MTF {} vs {}",
+            o.mtf,
+            product(16)
+        );
         assert!(o.worst_drift_rad >= o.drift_rad.abs());
     }
 }
@@ -177,7 +202,10 @@ fn steering_the_yaw_as_requested_leaves_the_reported_residual_drift() {
     let unsteered: Vec<f32> = c.outputs().map(|o| o.drift_rad).collect();
     eprintln!(
         "unsteered drifts {:?} mrad",
-        unsteered.iter().map(|r| (r * 1e4).round() / 10.0).collect::<Vec<_>>()
+        unsteered
+            .iter()
+            .map(|r| (r * 1e4).round() / 10.0)
+            .collect::<Vec<_>>()
     );
     att.yaw_rad += request;
     feed(&mut c, &nav_frame(2, 1_020_000, s, att));
@@ -198,7 +226,10 @@ fn steering_the_yaw_as_requested_leaves_the_reported_residual_drift() {
     eprintln!(
         "yaw request {:.3} mrad; residual drifts {:?} mrad",
         request * 1e3,
-        residual.iter().map(|r| (r * 1e4).round() / 10.0).collect::<Vec<_>>()
+        residual
+            .iter()
+            .map(|r| (r * 1e4).round() / 10.0)
+            .collect::<Vec<_>>()
     );
 }
 
@@ -259,7 +290,10 @@ fn every_fault_is_counted_and_changes_nothing() {
             ),
             Fault::AttitudeOutsideModel,
         ),
-        (nav_frame(7, 1_300_000, good, roll(0.9)), Fault::AttitudeOutsideModel),
+        (
+            nav_frame(7, 1_300_000, good, roll(0.9)),
+            Fault::AttitudeOutsideModel,
+        ),
         // Issue 12: 24 deg of roll at 0.5 rad/s would be 52 deg a second later.
         (
             nav_frame(
@@ -288,9 +322,18 @@ fn every_fault_is_counted_and_changes_nothing() {
             Fault::AttitudeOutsideModel,
         ),
         (nav_frame(73, 1_330_000, fast, roll(0.2)), Fault::OutOfRange),
-        (terrain_frame(74, 1_340_000, &[9_500.0; 10]), Fault::OutOfRange),
-        (terrain_frame(75, 1_345_000, &[f32::NAN; 10]), Fault::NonFinite),
-        (terrain_frame(76, 1_346_000, &[100.0; 9]), Fault::InvalidScene),
+        (
+            terrain_frame(74, 1_340_000, &[9_500.0; 10]),
+            Fault::OutOfRange,
+        ),
+        (
+            terrain_frame(75, 1_345_000, &[f32::NAN; 10]),
+            Fault::NonFinite,
+        ),
+        (
+            terrain_frame(76, 1_346_000, &[100.0; 9]),
+            Fault::InvalidScene,
+        ),
         (
             nav_frame(
                 8,

@@ -55,7 +55,11 @@ fn scene(kind: usize) -> Scene {
     let mut s = Scene::paper_default();
     match kind {
         0 => {}
-        1 => s.segments.iter_mut().take(10).for_each(|g| g.tdi_stages = 96),
+        1 => s
+            .segments
+            .iter_mut()
+            .take(10)
+            .for_each(|g| g.tdi_stages = 96),
         _ => {
             s.count = MAX_SEGMENTS as u8;
             for (k, g) in s.segments.iter_mut().enumerate() {
@@ -98,11 +102,7 @@ fn the_reported_worst_mismatch_bounds_the_truth_over_every_pixel() {
         // An orbit in the band (e up to ~0.02), an attitude anywhere in the envelope at
         // rates up to a third of its limit, yaw steered within 0.1 rad.
         let h = rng.uniform(510e3, 790e3);
-        let mut sv = state(
-            rng.uniform(0.0, 3.1),
-            rng.uniform(0.0, 6.28),
-            h,
-        );
+        let mut sv = state(rng.uniform(0.0, 3.1), rng.uniform(0.0, 6.28), h);
         let speed = rng.uniform(0.99, 1.01);
         sv.velocity_mps = sv.velocity_mps.map(|v| v * speed);
         let e = scene.envelope;
@@ -155,7 +155,12 @@ fn the_reported_worst_mismatch_bounds_the_truth_over_every_pixel() {
             w.margin = w.margin.min(reported - truth);
             w.ratio = w.ratio.max(truth / reported);
         }
-        w.samples += c.plan().active().iter().map(|s| usize::from(s.n_samples)).sum::<usize>();
+        w.samples += c
+            .plan()
+            .active()
+            .iter()
+            .map(|s| usize::from(s.n_samples))
+            .sum::<usize>();
     }
     assert!(w.compared >= 500, "only {} segments compared", w.compared);
     eprintln!(

@@ -38,7 +38,9 @@ fn default_update_period_meets_a_tenth_of_the_mtf_budget() {
             ] {
                 let s0 = circular_state(radius + h, 98f64.to_radians(), u);
                 let kepler = Kepler::new(s0.position_m, s0.velocity_mps, GM_M3_S2).unwrap();
-                for (roll_rate, pitch_rate) in [(rate, rate), (rate, -rate), (-rate, rate), (-rate, -rate)] {
+                for (roll_rate, pitch_rate) in
+                    [(rate, rate), (rate, -rate), (-rate, rate), (-rate, -rate)]
+                {
                     let at = |t: f64| EarthGeometry {
                         state: kepler.state_at(t),
                         attitude: Attitude {

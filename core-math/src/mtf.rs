@@ -175,7 +175,9 @@ impl<T: Real> StageRule<T> {
         let t = tan_drift.abs();
         let larger = if e > t { e } else { t };
         let mut hi = self.max_stages(larger, stage_limit)?;
-        let mut lo = self.max_stages((e * e + t * t).sqrt(), stage_limit)?.min(hi);
+        let mut lo = self
+            .max_stages((e * e + t * t).sqrt(), stage_limit)?
+            .min(hi);
         let half_pi = T::from_f64(HALF_PI);
         let meets = |m: u32| {
             let x = half_pi * T::from_u32(m);

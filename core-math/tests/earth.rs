@@ -472,19 +472,14 @@ fn a_yawed_update_is_the_update_at_the_turned_yaw() {
         if !inside(&c.geometry) || !inside(&turned) {
             continue;
         }
-        let r = EarthReference
-            .evaluate(&c.camera, &turned, c.n_px)
-            .unwrap();
+        let r = EarthReference.evaluate(&c.camera, &turned, c.n_px).unwrap();
         let (s, co) = libm::sincos(delta);
         let u64_ = GENERAL_F64.update(&c.geometry).unwrap().yawed(s, co);
         let p64 = GENERAL_F64.pixel(&c.camera, c.n_px).unwrap();
         let g = GENERAL_F64.motion(&u64_, &p64).unwrap();
         worst64 = worst64.max(rel(&g, &r));
         let g32 = c.geometry.to::<f32>();
-        let u32_ = GENERAL_F32
-            .update(&g32)
-            .unwrap()
-            .yawed(s as f32, co as f32);
+        let u32_ = GENERAL_F32.update(&g32).unwrap().yawed(s as f32, co as f32);
         let p32 = GENERAL_F32.pixel(&c.camera, c.n_px).unwrap();
         let m32 = GENERAL_F32.motion(&u32_, &p32).unwrap();
         let m32 = ImageMotion {

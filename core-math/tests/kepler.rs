@@ -8,7 +8,6 @@ fn dot(a: V3, b: V3) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
-
 fn add(a: V3, b: V3) -> V3 {
     [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
 }
@@ -64,9 +63,8 @@ fn small_steps_follow_taylor() {
     let acc = r0.map(|x| -GM_M3_S2 * x / rn.powi(3));
     // Jerk: -GM (v / r^3 - 3 (r . v) r / r^5).
     let rv = dot(r0, v0);
-    let jerk: V3 = std::array::from_fn(|i| {
-        -GM_M3_S2 * (v0[i] / rn.powi(3) - 3.0 * rv * r0[i] / rn.powi(5))
-    });
+    let jerk: V3 =
+        std::array::from_fn(|i| -GM_M3_S2 * (v0[i] / rn.powi(3) - 3.0 * rv * r0[i] / rn.powi(5)));
     let dt = 0.01;
     let (dr, _) = k.at(dt);
     for i in 0..3 {

@@ -182,7 +182,9 @@ fn stage_limit_with_drift_is_the_largest_count_meeting_the_floor() {
     };
     let mut state = 0x5EED_u64;
     let mut next = || {
-        state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
         (state >> 11) as f64 / (1u64 << 53) as f64
     };
     let mut checked = 0;
@@ -200,7 +202,10 @@ fn stage_limit_with_drift_is_the_largest_count_meeting_the_floor() {
                 expect += 1;
             }
             let got = rule.max_stages_with_drift(e, t, limit).unwrap();
-            assert_eq!(got, expect, "floor {floor}, e {e:e}, t {t:e}, limit {limit}");
+            assert_eq!(
+                got, expect,
+                "floor {floor}, e {e:e}, t {t:e}, limit {limit}"
+            );
             // f32: meets the floor in f64 to its own rounding, and at most one stage
             // from the f64 answer.
             let got32 = rule32

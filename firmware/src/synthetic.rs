@@ -13,7 +13,7 @@ use core_math::StateVector;
 
 use crate::FirmwareError;
 
-/// Orbit of the synthetic frame: the paper's 645 km (over R = 6 371 km), circular,
+/// Orbit of the synthetic frame: 645 km over the equatorial radius of WGS 84, circular,
 /// i0 97.98 deg, argument of latitude 0.5 rad.
 const ALTITUDE_M: f64 = 645e3;
 const INCLINATION_DEG: f64 = 97.98;
@@ -32,11 +32,12 @@ impl LinePeriodSink for NoRegisters {
 }
 
 /// A controller for `scene` (with the plan the scene needs, or `exhaustive`: every
-/// segment and term) holding one accepted NAV frame at t = 1 s with roll `roll_rad`.
+/// segment, the most samples) holding one accepted NAV frame at t = 1 s with
+/// `attitude`.
 pub fn controller_with_nav(
     scene: controller::Scene,
     exhaustive: bool,
-    roll_rad: f32,
+    attitude: Attitude<f32>,
 ) -> Result<Controller, FirmwareError> {
     let config = Config::default();
     let c = if exhaustive {
@@ -45,17 +46,13 @@ pub fn controller_with_nav(
         Controller::new(config, scene)
     };
     let mut c = c.map_err(|_| FirmwareError::Layout)?;
-    let r_m = config.earth_radius_m + ALTITUDE_M;
+    let r_m = controller::EARTH.a_m + ALTITUDE_M;
     let (i0, u) = (INCLINATION_DEG.to_radians(), ARG_LATITUDE_RAD);
     let speed = libm::sqrt(core_math::GM_M3_S2 / r_m);
     let (si, ci, su, cu) = (libm::sin(i0), libm::cos(i0), libm::sin(u), libm::cos(u));
     let state = StateVector {
         position_m: [r_m * cu, r_m * su * ci, r_m * su * si],
         velocity_mps: [-speed * su, speed * cu * ci, speed * cu * si],
-    };
-    let attitude = Attitude {
-        roll_rad,
-        ..Attitude::default()
     };
     let mut payload = [0u8; 96];
     let n = Nav { state, attitude }

@@ -11,7 +11,7 @@ mod motion;
 
 use std::time::Instant;
 
-use controller::{Config, Scene};
+use controller::Scene;
 use core_math::{
     mtf_mismatch, Backend, Camera, Geometry, ImageMotion, OrbitState, Reference, StageRule,
     CLOSED_F32, EARTH_RATE_RAD_S,
@@ -316,7 +316,8 @@ fn case(
 pub fn summary() -> Result<EllipsoidSummary, String> {
     let scene = Scene::paper_default();
     let camera = scene.camera;
-    let r_model = Config::default().earth_radius_m;
+    // The round Earth of the paper's model (the controller's until issue 12).
+    let r_model = 6_371_000.0;
     let orbit = Orbit::circular(r_model + ALTITUDE_M, INCLINATION_DEG.to_radians(), RAAN_RAD);
     let mut samples: Vec<f64> = Vec::new();
     for (_, s) in scene.active() {

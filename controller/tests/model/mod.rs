@@ -68,7 +68,10 @@ pub enum Action {
 
 /// Kinds the camera takes (and END, which ends a run): anything else is unknown.
 fn is_known_kind(k: u8) -> bool {
-    matches!(k, kind::NAV | kind::SCENE | kind::TERRAIN | kind::TIME | kind::END)
+    matches!(
+        k,
+        kind::NAV | kind::SCENE | kind::TERRAIN | kind::TIME | kind::END
+    )
 }
 
 impl Action {

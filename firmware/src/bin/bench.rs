@@ -100,11 +100,8 @@ fn plan_pixels<M: Model, B: Backend<M>>(
 where
     B::Pixel: Copy,
 {
-    let plan = controller::plan::Plan::new(
-        &controller::Scene::paper_default(),
-        &Config::default().envelope(),
-    )
-    .map_err(|_| FirmwareError::Layout)?;
+    let plan = controller::plan::Plan::new(&controller::Scene::paper_default(), &Config::default())
+        .map_err(|_| FirmwareError::Layout)?;
     let mut out = [backend.pixel(camera, 0.0)?; MAX_POINTS];
     let mut count = 0;
     for seg in plan.active() {
@@ -151,41 +148,57 @@ fn update_region(label: &str, c: &mut Controller, t_us: u64) -> Result<(), Firmw
     }
 }
 
-/// Instructions per update for each scene kind, planned and evaluate-everything.
+/// Instructions per update for each scene kind, planned and evaluate-everything: the
+/// whole update of the real-Earth controller (propagation, the general form's update,
+/// each segment's ground, samples, centre, MTF, stages, drift, yaw request).
 fn scene_kinds() -> Result<(), FirmwareError> {
     let all = controller::Scene::paper_default();
     let mut nadir = all;
-    nadir.max_roll_rad = 0.0;
+    nadir.envelope.max_roll_rad = 0.0;
+    nadir.envelope.max_pitch_rad = 0.0;
     let mut one = all;
     for (k, s) in one.segments.iter_mut().enumerate() {
         s.active = k == 9;
     }
-    let roll = 20f32.to_radians();
-    let kinds: [(&str, &str, controller::Scene, f32); 3] = [
+    // An agile instant: rolled and pitched, yaw steered, every angle moving.
+    let agile = controller::nav::Attitude {
+        roll_rad: 20f32.to_radians(),
+        pitch_rad: -10f32.to_radians(),
+        yaw_rad: 3f32.to_radians(),
+        roll_rate_rad_s: 0.5f32.to_radians(),
+        pitch_rate_rad_s: -0.2f32.to_radians(),
+        yaw_rate_rad_s: 0.05f32.to_radians(),
+    };
+    let kinds: [(
+        &str,
+        &str,
+        controller::Scene,
+        controller::nav::Attitude<f32>,
+    ); 3] = [
         (
             "scene nadir only, all segments: planned",
             "scene nadir only, all segments: evaluate everything",
             nadir,
-            0.0,
+            controller::nav::Attitude::default(),
         ),
         (
-            "scene roll up to 25 deg, all segments: planned",
-            "scene roll up to 25 deg, all segments: evaluate everything",
+            "scene roll and pitch up to 25 deg, all segments: planned",
+            "scene roll and pitch up to 25 deg, all segments: evaluate everything",
             all,
-            roll,
+            agile,
         ),
         (
-            "scene roll up to 25 deg, one segment active: planned",
-            "scene roll up to 25 deg, one segment active: evaluate everything",
+            "scene roll and pitch up to 25 deg, one segment active: planned",
+            "scene roll and pitch up to 25 deg, one segment active: evaluate everything",
             one,
-            roll,
+            agile,
         ),
     ];
-    for (planned, everything, scene, roll) in kinds {
-        let mut c = controller_with_nav(scene, false, roll)?;
-        update_region(planned, &mut c, 1_000_000)?;
-        let mut c = controller_with_nav(scene, true, roll)?;
-        update_region(everything, &mut c, 1_000_000)?;
+    for (planned, everything, scene, attitude) in kinds {
+        let mut c = controller_with_nav(scene, false, attitude)?;
+        update_region(planned, &mut c, 1_020_000)?;
+        let mut c = controller_with_nav(scene, true, attitude)?;
+        update_region(everything, &mut c, 1_020_000)?;
     }
     Ok(())
 }

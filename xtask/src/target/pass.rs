@@ -17,8 +17,10 @@
 //! Protocol and file format: docs/telemetry.md.
 
 mod check;
+mod plots;
 mod scenario;
 mod stream;
+mod truth;
 
 use std::collections::BTreeMap;
 use std::io::{Read, Write};
@@ -30,8 +32,8 @@ use controller::report::{mode_from_u8, Periods, Status};
 use controller::{Config, Fault, Mode};
 
 use crate::plot::{Legend, Plot, Series};
-use check::{Downlink, ReferencePlan, F32_REL_TOLERANCE};
-use scenario::{Pass, Truth};
+use check::{Downlink, F32_REL_TOLERANCE};
+use scenario::Pass;
 
 use super::{build_bin, ensure_target_tools, qemu, workspace_root};
 
@@ -57,11 +59,10 @@ pub struct RunOptions {
 pub fn run(options: &RunOptions) -> Result<(), String> {
     let started = Instant::now();
     let tick_us = Config::default().update_period_us;
-    let earth_radius_m = Config::default().earth_radius_m;
     let pass = match &options.telemetry {
         Some(path) => scenario::from_csv(path, tick_us)?,
-        None if options.short => scenario::short_pass(earth_radius_m, tick_us),
-        None => scenario::default_pass(earth_radius_m, tick_us),
+        None if options.short => scenario::short_pass(tick_us)?,
+        None => scenario::default_pass(tick_us)?,
     };
     ensure_target_tools()?;
     let elf = build_bin("firmware", "firmware", options.release, &[])?;
@@ -73,6 +74,9 @@ pub fn run(options: &RunOptions) -> Result<(), String> {
         .unwrap_or_else(|| workspace_root().join("target/pass/line-periods.png"));
     plot_periods(&pass, &result, &plot)?;
     println!("plot: {}", plot.display());
+    if let Some(dir) = plot.parent() {
+        plots::pass_plots(&pass, &result.firmware, dir)?;
+    }
     println!(
         "wall time {:.1} s for {:.0} s of orbit",
         started.elapsed().as_secs_f64(),
@@ -83,8 +87,7 @@ pub fn run(options: &RunOptions) -> Result<(), String> {
 
 /// `cargo xtask run --export-telemetry FILE`: the default pass's NAV samples as CSV.
 pub fn export(path: &Path) -> Result<(), String> {
-    let c = Config::default();
-    let pass = scenario::default_pass(c.earth_radius_m, c.update_period_us);
+    let pass = scenario::default_pass(Config::default().update_period_us)?;
     scenario::to_csv(&pass, path)?;
     println!(
         "wrote {} NAV samples of the {} to {} (faults are not part of the file)",
@@ -100,8 +103,7 @@ pub fn export(path: &Path) -> Result<(), String> {
 /// reference, every fault counted, no output changed by a fault.
 pub fn e2e_test() -> Result<(), String> {
     let started = Instant::now();
-    let c = Config::default();
-    let pass = scenario::short_pass(c.earth_radius_m, c.update_period_us);
+    let pass = scenario::short_pass(Config::default().update_period_us)?;
     let elf = build_bin("firmware", "firmware", true, &[])?;
     let result = play(&elf, &pass)?;
     result.finish()?;
@@ -132,6 +134,8 @@ struct Played {
     /// Final STATUS of the firmware.
     final_status: Option<Status>,
     count_failures: Vec<String>,
+    /// The truth checks of a built-in pass (none for a user's telemetry).
+    truth: Option<truth::Report>,
 }
 
 impl Played {
@@ -178,6 +182,10 @@ impl Played {
             "reference check: max relative difference {:.3e} over {} periods",
             self.max_rel, self.compared
         );
+        if let Some(t) = &self.truth {
+            t.print();
+            problems.extend(t.problems());
+        }
         println!(
             "faults: injected {counted}, rejected {}, outputs changed by faults {}",
             self.rejected(),
@@ -218,7 +226,11 @@ fn play(elf: &Path, pass: &Pass) -> Result<Played, String> {
     let controller = check::new_controller()?;
     let t_check = Instant::now();
     let (max_rel, max_ticks, compared, reference_failures) =
-        reference_check(pass, &firmware, &navs, &ReferencePlan::new(&controller)?)?;
+        reference_check(&firmware, &navs, &controller)?;
+    let truth = match pass.truth.agile() {
+        Some(a) => Some(truth::check(a, &firmware, &controller)?),
+        None => None,
+    };
     println!(
         "QEMU run {:.1} s; twin runs and reference check {:.1} s",
         t_check.duration_since(t_qemu).as_secs_f64() - twin_s,
@@ -267,6 +279,7 @@ fn play(elf: &Path, pass: &Pass) -> Result<Played, String> {
         changed_examples,
         final_status,
         count_failures,
+        truth,
     })
 }
 
@@ -313,15 +326,15 @@ fn describe(p: Option<&Vec<u8>>) -> String {
     }
 }
 
-/// Every fresh (not held) period of the firmware against the reference at its update
-/// instant. Returns the largest relative difference, the count, the failures.
+/// Every fresh (not held) period of the firmware against the f64 reference of the same
+/// update on the firmware's own inputs (`controller::golden`: the NAV frame and terrain
+/// in force, as the host twin had them). Returns the largest relative difference, the
+/// largest in ticks, the count, the failures.
 fn reference_check(
-    pass: &Pass,
     firmware: &Downlink,
-    navs: &BTreeMap<u64, controller::control::NavState>,
-    plan: &ReferencePlan,
+    inputs: &BTreeMap<u64, check::InForce>,
+    controller: &controller::Controller,
 ) -> Result<(f64, f64, usize, Vec<String>), String> {
-    let earth_radius_m = Config::default().earth_radius_m;
     let mut max_rel = 0.0f64;
     let mut max_ticks = 0.0f64;
     let mut compared = 0;
@@ -330,22 +343,29 @@ fn reference_check(
         if !periods.records().iter().any(|r| !r.held) {
             continue;
         }
-        let geometry = match &pass.truth {
-            Truth::Circular { .. } => pass.truth.geometry(t_us as f64 * 1e-6),
-            Truth::Telemetry => navs
-                .get(&t_us)
-                .map(|nav| check::propagated(nav, t_us, earth_radius_m)),
-        };
-        let Some(g) = geometry else {
+        let Some(input) = inputs.get(&t_us) else {
             failures.push(format!(
                 "update at {:.3} s: no state to compare with",
                 t_us as f64 * 1e-6
             ));
             continue;
         };
-        let reference = plan.ticks(&g)?;
+        let golden = controller::golden::update(
+            controller.scene(),
+            controller.plan(),
+            &input.heights_m,
+            &input.nav,
+            t_us,
+        )
+        .map_err(|e| format!("reference at {t_us} us: {}", e.name()))?;
         for r in periods.records().iter().filter(|r| !r.held) {
-            let Some(&exact) = reference.get(&r.index) else {
+            let Some(exact) = golden
+                .segments
+                .iter()
+                .flatten()
+                .find(|g| g.index == r.index)
+                .map(|g| g.ticks_exact)
+            else {
                 failures.push(format!("segment {} is not in the plan", r.index));
                 continue;
             };
@@ -486,7 +506,10 @@ fn print_table(pass: &Pass, played: &Played, every_s: u64, segments: &[u8]) {
         played.rx_bytes,
         played.tx_bytes
     );
-    let mut header = format!("{:>6} {:>8} {:>6}", "t_s", "mode", "roll");
+    let mut header = format!(
+        "{:>6} {:>8} {:>6} {:>6} {:>6}",
+        "t_s", "mode", "roll", "pitch", "yaw"
+    );
     for &s in &segments {
         header.push_str(&format!(
             " | seg {s}: {:>9} {:>6} {:>3}",
@@ -506,12 +529,17 @@ fn print_table(pass: &Pass, played: &Played, every_s: u64, segments: &[u8]) {
             break;
         };
         let t_s = *t_us as f64 * 1e-6;
-        let roll = pass
-            .truth
-            .roll_deg(t_s)
-            .or_else(|| telemetry_roll_deg(pass, *t_us))
-            .map_or("-".to_string(), |r| format!("{r:.2}"));
-        let mut line = format!("{t_s:>6.1} {:>8} {roll:>6}", mode_name(p.mode));
+        let angles = telemetry_attitude_deg(pass, *t_us)
+            .map_or(["-".to_string(), "-".into(), "-".into()], |a| {
+                a.map(|x| format!("{x:.2}"))
+            });
+        let mut line = format!(
+            "{t_s:>6.1} {:>8} {:>6} {:>6} {:>6}",
+            mode_name(p.mode),
+            angles[0],
+            angles[1],
+            angles[2]
+        );
         for &s in &segments {
             match p.records().iter().find(|r| r.index == s) {
                 Some(r) => line.push_str(&format!(
@@ -550,15 +578,20 @@ fn print_table(pass: &Pass, played: &Played, every_s: u64, segments: &[u8]) {
         println!("{}", line.trim_end());
         next += every_s * 1_000_000;
     }
-    println!("(period in us of the 10 MHz line clock; h: held over a fault; M: largest TDI stage count meeting MTF 0.95)");
+    println!("(attitude in deg from the last NAV frame, propagated at its rates; period in us of the 10 MHz line clock; h: held over a fault; MTF: mismatch x drift smear with the segment's 16 stages; M: largest TDI stage count meeting MTF 0.95)");
 }
 
-/// The roll of the last NAV sample at or before `t_us`, propagated at its rate (deg).
-fn telemetry_roll_deg(pass: &Pass, t_us: u64) -> Option<f64> {
+/// Roll, pitch and yaw of the last NAV sample at or before `t_us`, propagated at their
+/// rates (deg).
+fn telemetry_attitude_deg(pass: &Pass, t_us: u64) -> Option<[f64; 3]> {
     let s = pass.samples.iter().rev().find(|s| s.t_us <= t_us)?;
-    let a = s.nav.attitude;
+    let a = s.nav.attitude.to_f64();
     let dt = (t_us - s.t_us) as f64 * 1e-6;
-    Some((f64::from(a.roll_rad) + f64::from(a.roll_rate_rad_s) * dt).to_degrees())
+    Some([
+        (a.roll_rad + a.roll_rate_rad_s * dt).to_degrees(),
+        (a.pitch_rad + a.pitch_rate_rad_s * dt).to_degrees(),
+        (a.yaw_rad + a.yaw_rate_rad_s * dt).to_degrees(),
+    ])
 }
 
 /// The line period of every segment over time, as programmed.

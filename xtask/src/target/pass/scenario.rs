@@ -1,9 +1,12 @@
-//! What a pass is: NAV telemetry samples, the truth the reference check uses, and the
-//! faults to inject. The default pass is built here from a circular Keplerian orbit and
-//! a roll manoeuvre; a user's pass comes from a CSV file.
+//! What a pass is: NAV telemetry samples, TERRAIN uploads, the truth the checks use, and
+//! the faults to inject. The built-in passes are made here: a J2 orbit, roll and pitch
+//! manoeuvres, a mountain range, and the yaw steered by the firmware's own requests
+//! (closed loop through a host run of the same controller); a user's pass comes from a
+//! CSV file.
 
 use controller::nav::{Attitude, Nav};
-use core_math::{Geometry, StateVector, GM_M3_S2};
+use controller::EARTH;
+use core_math::{StateVector, GM_M3_S2};
 
 use crate::csv::Table;
 
@@ -14,54 +17,117 @@ pub struct Sample {
     pub nav: Nav,
 }
 
-/// A circular Keplerian orbit over a round Earth (ECI, z along the spin axis).
-#[derive(Clone, Copy, Debug)]
-pub struct CircularOrbit {
-    pub earth_radius_m: f64,
-    pub altitude_m: f64,
-    pub inclination_rad: f64,
-    /// Right ascension of the ascending node.
-    pub raan_rad: f64,
-    /// Argument of latitude at t = 0.
-    pub u0_rad: f64,
+/// J2 of the Earth's gravity field (EGM 2008, unnormalised) and its reference radius.
+pub const J2: f64 = 1.082_626_68e-3;
+/// Step of the truth orbit's grid (s).
+const ORBIT_STEP_S: f64 = 1.0;
+
+/// The truth orbit: an inertial state propagated under the Earth's central field and its
+/// J2 term by fourth-order Runge-Kutta (1 s steps: the truncation error, (n h)^4 of the
+/// orbit, is below 1e-12 of it), so that the firmware's two-body propagation between NAV
+/// frames carries a real model error.
+#[derive(Clone, Debug)]
+pub struct J2Orbit {
+    grid: Vec<StateVector>,
 }
 
-impl CircularOrbit {
-    /// Mean motion sqrt(GM / a^3) (rad/s).
-    pub fn rate_rad_s(&self) -> f64 {
-        core_math::orbital_rate_rad_s(self.earth_radius_m, self.altitude_m)
-    }
+fn accel(r: [f64; 3]) -> [f64; 3] {
+    let r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+    let rn = r2.sqrt();
+    let mu_r3 = GM_M3_S2 / (r2 * rn);
+    let re = EARTH.a_m;
+    let z2 = r[2] * r[2] / r2;
+    let k = 1.5 * J2 * re * re / r2;
+    [
+        -mu_r3 * r[0] * (1.0 + k * (1.0 - 5.0 * z2)),
+        -mu_r3 * r[1] * (1.0 + k * (1.0 - 5.0 * z2)),
+        -mu_r3 * r[2] * (1.0 + k * (3.0 - 5.0 * z2)),
+    ]
+}
 
-    pub fn arg_latitude_rad(&self, t_s: f64) -> f64 {
-        self.u0_rad + self.rate_rad_s() * t_s
+fn rk4(s: &StateVector, h: f64) -> StateVector {
+    let add = |a: [f64; 3], b: [f64; 3], k: f64| std::array::from_fn(|i| a[i] + k * b[i]);
+    let (r, v) = (s.position_m, s.velocity_mps);
+    let (k1r, k1v) = (v, accel(r));
+    let (k2r, k2v) = (add(v, k1v, h / 2.0), accel(add(r, k1r, h / 2.0)));
+    let (k3r, k3v) = (add(v, k2v, h / 2.0), accel(add(r, k2r, h / 2.0)));
+    let (k4r, k4v) = (add(v, k3v, h), accel(add(r, k3r, h)));
+    StateVector {
+        position_m: std::array::from_fn(|i| {
+            r[i] + h / 6.0 * (k1r[i] + 2.0 * k2r[i] + 2.0 * k3r[i] + k4r[i])
+        }),
+        velocity_mps: std::array::from_fn(|i| {
+            v[i] + h / 6.0 * (k1v[i] + 2.0 * k2v[i] + 2.0 * k3v[i] + k4v[i])
+        }),
     }
+}
 
-    /// ECI position and velocity at `t_s`.
-    pub fn state(&self, t_s: f64) -> StateVector {
-        let a = self.earth_radius_m + self.altitude_m;
-        let speed = (GM_M3_S2 / a).sqrt();
-        let (si, ci) = self.inclination_rad.sin_cos();
-        let (su, cu) = self.arg_latitude_rad(t_s).sin_cos();
-        let (sn, cn) = self.raan_rad.sin_cos();
-        // In-plane unit vectors: towards the node, and 90 deg ahead of it.
-        let p = [cn, sn, 0.0];
-        let q = [-sn * ci, cn * ci, si];
-        StateVector {
-            position_m: std::array::from_fn(|k| a * (cu * p[k] + su * q[k])),
-            velocity_mps: std::array::from_fn(|k| speed * (-su * p[k] + cu * q[k])),
+impl J2Orbit {
+    /// From the osculating elements at t = 0: semi-major axis, eccentricity,
+    /// inclination, node, argument of perigee, mean anomaly.
+    pub fn new(
+        a_m: f64,
+        e: f64,
+        i_rad: f64,
+        raan_rad: f64,
+        argp_rad: f64,
+        m0_rad: f64,
+        duration_s: f64,
+    ) -> J2Orbit {
+        // Kepler's equation for E, then the perifocal state turned into ECI.
+        let mut ea = m0_rad;
+        for _ in 0..50 {
+            ea -= (ea - e * ea.sin() - m0_rad) / (1.0 - e * ea.cos());
         }
+        let (se, ce) = ea.sin_cos();
+        let root = (1.0 - e * e).sqrt();
+        // dE/dt a = sqrt(GM a) / r.
+        let speed = (GM_M3_S2 * a_m).sqrt() / (a_m * (1.0 - e * ce));
+        let pf_r = [a_m * (ce - e), a_m * root * se];
+        let pf_v = [-se * speed, root * ce * speed];
+        let (so, co) = raan_rad.sin_cos();
+        let (si, ci) = i_rad.sin_cos();
+        let (sw, cw) = argp_rad.sin_cos();
+        let p = [co * cw - so * sw * ci, so * cw + co * sw * ci, sw * si];
+        let q = [-co * sw - so * cw * ci, -so * sw + co * cw * ci, cw * si];
+        let s0 = StateVector {
+            position_m: std::array::from_fn(|k| pf_r[0] * p[k] + pf_r[1] * q[k]),
+            velocity_mps: std::array::from_fn(|k| pf_v[0] * p[k] + pf_v[1] * q[k]),
+        };
+        let steps = (duration_s / ORBIT_STEP_S).ceil() as usize + 2;
+        let mut grid = Vec::with_capacity(steps);
+        grid.push(s0);
+        for k in 1..steps {
+            let next = rk4(&grid[k - 1], ORBIT_STEP_S);
+            grid.push(next);
+        }
+        J2Orbit { grid }
+    }
+
+    /// The ECI state at `t_s` (0 <= t within the duration): one Runge-Kutta step from
+    /// the grid point before it.
+    pub fn state(&self, t_s: f64) -> StateVector {
+        let k = ((t_s / ORBIT_STEP_S).floor().max(0.0) as usize).min(self.grid.len() - 1);
+        rk4(&self.grid[k], t_s - k as f64 * ORBIT_STEP_S)
+    }
+
+    /// Eccentricity of the osculating two-body orbit at `t_s` (for the pass line).
+    pub fn eccentricity(&self, t_s: f64) -> f64 {
+        let s = self.state(t_s);
+        core_math::earth::kepler::Kepler::new(s.position_m, s.velocity_mps, GM_M3_S2)
+            .map_or(f64::NAN, |k| k.eccentricity())
     }
 }
 
-/// Roll as a piecewise-linear function of time through `corners` (t_s, roll_rad),
+/// An angle as a piecewise-linear function of time through `corners` (t_s, rad),
 /// constant before the first and after the last.
 #[derive(Clone, Debug)]
-pub struct RollProfile {
+pub struct Profile {
     pub corners: Vec<(f64, f64)>,
 }
 
-impl RollProfile {
-    /// Roll (rad) and its rate (rad/s; the rate of the piece starting at `t_s`).
+impl Profile {
+    /// The angle (rad) and its rate (rad/s; the rate of the piece starting at `t_s`).
     pub fn at(&self, t_s: f64) -> (f64, f64) {
         let c = &self.corners;
         let Some(&(t_first, r_first)) = c.first() else {
@@ -81,38 +147,89 @@ impl RollProfile {
     }
 }
 
+/// The ground under each segment over the pass: a mountain range crossed along track
+/// (up to 4 600 m, its ridge slanting across the swath), on a plain a few hundred
+/// metres up. Heights in m above the ellipsoid, by time and segment index.
+#[derive(Clone, Copy, Debug)]
+pub struct TerrainProfile {
+    /// Instant the array centre crosses the ridge (s), and the range's half width in
+    /// time (s).
+    pub ridge_s: f64,
+    pub half_width_s: f64,
+}
+
+impl TerrainProfile {
+    pub fn height_m(&self, t_s: f64, segment: usize) -> f64 {
+        // The ridge reaches each segment at a slightly different time (slanting).
+        let x = (t_s - self.ridge_s - 4.0 * segment as f64) / self.half_width_s;
+        let plain = 250.0 + 150.0 * (0.05 * t_s + 0.7 * segment as f64).sin();
+        plain + 4_300.0 * (-x * x).exp() * (1.0 + 0.08 * (1.3 * segment as f64).sin())
+    }
+}
+
+/// The truth of a built-in pass: what the spacecraft really did.
+#[derive(Clone, Debug)]
+pub struct AgileTruth {
+    pub orbit: J2Orbit,
+    pub roll: Profile,
+    pub pitch: Profile,
+    /// The yaw the attitude control flew following the firmware's requests: (t_us,
+    /// yaw, rate) at each NAV instant, linear in between.
+    pub yaw: Vec<(u64, f64, f64)>,
+    pub terrain: TerrainProfile,
+    pub segments: usize,
+}
+
+impl AgileTruth {
+    /// Attitude (rad, rad/s) at `t_s`.
+    pub fn attitude(&self, t_s: f64) -> Attitude<f64> {
+        let (roll, roll_rate) = self.roll.at(t_s);
+        let (pitch, pitch_rate) = self.pitch.at(t_s);
+        let t_us = us(t_s);
+        let k = self.yaw.partition_point(|y| y.0 <= t_us);
+        let (yaw, yaw_rate) = match k.checked_sub(1).and_then(|k| self.yaw.get(k)) {
+            Some(&(t0, y, r)) => (y + r * (t_s - t0 as f64 * 1e-6), r),
+            None => (0.0, 0.0),
+        };
+        Attitude {
+            roll_rad: roll,
+            pitch_rad: pitch,
+            yaw_rad: yaw,
+            roll_rate_rad_s: roll_rate,
+            pitch_rate_rad_s: pitch_rate,
+            yaw_rate_rad_s: yaw_rate,
+        }
+    }
+
+    /// Ground heights of the scene's table at `t_s`.
+    pub fn heights_m(&self, t_s: f64) -> Vec<f32> {
+        (0..self.segments)
+            .map(|k| self.terrain.height_m(t_s, k) as f32)
+            .collect()
+    }
+
+    /// The NAV content the spacecraft would send at `t_s`.
+    pub fn nav(&self, t_s: f64) -> Nav {
+        Nav {
+            state: self.orbit.state(t_s),
+            attitude: self.attitude(t_s).to::<f32>(),
+        }
+    }
+}
+
 /// The state the reference check holds the firmware to.
 #[derive(Clone, Debug)]
 pub enum Truth {
-    /// The default pass: the orbit and the roll profile, exact at any instant.
-    Circular {
-        orbit: CircularOrbit,
-        roll: RollProfile,
-    },
-    /// A user's file: the last NAV sample the controller accepted, propagated to the
-    /// update instant in f64 (argument of latitude at the orbit rate, roll at its rate).
+    /// A built-in pass: orbit, attitude, terrain, exact at any instant.
+    Agile(Box<AgileTruth>),
+    /// A user's file: only the telemetry is known.
     Telemetry,
 }
 
 impl Truth {
-    /// The f64 geometry at `t_s`, when known from the truth alone.
-    pub fn geometry(&self, t_s: f64) -> Option<Geometry<f64>> {
+    pub fn agile(&self) -> Option<&AgileTruth> {
         match self {
-            Truth::Circular { orbit, roll } => Some(Geometry::circular(
-                roll.at(t_s).0,
-                orbit.inclination_rad,
-                orbit.arg_latitude_rad(t_s),
-                orbit.altitude_m,
-                orbit.earth_radius_m,
-            )),
-            Truth::Telemetry => None,
-        }
-    }
-
-    /// Roll (deg) at `t_s` for the table, when known.
-    pub fn roll_deg(&self, t_s: f64) -> Option<f64> {
-        match self {
-            Truth::Circular { roll, .. } => Some(roll.at(t_s).0.to_degrees()),
+            Truth::Agile(a) => Some(a),
             Truth::Telemetry => None,
         }
     }
@@ -141,6 +258,12 @@ pub enum FaultSpec {
     /// An extra SCENE frame at `t_s` that the camera cannot use: refused as
     /// `invalid_scene` (issue 13's third defect).
     BadScene { t_s: f64, probe: SceneProbe },
+    /// An extra TERRAIN frame at `t_s` with every height `height_m` (outside
+    /// -500..=9 000 m): refused as `out_of_range`.
+    Terrain { t_s: f64, height_m: f32 },
+    /// An extra NAV frame at `t_s` whose roll rate (0.5 rad/s) would carry it out of
+    /// the scene's envelope: refused as `attitude_outside_model` (issue 12).
+    Envelope { t_s: f64 },
 }
 
 /// The SCENE uploads an outside client found accepted before issue 13.
@@ -233,6 +356,10 @@ impl FaultSpec {
             FaultSpec::BadScene { t_s, probe } => {
                 format!("SCENE with {} at {t_s} s", probe.label())
             }
+            FaultSpec::Terrain { t_s, height_m } => {
+                format!("TERRAIN at {height_m} m at {t_s} s")
+            }
+            FaultSpec::Envelope { t_s } => format!("NAV rolling at 0.5 rad/s at {t_s} s"),
         }
     }
 }
@@ -243,6 +370,8 @@ pub struct Pass {
     pub name: String,
     /// NAV samples in sending order (the gaps already cut out).
     pub samples: Vec<Sample>,
+    /// TERRAIN uploads: time tag and the heights of the scene's table (m).
+    pub terrain: Vec<(u64, Vec<f32>)>,
     /// Cadence of TIME frames (us): the controller's update period.
     pub tick_us: u64,
     /// Last instant of the pass (us): TIME frames run up to it.
@@ -257,65 +386,199 @@ pub fn us(t_s: f64) -> u64 {
 
 /// NAV rate of the built-in passes.
 pub const NAV_PERIOD_US: u64 = 250_000;
+/// TERRAIN uploads of the built-in passes: once a second, 0.1 s after the second, with
+/// the heights at the middle of the second they serve.
+pub const TERRAIN_PERIOD_US: u64 = 1_000_000;
+pub const TERRAIN_OFFSET_US: u64 = 100_000;
+/// Time constant of the attitude control's yaw tracking (s), its largest yaw rate
+/// (rad/s) and its largest change of yaw rate from one NAV instant to the next: a yaw
+/// steering law is slow and smooth (a yaw rate turns the image about the boresight, so
+/// a jerky one would move the swath's ends along track).
+const YAW_TAU_S: f64 = 4.0;
+const MAX_YAW_RATE_RAD_S: f64 = 2e-3;
+const MAX_YAW_RATE_STEP_RAD_S: f64 = 1e-4;
 
-/// The paper's orbit: sun-synchronous, 645 km, i0 97.98 deg; node and start position
-/// arbitrary (the round-Earth model does not depend on the node).
-pub fn paper_orbit(earth_radius_m: f64) -> CircularOrbit {
-    CircularOrbit {
-        earth_radius_m,
-        altitude_m: 645e3,
-        inclination_rad: 97.98f64.to_radians(),
-        raan_rad: 0.4,
-        u0_rad: (-20f64).to_radians(),
-    }
+/// The truth orbit of the built-in passes: sun-synchronous, 645 km, e = 0.001 (perigee
+/// 638 km, apogee 652 km), i = 97.98 deg, J2 included.
+pub fn sun_synchronous(duration_s: f64) -> J2Orbit {
+    J2Orbit::new(
+        EARTH.a_m + 645e3,
+        0.001,
+        97.98f64.to_radians(),
+        0.4,
+        1.2,
+        -1.6,
+        duration_s,
+    )
 }
 
-/// A pass over `orbit` with `roll`, NAV at 4 Hz from 0 to `duration_s`, the `gaps`
-/// among `faults` cut out of the samples.
-pub fn synthetic(
-    name: &str,
-    orbit: CircularOrbit,
-    roll: RollProfile,
-    duration_s: f64,
+/// What one kind of frame goes where in a pass's time line.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SlotKind {
+    Nav,
+    Terrain,
+    Time,
+}
+
+/// The time line of a pass: NAV frames at `nav_us`, TERRAIN frames at `terrain_us`, TIME
+/// frames at every tick of the update period that has no other frame, up to `end_us`,
+/// all in time order (NAV before TERRAIN at one instant). The player that builds a pass
+/// and the stream that sends it walk this same list.
+pub fn schedule(
+    nav_us: &[u64],
+    terrain_us: &[u64],
     tick_us: u64,
-    faults: Vec<FaultSpec>,
-) -> Pass {
-    let end_us = us(duration_s);
+    end_us: u64,
+) -> Vec<(u64, SlotKind)> {
+    let mut slots: Vec<(u64, SlotKind)> = nav_us
+        .iter()
+        .map(|&t| (t, SlotKind::Nav))
+        .chain(terrain_us.iter().map(|&t| (t, SlotKind::Terrain)))
+        .collect();
+    let taken: std::collections::BTreeSet<u64> = slots.iter().map(|s| s.0).collect();
+    let tick = tick_us.max(1);
+    slots.extend(
+        (0..=end_us / tick)
+            .map(|k| k * tick)
+            .filter(|t| !taken.contains(t))
+            .map(|t| (t, SlotKind::Time)),
+    );
+    let order = |k: SlotKind| match k {
+        SlotKind::Nav => 0,
+        SlotKind::Terrain => 1,
+        SlotKind::Time => 2,
+    };
+    slots.sort_by_key(|&(t, k)| (t, order(k)));
+    slots
+}
+
+/// A built-in pass: its attitude manoeuvres, terrain and faults.
+pub struct Manoeuvres {
+    pub name: &'static str,
+    pub duration_s: f64,
+    pub roll: Profile,
+    pub pitch: Profile,
+    pub terrain: TerrainProfile,
+    pub faults: Vec<FaultSpec>,
+}
+
+/// Plays `m` through a host run of the firmware's controller to fly the yaw it asks
+/// for: at each NAV instant the attitude control turns the yaw towards the last
+/// request (the yaw at that update plus the correction) with a first-order lag, and the
+/// NAV frame reports the yaw and rate it flies. The host run sees exactly the clean
+/// stream the firmware will see (the injected faults change no output, which the pass
+/// checks), so its requests are the firmware's.
+pub fn build(m: Manoeuvres, tick_us: u64) -> Result<Pass, String> {
+    use controller::frame::{encode, kind, MAX_FRAME};
+    let end_us = us(m.duration_s);
     let in_gap = |t_us: u64| {
-        faults.iter().any(|f| match *f {
+        m.faults.iter().any(|f| match *f {
             FaultSpec::Gap { from_s, len_s } => t_us > us(from_s) && t_us < us(from_s + len_s),
             _ => false,
         })
     };
-    let samples = (0..=end_us / NAV_PERIOD_US)
+    let nav_us: Vec<u64> = (0..=end_us / NAV_PERIOD_US)
         .map(|k| k * NAV_PERIOD_US)
         .filter(|&t| !in_gap(t))
-        .map(|t_us| Sample {
-            t_us,
-            nav: true_nav(&orbit, &roll, t_us as f64 * 1e-6),
-        })
         .collect();
-    Pass {
-        name: name.to_string(),
+    let terrain_us: Vec<u64> = (0..end_us / TERRAIN_PERIOD_US)
+        .map(|k| k * TERRAIN_PERIOD_US + TERRAIN_OFFSET_US)
+        .collect();
+    let scene = controller::Scene::paper_default();
+    let mut truth = AgileTruth {
+        orbit: sun_synchronous(m.duration_s + 2.0),
+        roll: m.roll,
+        pitch: m.pitch,
+        yaw: Vec::new(),
+        terrain: m.terrain,
+        segments: usize::from(scene.count),
+    };
+    let controller = controller::Controller::new(controller::Config::default(), scene)
+        .map_err(|f| format!("the default scene was refused: {}", f.name()))?;
+    let mut session = controller::session::Session::new(controller);
+    let mut sequence = 0u16;
+    let mut feed =
+        |session: &mut controller::session::Session, kind: u8, t: u64, payload: &[u8]| {
+            let mut buf = [0u8; MAX_FRAME];
+            let n = encode(kind, sequence, t, payload, &mut buf).unwrap_or(0);
+            sequence = sequence.wrapping_add(1);
+            session.feed(&buf[..n], &mut super::check::Accept, |_| {});
+        };
+    let (mut samples, mut terrain) = (Vec::new(), Vec::new());
+    // The pass starts steered: the request of a first update at t = 0 with the yaw at 0.
+    let mut target_rad = {
+        let mut probe = session.controller.clone();
+        let nav = truth.nav(0.0);
+        let mut p = [0u8; 128];
+        let n = nav.encode(&mut p).unwrap_or(0);
+        let mut buf = [0u8; MAX_FRAME];
+        let len = encode(kind::NAV, 0, 0, &p[..n], &mut buf).unwrap_or(0);
+        let mut decoder = controller::frame::Decoder::new();
+        decoder.feed(&buf[..len], |e| {
+            if let controller::frame::Event::Frame(f) = e {
+                probe.on_frame(&f);
+            }
+        });
+        probe.advance(0, &mut super::check::Accept);
+        f64::from(
+            probe
+                .yaw_request_rad()
+                .ok_or("no yaw request at the start of the pass")?,
+        )
+    };
+    truth.yaw.push((0, target_rad, 0.0));
+    let mut rate_rad_s = 0.0f64;
+    for (t_us, slot) in schedule(&nav_us, &terrain_us, tick_us, end_us) {
+        let t_s = t_us as f64 * 1e-6;
+        match slot {
+            SlotKind::Nav => {
+                let c = &session.controller;
+                if let (Some(request), Some(u)) = (c.yaw_request_rad(), c.last_update_us()) {
+                    target_rad = truth.attitude(u as f64 * 1e-6).yaw_rad + f64::from(request);
+                }
+                let yaw = truth.attitude(t_s).yaw_rad;
+                let wanted =
+                    ((target_rad - yaw) / YAW_TAU_S).clamp(-MAX_YAW_RATE_RAD_S, MAX_YAW_RATE_RAD_S);
+                rate_rad_s +=
+                    (wanted - rate_rad_s).clamp(-MAX_YAW_RATE_STEP_RAD_S, MAX_YAW_RATE_STEP_RAD_S);
+                if t_us > 0 {
+                    truth.yaw.push((t_us, yaw, rate_rad_s));
+                }
+                let nav = truth.nav(t_s);
+                let mut p = [0u8; 128];
+                let n = nav.encode(&mut p).unwrap_or(0);
+                feed(&mut session, kind::NAV, t_us, &p[..n]);
+                samples.push(Sample { t_us, nav });
+            }
+            SlotKind::Terrain => {
+                let heights = truth.heights_m(t_s + 0.5);
+                let payload = terrain_payload(&heights);
+                feed(&mut session, kind::TERRAIN, t_us, &payload);
+                terrain.push((t_us, heights));
+            }
+            SlotKind::Time => feed(&mut session, kind::TIME, t_us, &[]),
+        }
+    }
+    Ok(Pass {
+        name: m.name.to_string(),
         samples,
+        terrain,
         tick_us,
         end_us,
-        truth: Truth::Circular { orbit, roll },
-        faults,
-    }
+        truth: Truth::Agile(Box::new(truth)),
+        faults: m.faults,
+    })
 }
 
-/// The NAV content the spacecraft would send at `t_s`: orbit state, roll and its rate.
-pub fn true_nav(orbit: &CircularOrbit, roll: &RollProfile, t_s: f64) -> Nav {
-    let (r, rate) = roll.at(t_s);
-    Nav {
-        state: orbit.state(t_s),
-        attitude: Attitude {
-            roll_rad: r as f32,
-            roll_rate_rad_s: rate as f32,
-            ..Attitude::default()
-        },
-    }
+/// A TERRAIN payload of `heights`.
+pub fn terrain_payload(heights: &[f32]) -> Vec<u8> {
+    let t = controller::Terrain {
+        heights_m: std::array::from_fn(|k| heights.get(k).copied().unwrap_or(0.0)),
+        count: heights.len() as u8,
+    };
+    let mut p = [0u8; 128];
+    let n = t.encode(&mut p).unwrap_or(0);
+    p[..n].to_vec()
 }
 
 /// The link probes of issue 13 from `t0_s` on: a TIME frame tagged 2^64 - 1, one an
@@ -341,19 +604,22 @@ pub fn link_probes(t0_s: f64) -> Vec<FaultSpec> {
     out
 }
 
-/// The default pass: ten minutes of the paper's orbit; roll 0, then 0 -> 25 deg at
-/// 1 deg/s (60-85 s), held, and back at 1 deg/s (400-425 s); faults spread over it,
-/// none at a corner of the roll profile (a lost frame there would leave the controller
-/// extrapolating the old rate, which is the telemetry's loss, not an error).
-pub fn default_pass(earth_radius_m: f64, tick_us: u64) -> Pass {
-    let roll = RollProfile {
-        corners: vec![
-            (60.0, 0.0),
-            (85.0, 25f64.to_radians()),
-            (400.0, 25f64.to_radians()),
-            (425.0, 0.0),
-        ],
-    };
+fn deg(corners: &[(f64, f64)]) -> Profile {
+    Profile {
+        corners: corners.iter().map(|&(t, a)| (t, a.to_radians())).collect(),
+    }
+}
+
+/// The default pass: ten minutes of the sun-synchronous J2 orbit over a mountain range
+/// (ridge at 300 s, up to 4 900 m). Roll 0 -> 20 deg at 1 deg/s (40-60 s), held, back
+/// (140-160 s); a stereo pair: pitch 0 -> +20 deg at 0.2 deg/s (180-280 s), held
+/// (forward look), -> -20 deg (310-510 s), held (backward look); yaw steered by the
+/// firmware's requests. (A pitch rate is seen whole in the image motion: at 0.2 deg/s it
+/// changes |v1| by a third of the ground's 0.6 deg/s; a stereo slew at 1 deg/s would
+/// reverse it.) Faults spread over it, none at a corner of a profile (a lost frame there
+/// would leave the controller extrapolating the old rate, which is the telemetry's loss,
+/// not an error).
+pub fn default_pass(tick_us: u64) -> Result<Pass, String> {
     let mut faults = vec![
         FaultSpec::BitFlip { t_s: 30.0 },
         FaultSpec::BitFlip { t_s: 70.5 },
@@ -363,42 +629,45 @@ pub fn default_pass(earth_radius_m: f64, tick_us: u64) -> Pass {
             bytes: 48,
         },
         FaultSpec::Backwards {
-            t_s: 200.0,
+            t_s: 190.0,
             back_s: 1.0,
         },
+        FaultSpec::Terrain {
+            t_s: 230.31,
+            height_m: 9_500.0,
+        },
+        FaultSpec::Envelope { t_s: 240.125 },
         FaultSpec::NaN { t_s: 250.125 },
         FaultSpec::Altitude {
-            t_s: 300.125,
+            t_s: 310.125,
             altitude_m: 100e3,
         },
         FaultSpec::BitFlip { t_s: 410.0 },
         FaultSpec::Gap {
-            from_s: 500.0,
+            from_s: 520.0,
             len_s: 2.0,
         },
     ];
     faults.extend(link_probes(160.0));
-    synthetic(
-        "default pass (600 s)",
-        paper_orbit(earth_radius_m),
-        roll,
-        600.0,
+    build(
+        Manoeuvres {
+            name: "default pass (600 s)",
+            duration_s: 600.0,
+            roll: deg(&[(40.0, 0.0), (60.0, 20.0), (140.0, 20.0), (160.0, 0.0)]),
+            pitch: deg(&[(180.0, 0.0), (280.0, 20.0), (310.0, 20.0), (510.0, -20.0)]),
+            terrain: TerrainProfile {
+                ridge_s: 300.0,
+                half_width_s: 90.0,
+            },
+            faults,
+        },
         tick_us,
-        faults,
     )
 }
 
-/// The end-to-end test's pass: one minute, a faster manoeuvre (0 -> 25 deg at 2 deg/s
-/// and back), every kind of fault.
-pub fn short_pass(earth_radius_m: f64, tick_us: u64) -> Pass {
-    let roll = RollProfile {
-        corners: vec![
-            (10.0, 0.0),
-            (22.5, 25f64.to_radians()),
-            (35.0, 25f64.to_radians()),
-            (47.5, 0.0),
-        ],
-    };
+/// The end-to-end test's pass: one minute, roll 0 -> 20 deg at 1.25 deg/s, then pitch
+/// 0 -> 5 deg at 0.2 deg/s, a ridge at 40 s, every kind of fault.
+pub fn short_pass(tick_us: u64) -> Result<Pass, String> {
     let mut faults = vec![
         FaultSpec::BitFlip { t_s: 5.0 },
         FaultSpec::Truncate { t_s: 8.0 },
@@ -411,24 +680,35 @@ pub fn short_pass(earth_radius_m: f64, tick_us: u64) -> Pass {
             back_s: 0.5,
         },
         FaultSpec::NaN { t_s: 18.125 },
+        FaultSpec::Terrain {
+            t_s: 22.31,
+            height_m: -800.0,
+        },
+        FaultSpec::Envelope { t_s: 24.125 },
         FaultSpec::Altitude {
-            t_s: 25.125,
+            t_s: 26.125,
             altitude_m: 100e3,
         },
         FaultSpec::BitFlip { t_s: 40.0 },
         FaultSpec::Gap {
-            from_s: 50.0,
+            from_s: 52.0,
             len_s: 2.0,
         },
     ];
     faults.extend(link_probes(28.0));
-    synthetic(
-        "short pass (60 s)",
-        paper_orbit(earth_radius_m),
-        roll,
-        60.0,
+    build(
+        Manoeuvres {
+            name: "short pass (60 s)",
+            duration_s: 60.0,
+            roll: deg(&[(8.5, 0.0), (24.5, 20.0)]),
+            pitch: deg(&[(30.0, 0.0), (55.0, 5.0)]),
+            terrain: TerrainProfile {
+                ridge_s: 40.0,
+                half_width_s: 15.0,
+            },
+            faults,
+        },
         tick_us,
-        faults,
     )
 }
 
@@ -512,6 +792,7 @@ pub fn from_csv(path: &std::path::Path, tick_us: u64) -> Result<Pass, String> {
         samples,
         tick_us,
         end_us,
+        terrain: Vec::new(),
         truth: Truth::Telemetry,
         faults: Vec::new(),
     })

@@ -1,5 +1,6 @@
-//! The byte stream a pass sends: NAV frames at the samples' time tags, TIME frames at
-//! every tick of the update period that has no NAV frame, the injected faults, END.
+//! The byte stream a pass sends: NAV frames at the samples' time tags, TERRAIN uploads,
+//! TIME frames at every tick of the update period that has no other frame, the
+//! injected faults, END.
 //!
 //! Every item knows whether it is an injected fault: the firmware gets all of them, the
 //! host twin only the others ("the stream with the injected faulty frames removed").
@@ -8,7 +9,9 @@ use controller::frame::{encode, kind, MAX_FRAME, SYNC};
 use controller::nav::Nav;
 use controller::Fault;
 
-use super::scenario::{us, FaultSpec, Pass, Sample, Truth};
+use controller::EARTH;
+
+use super::scenario::{schedule, terrain_payload, us, FaultSpec, Pass, SlotKind};
 
 /// One piece of the stream.
 #[derive(Clone, Debug)]
@@ -70,55 +73,37 @@ impl Frames {
     }
 }
 
-/// Where a NAV or extra frame goes in time order.
-enum Slot {
-    Nav(Sample),
-    Time(u64),
-}
-
 /// Builds the stream of `pass`.
 pub fn build(pass: &Pass) -> Result<Stream, String> {
-    // NAV samples in their order; TIME ticks in between where no NAV has the instant.
-    let mut slots = Vec::new();
-    let mut next_tick = 0u64;
-    let tick = pass.tick_us.max(1);
-    let mut last_t = None;
-    for s in &pass.samples {
-        if last_t.is_none_or(|l| s.t_us > l) {
-            while next_tick < s.t_us {
-                slots.push(Slot::Time(next_tick));
-                next_tick += tick;
-            }
-            if next_tick == s.t_us {
-                next_tick += tick;
-            }
-            last_t = Some(s.t_us);
-        }
-        slots.push(Slot::Nav(*s));
-    }
-    while next_tick <= pass.end_us {
-        slots.push(Slot::Time(next_tick));
-        next_tick += tick;
-    }
+    // The pass's time line (the same the player built it on): NAV samples, TERRAIN
+    // uploads, TIME ticks in between.
+    let nav_us: Vec<u64> = pass.samples.iter().map(|s| s.t_us).collect();
+    let terrain_us: Vec<u64> = pass.terrain.iter().map(|t| t.0).collect();
+    let slots = schedule(&nav_us, &terrain_us, pass.tick_us, pass.end_us);
+    let (mut navs, mut uploads) = (pass.samples.iter(), pass.terrain.iter());
 
     let mut frames = Frames { sequence: 0 };
     let mut items: Vec<Item> = Vec::with_capacity(slots.len() + 16);
     // Index of the item carrying the NAV frame of each instant.
     let mut nav_item = std::collections::HashMap::new();
-    for slot in &slots {
-        match slot {
-            Slot::Nav(s) => {
+    for &(t, kind_of) in &slots {
+        let bytes = match kind_of {
+            SlotKind::Nav => {
+                let s = navs
+                    .next()
+                    .ok_or("the schedule has more NAV slots than samples")?;
                 nav_item.insert(s.t_us, items.len());
-                items.push(Item {
-                    bytes: frames.nav(s.t_us, &s.nav),
-                    fault: None,
-                });
+                frames.nav(s.t_us, &s.nav)
             }
-            Slot::Time(t) => items.push(Item {
-                bytes: frames.frame(kind::TIME, *t, &[]),
-                fault: None,
-            }),
-        }
+            SlotKind::Terrain => {
+                let (_, heights) = uploads
+                    .next()
+                    .ok_or("the schedule has more TERRAIN slots than uploads")?;
+                frames.frame(kind::TERRAIN, t, &terrain_payload(heights))
+            }
+            SlotKind::Time => frames.frame(kind::TIME, t, &[]),
+        };
+        items.push(Item { bytes, fault: None });
     }
 
     let mut injected = Vec::new();
@@ -131,19 +116,13 @@ pub fn build(pass: &Pass) -> Result<Stream, String> {
             .ok_or_else(|| format!("no NAV frame at {t_s} s to inject a fault into"))
     };
     // The first item whose frame is time-tagged after `t_us` (extra frames go before it).
-    let times: Vec<u64> = slots
-        .iter()
-        .map(|s| match s {
-            Slot::Nav(n) => n.t_us,
-            Slot::Time(t) => *t,
-        })
-        .collect();
+    let times: Vec<u64> = slots.iter().map(|s| s.0).collect();
     let after = |t_us: u64| times.iter().position(|&t| t > t_us).unwrap_or(times.len());
     let truth_nav = |t_s: f64| -> Result<Nav, String> {
-        match &pass.truth {
-            Truth::Circular { orbit, roll } => Ok(super::scenario::true_nav(orbit, roll, t_s)),
-            Truth::Telemetry => Err("faults are injected into the built-in passes only".into()),
-        }
+        pass.truth
+            .agile()
+            .map(|a| a.nav(t_s))
+            .ok_or_else(|| "faults are injected into the built-in passes only".to_string())
     };
     for (k, f) in pass.faults.iter().enumerate() {
         let expect = match *f {
@@ -198,10 +177,7 @@ pub fn build(pass: &Pass) -> Result<Stream, String> {
                 let mut nav = truth_nav(t_s)?;
                 let r = nav.state.position_m;
                 let norm = (r[0] * r[0] + r[1] * r[1] + r[2] * r[2]).sqrt();
-                let Truth::Circular { orbit, .. } = &pass.truth else {
-                    return Err("faults are injected into the built-in passes only".into());
-                };
-                let scale = (orbit.earth_radius_m + altitude_m) / norm;
+                let scale = (EARTH.a_m + altitude_m) / norm;
                 nav.state.position_m = r.map(|x| x * scale);
                 let bytes = frames.nav(us(t_s), &nav);
                 extra.push((
@@ -236,6 +212,32 @@ pub fn build(pass: &Pass) -> Result<Stream, String> {
                     },
                 ));
                 Some(Fault::InvalidScene)
+            }
+            FaultSpec::Terrain { t_s, height_m } => {
+                let n = pass.terrain.first().map_or(0, |t| t.1.len());
+                let bytes =
+                    frames.frame(kind::TERRAIN, us(t_s), &terrain_payload(&vec![height_m; n]));
+                extra.push((
+                    after(us(t_s)),
+                    Item {
+                        bytes,
+                        fault: Some(k),
+                    },
+                ));
+                Some(Fault::OutOfRange)
+            }
+            FaultSpec::Envelope { t_s } => {
+                let mut nav = truth_nav(t_s)?;
+                nav.attitude.roll_rate_rad_s = 0.5;
+                let bytes = frames.nav(us(t_s), &nav);
+                extra.push((
+                    after(us(t_s)),
+                    Item {
+                        bytes,
+                        fault: Some(k),
+                    },
+                ));
+                Some(Fault::AttitudeOutsideModel)
             }
         };
         injected.push((f.label(), expect));

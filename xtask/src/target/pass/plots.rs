@@ -1,0 +1,124 @@
+//! The plots of a played pass, from what the firmware sent (and the terrain the pass
+//! uploaded): drift, MTF and the yaw request per segment over time, and the terrain.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use crate::plot::{Legend, Plot, Series};
+
+use super::check::Downlink;
+use super::scenario::Pass;
+
+/// One series per segment of `value` over the pass, from every record not held.
+fn per_segment(
+    firmware: &Downlink,
+    value: impl Fn(&controller::SegmentOutput) -> f64,
+) -> BTreeMap<u8, Vec<(f64, f64)>> {
+    let mut series: BTreeMap<u8, Vec<(f64, f64)>> = BTreeMap::new();
+    for (t_us, p) in firmware.decoded() {
+        for r in p.records().iter().filter(|r| !r.held) {
+            series
+                .entry(r.index)
+                .or_default()
+                .push((t_us as f64 * 1e-6, value(r)));
+        }
+    }
+    series
+}
+
+fn save(
+    pass: &Pass,
+    plot: Plot,
+    series: BTreeMap<u8, Vec<(f64, f64)>>,
+    path: &Path,
+) -> Result<(), String> {
+    let mut plot = plot
+        .legend(Legend::TopRight)
+        .x_range(0.0, (pass.end_us as f64 * 1e-6).max(1.0))
+        .size(1100, 650);
+    for (i, (index, points)) in series.into_iter().enumerate() {
+        plot = plot.series(Series::line(&format!("segment {index}"), points).palette(i));
+    }
+    plot.save(path)
+}
+
+/// Writes drift.png, mtf.png, terrain.png and yaw.png into `dir`.
+pub fn pass_plots(pass: &Pass, firmware: &Downlink, dir: &Path) -> Result<(), String> {
+    std::fs::create_dir_all(dir).map_err(|e| format!("creating {}: {e}", dir.display()))?;
+    save(
+        pass,
+        Plot::new(
+            &format!("Drift at each segment's centre, yaw steered, {}", pass.name),
+            "time (s)",
+            "drift atan(v2/v1) (mrad)",
+        ),
+        per_segment(firmware, |r| f64::from(r.drift_rad) * 1e3),
+        &dir.join("drift.png"),
+    )?;
+    save(
+        pass,
+        Plot::new(
+            &format!(
+                "MTF at Nyquist, mismatch x drift smear, 16 stages, {}",
+                pass.name
+            ),
+            "time (s)",
+            "MTF",
+        )
+        .y_range(0.0, 1.05),
+        per_segment(firmware, |r| f64::from(r.mtf)),
+        &dir.join("mtf.png"),
+    )?;
+    let mut terrain: BTreeMap<u8, Vec<(f64, f64)>> = BTreeMap::new();
+    for (t_us, heights) in &pass.terrain {
+        for (k, h) in heights.iter().enumerate() {
+            terrain
+                .entry(k as u8)
+                .or_default()
+                .push((*t_us as f64 * 1e-6, f64::from(*h)));
+        }
+    }
+    save(
+        pass,
+        Plot::new(
+            &format!("Ground height uploaded by TERRAIN frames, {}", pass.name),
+            "time (s)",
+            "height above WGS 84 (m)",
+        ),
+        terrain,
+        &dir.join("terrain.png"),
+    )?;
+    let mut yaw = Plot::new(
+        &format!(
+            "Yaw steering: the firmware's request and the yaw flown, {}",
+            pass.name
+        ),
+        "time (s)",
+        "yaw (mrad)",
+    )
+    .legend(Legend::TopRight)
+    .x_range(0.0, (pass.end_us as f64 * 1e-6).max(1.0))
+    .size(1100, 650);
+    let requests: Vec<(f64, f64)> = firmware
+        .decoded()
+        .iter()
+        .filter_map(|(t, p)| {
+            p.yaw_request_rad
+                .map(|y| (*t as f64 * 1e-6, f64::from(y) * 1e3))
+        })
+        .collect();
+    let flown: Vec<(f64, f64)> = pass
+        .samples
+        .iter()
+        .map(|s| {
+            (
+                s.t_us as f64 * 1e-6,
+                f64::from(s.nav.attitude.yaw_rad) * 1e3,
+            )
+        })
+        .collect();
+    yaw = yaw
+        .series(Series::line("yaw flown (NAV)", flown).palette(0))
+        .series(Series::line("correction requested", requests).palette(1));
+    yaw.save(&dir.join("yaw.png"))
+}

@@ -1,0 +1,261 @@
+//! The checks of a built-in pass against its truth: what the pass was (attitude,
+//! terrain, orbit), how far the paper's model and this controller are from the true
+//! line period, and the drift with and without the yaw steering the firmware asked for.
+//!
+//! The truth at an update instant: the J2-propagated state, the attitude flown, the
+//! terrain under each segment at that very instant (the uploads are up to a second
+//! old), the f64 reference of the real-Earth model at the plan's sample pixels. The
+//! paper's model: today's round Earth (R = 6 371 km), roll only, circular orbit from
+//! the state, period from |v_P|, the same pixels.
+
+use controller::golden::{self, NavInput};
+use controller::Controller;
+use core_math::earth::{Attitude, EarthGeometry};
+use core_math::{Backend, Geometry, OrbitState, Reference, EARTH_RATE_RAD_S};
+
+use super::check::Downlink;
+use super::scenario::AgileTruth;
+
+/// The round-Earth radius of the paper's model (the controller's before issue 12).
+const PAPER_EARTH_RADIUS_M: f64 = 6_371_000.0;
+
+/// What the truth checks found.
+pub struct Report {
+    max_roll_deg: f64,
+    max_pitch_deg: f64,
+    max_yaw_deg: f64,
+    heights_m: (f64, f64),
+    eccentricity: f64,
+    /// Largest relative period error against the truth: the paper's model, the
+    /// firmware; and the instant and segment of each.
+    paper: (f64, u64, u8),
+    firmware: (f64, u64, u8),
+    /// Largest |drift| at the segments' centres without and with the yaw steering, and
+    /// at the array centre (rad), over the imaging holds (roll and pitch still: during a
+    /// slew the image runs across the line at the slew's rate, which no yaw can steer).
+    drift_unsteered: f64,
+    drift_steered: f64,
+    centre_unsteered: f64,
+    centre_steered: f64,
+    /// Smallest MTF the firmware reported over the holds, and where.
+    worst_mtf: (f32, u64, u8),
+    updates: usize,
+    holds: usize,
+}
+
+fn drift(g: &EarthGeometry<f64>, camera: &core_math::EarthCamera, n: f64) -> Option<f64> {
+    core_math::EarthReference
+        .evaluate(camera, g, n)
+        .ok()
+        .map(|m| (m.v2_mps / m.v1_mps).atan())
+}
+
+/// Every update of the firmware's downlink with fresh periods against the truth.
+pub fn check(
+    truth: &AgileTruth,
+    firmware: &Downlink,
+    controller: &Controller,
+) -> Result<Report, String> {
+    let scene = controller.scene();
+    let plan = controller.plan();
+    let mut r = Report {
+        max_roll_deg: 0.0,
+        max_pitch_deg: 0.0,
+        max_yaw_deg: 0.0,
+        heights_m: (f64::INFINITY, f64::NEG_INFINITY),
+        eccentricity: truth.orbit.eccentricity(0.0),
+        paper: (0.0, 0, 0),
+        firmware: (0.0, 0, 0),
+        drift_unsteered: 0.0,
+        drift_steered: 0.0,
+        centre_unsteered: 0.0,
+        centre_steered: 0.0,
+        worst_mtf: (f32::INFINITY, 0, 0),
+        updates: 0,
+        holds: 0,
+    };
+    let boresight = core_math::EarthCamera {
+        p1_m: 0.0,
+        ..scene.earth_camera(&scene.segments[0])
+    };
+    for (t_us, periods) in firmware.decoded() {
+        let fresh: Vec<_> = periods.records().iter().filter(|o| !o.held).collect();
+        if fresh.is_empty() {
+            continue;
+        }
+        let t_s = t_us as f64 * 1e-6;
+        let state = truth.orbit.state(t_s);
+        let attitude = truth.attitude(t_s);
+        let heights = truth.heights_m(t_s);
+        r.max_roll_deg = r.max_roll_deg.max(attitude.roll_rad.abs().to_degrees());
+        r.max_pitch_deg = r.max_pitch_deg.max(attitude.pitch_rad.abs().to_degrees());
+        r.max_yaw_deg = r.max_yaw_deg.max(attitude.yaw_rad.abs().to_degrees());
+        for &h in &heights {
+            r.heights_m.0 = r.heights_m.0.min(f64::from(h));
+            r.heights_m.1 = r.heights_m.1.max(f64::from(h));
+        }
+        let exact = golden::update(
+            scene,
+            plan,
+            &heights,
+            &NavInput {
+                state,
+                attitude: attitude.to::<f32>(),
+                time_us: t_us,
+            },
+            t_us,
+        )
+        .map_err(|e| format!("truth at {t_s} s: {}", e.name()))?;
+        let orbit = OrbitState::from_state(&state, PAPER_EARTH_RADIUS_M)
+            .map_err(|e| format!("paper model at {t_s} s: {}", e.name()))?;
+        let paper = Geometry {
+            roll_rad: attitude.roll_rad,
+            inclination_rad: orbit.inclination_rad,
+            arg_latitude_rad: orbit.arg_latitude_rad,
+            altitude_m: orbit.altitude_m,
+            earth_radius_m: PAPER_EARTH_RADIUS_M,
+            earth_rate_rad_s: EARTH_RATE_RAD_S,
+            orbit_rate_rad_s: orbit.orbit_rate_rad_s,
+        };
+        let paper_update = Reference.update(&paper).ok();
+        let hold = attitude.roll_rate_rad_s == 0.0 && attitude.pitch_rate_rad_s == 0.0;
+        r.holds += usize::from(hold);
+        for o in &fresh {
+            let Some(seg) = plan.active().iter().find(|s| s.index == o.index) else {
+                continue;
+            };
+            let Some(gold) = exact.segments.iter().flatten().find(|g| g.index == o.index) else {
+                continue;
+            };
+            let rel = (f64::from(o.ticks) / gold.ticks_exact - 1.0).abs();
+            if rel > r.firmware.0 {
+                r.firmware = (rel, t_us, o.index);
+            }
+            // The paper's period: |v_P| of the round-Earth model at the same pixels.
+            if let Some(u) = &paper_update {
+                let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
+                for &n in seg.sample_px() {
+                    let p = Reference
+                        .pixel(&scene.camera, f64::from(n))
+                        .map_err(|e| e.name().to_string())?;
+                    if let Ok(m) = Reference.motion(u, &p) {
+                        lo = lo.min(m.speed_mps());
+                        hi = hi.max(m.speed_mps());
+                    }
+                }
+                let ticks = 0.5
+                    * (scene.camera.pixel_m / lo + scene.camera.pixel_m / hi)
+                    * scene.line_clock_hz;
+                let rel = (ticks / gold.ticks_exact - 1.0).abs();
+                if rel.is_finite() && rel > r.paper.0 {
+                    r.paper = (rel, t_us, o.index);
+                }
+            }
+            if !hold {
+                continue;
+            }
+            if o.mtf < r.worst_mtf.0 {
+                r.worst_mtf = (o.mtf, t_us, o.index);
+            }
+            // Drift at the segment's centre, flown and with the yaw left at zero.
+            let spec = scene.segments[usize::from(o.index)];
+            let camera = scene.earth_camera(&spec);
+            let h = f64::from(heights[usize::from(o.index)]);
+            let flown = EarthGeometry {
+                state,
+                attitude,
+                ground_h_m: h,
+                ellipsoid: controller::EARTH,
+                earth_rate_rad_s: EARTH_RATE_RAD_S,
+            };
+            let unsteered = EarthGeometry {
+                attitude: Attitude {
+                    yaw_rad: 0.0,
+                    yaw_rate_rad_s: 0.0,
+                    ..attitude
+                },
+                ..flown
+            };
+            if let (Some(s), Some(u)) = (
+                drift(&flown, &camera, spec.centre_px()),
+                drift(&unsteered, &camera, spec.centre_px()),
+            ) {
+                r.drift_steered = r.drift_steered.max(s.abs());
+                r.drift_unsteered = r.drift_unsteered.max(u.abs());
+            }
+        }
+        r.updates += 1;
+        if !hold {
+            continue;
+        }
+        let h0 = f64::from(heights[usize::from(plan.boresight_segment)]);
+        let flown = EarthGeometry {
+            state,
+            attitude,
+            ground_h_m: h0,
+            ellipsoid: controller::EARTH,
+            earth_rate_rad_s: EARTH_RATE_RAD_S,
+        };
+        let unsteered = EarthGeometry {
+            attitude: Attitude {
+                yaw_rad: 0.0,
+                yaw_rate_rad_s: 0.0,
+                ..attitude
+            },
+            ..flown
+        };
+        if let (Some(s), Some(u)) = (
+            drift(&flown, &boresight, 0.0),
+            drift(&unsteered, &boresight, 0.0),
+        ) {
+            r.centre_steered = r.centre_steered.max(s.abs());
+            r.centre_unsteered = r.centre_unsteered.max(u.abs());
+        }
+    }
+    Ok(r)
+}
+
+impl Report {
+    pub fn print(&self) {
+        println!(
+            "pass: max |roll| {:.1} deg, max |pitch| {:.1} deg, max |yaw| {:.2} deg, ground height {:.0}..{:.0} m, eccentricity {:.5}",
+            self.max_roll_deg, self.max_pitch_deg, self.max_yaw_deg, self.heights_m.0, self.heights_m.1, self.eccentricity
+        );
+        println!(
+            "model gain: the paper's model would be off by {:.3e}, this controller by {:.3e} (largest relative period error against the truth over {} updates: J2 orbit, attitude flown, terrain at the instant; paper's worst at {:.2} s segment {}, firmware's at {:.2} s segment {})",
+            self.paper.0,
+            self.firmware.0,
+            self.updates,
+            self.paper.1 as f64 * 1e-6,
+            self.paper.2,
+            self.firmware.1 as f64 * 1e-6,
+            self.firmware.2
+        );
+        println!(
+            "drift: max |drift| {:.1} mrad unsteered, {:.1} mrad with yaw steering; worst segment MTF {:.3} (over the {} updates of the imaging holds; worst MTF at {:.2} s, segment {}; at the array centre {:.1} mrad unsteered, {:.3} mrad steered)",
+            self.drift_unsteered * 1e3,
+            self.drift_steered * 1e3,
+            self.worst_mtf.0,
+            self.holds,
+            self.worst_mtf.1 as f64 * 1e-6,
+            self.worst_mtf.2,
+            self.centre_unsteered * 1e3,
+            self.centre_steered * 1e3
+        );
+    }
+
+    /// The issue's acceptance conditions on a built-in pass.
+    pub fn problems(&self) -> Vec<String> {
+        let mut p = Vec::new();
+        if self.updates == 0 {
+            p.push("no update was checked against the truth".into());
+        }
+        if !(self.firmware.0 <= 0.1 * self.paper.0) {
+            p.push(format!(
+                "the controller's period error {:.3e} is more than a tenth of the paper model's {:.3e}",
+                self.firmware.0, self.paper.0
+            ));
+        }
+        p
+    }
+}
