@@ -102,7 +102,11 @@ fn the_reported_worst_mismatch_bounds_the_truth_over_every_pixel() {
         // An orbit in the band (e up to ~0.02), an attitude anywhere in the envelope at
         // rates up to a third of its limit, yaw steered within 0.1 rad.
         let h = rng.uniform(510e3, 790e3);
-        let mut sv = state(rng.uniform(0.0, 3.1), rng.uniform(0.0, 6.28), h);
+        let mut sv = state(
+            rng.uniform(0.0, 3.1),
+            rng.uniform(0.0, std::f64::consts::TAU),
+            h,
+        );
         let speed = rng.uniform(0.99, 1.01);
         sv.velocity_mps = sv.velocity_mps.map(|v| v * speed);
         let e = scene.envelope;

@@ -250,7 +250,7 @@ impl Report {
         if self.updates == 0 {
             p.push("no update was checked against the truth".into());
         }
-        if !(self.firmware.0 <= 0.1 * self.paper.0) {
+        if self.firmware.0.is_nan() || self.firmware.0 > 0.1 * self.paper.0 {
             p.push(format!(
                 "the controller's period error {:.3e} is more than a tenth of the paper model's {:.3e}",
                 self.firmware.0, self.paper.0
