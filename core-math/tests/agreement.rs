@@ -83,7 +83,11 @@ proptest! {
         let sp = r.speed_mps();
         prop_assert!(rel(m.speed_mps() as f64, sp) <= F32_REL_TOLERANCE, "|v| {} vs {} ({:?})", m.speed_mps(), sp, c);
         prop_assert!(rel(m.v1_mps as f64, r.v1_mps) <= F32_REL_TOLERANCE, "v1 {} vs {} ({:?})", m.v1_mps, r.v1_mps, c);
-        prop_assert!((m.v2_mps as f64 - r.v2_mps).abs() <= F32_V2_TOLERANCE * sp, "v2 {} vs {} ({:?})", m.v2_mps, r.v2_mps, c);
+        // v2's error: a floor of F32_V2_TOLERANCE |v_P| (v2 may be 0), plus the relative
+        // tolerance of v2 itself where v2 is a large share of |v_P| (field angles near
+        // 80 deg: proptest found 2.0e-7 |v_P| at 77.9 deg, regression file).
+        let v2_tol = F32_V2_TOLERANCE * sp + F32_REL_TOLERANCE * r.v2_mps.abs();
+        prop_assert!((m.v2_mps as f64 - r.v2_mps).abs() <= v2_tol, "v2 {} vs {} ({:?})", m.v2_mps, r.v2_mps, c);
     }
 
     /// The chain images pixel n at P2 = n A (Eq. 2's field angle, recovered through the
