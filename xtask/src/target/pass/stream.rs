@@ -151,26 +151,14 @@ pub fn build(pass: &Pass) -> Result<Stream, String> {
             FaultSpec::Backwards { t_s, back_s } => {
                 let t_old = t_s - back_s;
                 let bytes = frames.nav(us(t_old), &truth_nav(t_old)?);
-                extra.push((
-                    after(us(t_s)),
-                    Item {
-                        bytes,
-                        fault: Some(k),
-                    },
-                ));
+                extra.push(injected_item(after(us(t_s)), bytes, k));
                 Some(Fault::TimeWentBackwards)
             }
             FaultSpec::NaN { t_s } => {
                 let mut nav = truth_nav(t_s)?;
                 nav.state.velocity_mps[0] = f64::NAN;
                 let bytes = frames.nav(us(t_s), &nav);
-                extra.push((
-                    after(us(t_s)),
-                    Item {
-                        bytes,
-                        fault: Some(k),
-                    },
-                ));
+                extra.push(injected_item(after(us(t_s)), bytes, k));
                 Some(Fault::NonFinite)
             }
             FaultSpec::Altitude { t_s, altitude_m } => {
@@ -180,63 +168,33 @@ pub fn build(pass: &Pass) -> Result<Stream, String> {
                 let scale = (EARTH.a_m + altitude_m) / norm;
                 nav.state.position_m = r.map(|x| x * scale);
                 let bytes = frames.nav(us(t_s), &nav);
-                extra.push((
-                    after(us(t_s)),
-                    Item {
-                        bytes,
-                        fault: Some(k),
-                    },
-                ));
+                extra.push(injected_item(after(us(t_s)), bytes, k));
                 Some(Fault::OutOfRange)
             }
             // Cut out of the samples already: missing telemetry, in both runs.
             FaultSpec::Gap { .. } => Some(Fault::Stale),
             FaultSpec::TimeTag { t_s, tag_us } => {
                 let bytes = frames.frame(kind::TIME, tag_us, &[]);
-                extra.push((
-                    after(us(t_s)),
-                    Item {
-                        bytes,
-                        fault: Some(k),
-                    },
-                ));
+                extra.push(injected_item(after(us(t_s)), bytes, k));
                 Some(Fault::TimeJump)
             }
             FaultSpec::BadScene { t_s, probe } => {
                 let bytes = frames.frame(kind::SCENE, us(t_s), &probe.payload());
-                extra.push((
-                    after(us(t_s)),
-                    Item {
-                        bytes,
-                        fault: Some(k),
-                    },
-                ));
+                extra.push(injected_item(after(us(t_s)), bytes, k));
                 Some(Fault::InvalidScene)
             }
             FaultSpec::Terrain { t_s, height_m } => {
                 let n = pass.terrain.first().map_or(0, |t| t.1.len());
                 let bytes =
                     frames.frame(kind::TERRAIN, us(t_s), &terrain_payload(&vec![height_m; n]));
-                extra.push((
-                    after(us(t_s)),
-                    Item {
-                        bytes,
-                        fault: Some(k),
-                    },
-                ));
+                extra.push(injected_item(after(us(t_s)), bytes, k));
                 Some(Fault::OutOfRange)
             }
             FaultSpec::Envelope { t_s } => {
                 let mut nav = truth_nav(t_s)?;
                 nav.attitude.roll_rate_rad_s = 0.5;
                 let bytes = frames.nav(us(t_s), &nav);
-                extra.push((
-                    after(us(t_s)),
-                    Item {
-                        bytes,
-                        fault: Some(k),
-                    },
-                ));
+                extra.push(injected_item(after(us(t_s)), bytes, k));
                 Some(Fault::AttitudeOutsideModel)
             }
         };
@@ -253,6 +211,17 @@ pub fn build(pass: &Pass) -> Result<Stream, String> {
         fault: None,
     });
     Ok(Stream { items, injected })
+}
+
+/// The item of injected fault `k`, to go before item `at`.
+fn injected_item(at: usize, bytes: Vec<u8>, k: usize) -> (usize, Item) {
+    (
+        at,
+        Item {
+            bytes,
+            fault: Some(k),
+        },
+    )
 }
 
 /// True when `bytes` holds the sync word anywhere.

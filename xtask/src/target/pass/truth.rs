@@ -50,6 +50,30 @@ fn drift(g: &EarthGeometry<f64>, camera: &core_math::EarthCamera, n: f64) -> Opt
         .map(|m| (m.v2_mps / m.v1_mps).atan())
 }
 
+/// The geometry flown over ground `h_m`, and the same with the yaw left at zero.
+fn flown_and_unsteered(
+    state: core_math::StateVector,
+    attitude: Attitude<f64>,
+    h_m: f32,
+) -> (EarthGeometry<f64>, EarthGeometry<f64>) {
+    let flown = EarthGeometry {
+        state,
+        attitude,
+        ground_h_m: f64::from(h_m),
+        ellipsoid: controller::EARTH,
+        earth_rate_rad_s: EARTH_RATE_RAD_S,
+    };
+    let unsteered = EarthGeometry {
+        attitude: Attitude {
+            yaw_rad: 0.0,
+            yaw_rate_rad_s: 0.0,
+            ..attitude
+        },
+        ..flown
+    };
+    (flown, unsteered)
+}
+
 /// Every update of the firmware's downlink with fresh periods against the truth.
 pub fn check(
     truth: &AgileTruth,
@@ -160,22 +184,8 @@ pub fn check(
             // Drift at the segment's centre, flown and with the yaw left at zero.
             let spec = scene.segments[usize::from(o.index)];
             let camera = scene.earth_camera(&spec);
-            let h = f64::from(heights[usize::from(o.index)]);
-            let flown = EarthGeometry {
-                state,
-                attitude,
-                ground_h_m: h,
-                ellipsoid: controller::EARTH,
-                earth_rate_rad_s: EARTH_RATE_RAD_S,
-            };
-            let unsteered = EarthGeometry {
-                attitude: Attitude {
-                    yaw_rad: 0.0,
-                    yaw_rate_rad_s: 0.0,
-                    ..attitude
-                },
-                ..flown
-            };
+            let (flown, unsteered) =
+                flown_and_unsteered(state, attitude, heights[usize::from(o.index)]);
             if let (Some(s), Some(u)) = (
                 drift(&flown, &camera, spec.centre_px()),
                 drift(&unsteered, &camera, spec.centre_px()),
@@ -188,22 +198,11 @@ pub fn check(
         if !hold {
             continue;
         }
-        let h0 = f64::from(heights[usize::from(plan.boresight_segment)]);
-        let flown = EarthGeometry {
+        let (flown, unsteered) = flown_and_unsteered(
             state,
             attitude,
-            ground_h_m: h0,
-            ellipsoid: controller::EARTH,
-            earth_rate_rad_s: EARTH_RATE_RAD_S,
-        };
-        let unsteered = EarthGeometry {
-            attitude: Attitude {
-                yaw_rad: 0.0,
-                yaw_rate_rad_s: 0.0,
-                ..attitude
-            },
-            ..flown
-        };
+            heights[usize::from(plan.boresight_segment)],
+        );
         if let (Some(s), Some(u)) = (
             drift(&flown, &boresight, 0.0),
             drift(&unsteered, &boresight, 0.0),
