@@ -90,14 +90,10 @@ pub struct Plan {
     pub period_bounds_s: (f32, f32),
 }
 
-/// Per-update constants of the probe grid at `ground_h_m`.
-fn probe_updates(
-    env: &AttitudeEnvelope,
-    config: &Config,
-    ground_h_m: f32,
-) -> [Option<GeneralUpdate<f32>>; 216] {
-    let mut out = [None; 216];
-    let mut k = 0;
+/// Calls `f` with the update of every instant of the probe grid, at the lowest and the
+/// highest ground (432 updates; the grid is walked once, never stored: a scene upload
+/// costs no stack for it).
+fn for_each_probe(env: &AttitudeEnvelope, config: &Config, mut f: impl FnMut(&GeneralUpdate<f32>)) {
     let (r, p) = (f64::from(env.max_roll_rad), f64::from(env.max_pitch_rad));
     let (h_lo, h_hi) = config.altitude_range_m;
     let inclination = 98f64.to_radians();
@@ -119,68 +115,85 @@ fn probe_updates(
                             ..Attitude::default()
                         }
                         .to::<f32>();
-                        let update = GENERAL_F32
-                            .instant(&state, &attitude, &EARTH, EARTH_RATE_RAD_S)
-                            .and_then(|i| GENERAL_F32.ground(&i, &EARTH, ground_h_m));
-                        if let Some(slot) = out.get_mut(k) {
-                            *slot = update.ok();
+                        let Ok(instant) =
+                            GENERAL_F32.instant(&state, &attitude, &EARTH, EARTH_RATE_RAD_S)
+                        else {
+                            continue;
+                        };
+                        for ground_h_m in [MIN_GROUND_H_M, MAX_GROUND_H_M] {
+                            if let Ok(update) = GENERAL_F32.ground(&instant, &EARTH, ground_h_m) {
+                                f(&update);
+                            }
                         }
-                        k += 1;
                     }
                 }
             }
         }
     }
-    out
 }
 
-/// (max |v1''| per pixel^2, min |v1|) over the segment and the probe grid, by second
-/// differences at the probe spacing.
-fn curvature(
-    scene: &Scene,
-    spec: &SegmentSpec,
-    updates: &[Option<GeneralUpdate<f32>>],
-) -> Result<(f64, f64), Fault> {
-    let camera = scene.earth_camera(spec);
-    let width = f64::from(spec.last_px) - f64::from(spec.first_px);
-    let h = width / (PROBES - 1) as f64;
-    let mut probes = [None; PROBES];
-    for (j, p) in probes.iter_mut().enumerate() {
-        let n = f64::from(spec.first_px) + h * j as f64;
-        *p = Some(
+/// One segment's probe pixels across its width, and what the probe grid has shown of
+/// it so far: max |v1''| per pixel^2 by second differences at the probe spacing, and
+/// min |v1|.
+#[derive(Clone, Copy)]
+struct Curvature {
+    pixels: [GeneralPixel<f32>; PROBES],
+    spacing_px: f64,
+    c: f64,
+    v_min: f64,
+}
+
+impl Curvature {
+    fn new(scene: &Scene, spec: &SegmentSpec) -> Result<Curvature, Fault> {
+        let camera = scene.earth_camera(spec);
+        let width = f64::from(spec.last_px) - f64::from(spec.first_px);
+        let spacing_px = width / (PROBES - 1) as f64;
+        let pixel = |j: usize| {
+            let n = f64::from(spec.first_px) + spacing_px * j as f64;
             GENERAL_F32
                 .pixel(&camera, n)
-                .map_err(|_| Fault::InvalidScene)?,
-        );
+                .map_err(|_| Fault::InvalidScene)
+        };
+        let first = pixel(0)?;
+        let mut pixels = [first; PROBES];
+        for (j, p) in pixels.iter_mut().enumerate().skip(1) {
+            *p = pixel(j)?;
+        }
+        Ok(Curvature {
+            pixels,
+            spacing_px,
+            c: 0.0,
+            v_min: f64::INFINITY,
+        })
     }
-    let (mut c, mut v_min) = (0.0f64, f64::INFINITY);
-    for u in updates.iter().flatten() {
+
+    fn observe(&mut self, u: &GeneralUpdate<f32>) {
         let mut v = [0.0f64; PROBES];
-        let mut ok = true;
-        for (vj, p) in v.iter_mut().zip(probes.iter().flatten()) {
+        for (vj, p) in v.iter_mut().zip(&self.pixels) {
             match GENERAL_F32.motion(u, p) {
                 Ok(m) => *vj = f64::from(m.v1_mps),
-                Err(_) => ok = false,
+                // Conditions where the segment sees past the limb cannot be imaged.
+                Err(_) => return,
             }
-        }
-        // Conditions where the segment sees past the limb cannot be imaged: skip.
-        if !ok {
-            continue;
         }
         for vj in v {
-            v_min = v_min.min(libm::fabs(vj));
+            self.v_min = self.v_min.min(libm::fabs(vj));
         }
-        if width > 0.0 {
+        let h = self.spacing_px;
+        if h > 0.0 {
             for w in v.windows(3) {
-                c = c.max(libm::fabs(w[0] - 2.0 * w[1] + w[2]) / (h * h));
+                self.c = self.c.max(libm::fabs(w[0] - 2.0 * w[1] + w[2]) / (h * h));
             }
         }
     }
-    if !(v_min > 0.0 && v_min.is_finite()) {
-        // Not one probe condition images this segment.
-        return Err(Fault::InvalidScene);
+
+    /// (max |v1''|, min |v1|) over the grid; refused if not one condition images it.
+    fn result(&self) -> Result<(f64, f64), Fault> {
+        if !(self.v_min > 0.0 && self.v_min.is_finite()) {
+            return Err(Fault::InvalidScene);
+        }
+        Ok((self.c, self.v_min))
     }
-    Ok((c, v_min))
 }
 
 impl Plan {
@@ -199,8 +212,18 @@ impl Plan {
         scene.validate(&EARTH, config.altitude_range_m.1)?;
         let stage_rule =
             StageRule::<f32>::new(f64::from(scene.mtf_floor)).map_err(|_| Fault::InvalidScene)?;
-        let low = probe_updates(&scene.envelope, config, MIN_GROUND_H_M);
-        let high = probe_updates(&scene.envelope, config, MAX_GROUND_H_M);
+        // Every planned segment's curvature, the probe grid walked once for all.
+        let mut curvatures: [Option<Curvature>; MAX_SEGMENTS] = [None; MAX_SEGMENTS];
+        for (slot, spec) in curvatures.iter_mut().zip(scene.table()) {
+            if exhaustive || spec.active {
+                *slot = Some(Curvature::new(scene, spec)?);
+            }
+        }
+        for_each_probe(&scene.envelope, config, |u| {
+            for c in curvatures.iter_mut().flatten() {
+                c.observe(u);
+            }
+        });
         let boresight_camera = core_math::EarthCamera {
             focal_m: scene.camera.focal_m,
             pixel_m: scene.camera.pixel_m,
@@ -228,10 +251,13 @@ impl Plan {
             let camera = scene.earth_camera(spec);
             let budget = SAMPLING_SHARE * f64::from(stage_rule.mismatch_budget())
                 / f64::from(spec.tdi_stages);
-            let (c_low, v_low) = curvature(scene, spec, &low)?;
-            let (c_high, v_high) = curvature(scene, spec, &high)?;
-            let c = CURVATURE_SAFETY * c_low.max(c_high);
-            let v_min = v_low.min(v_high);
+            let (c, v_min) = curvatures
+                .get(index)
+                .copied()
+                .flatten()
+                .ok_or(Fault::InvalidScene)?
+                .result()?;
+            let c = CURVATURE_SAFETY * c;
             let width = f64::from(spec.last_px) - f64::from(spec.first_px);
             let error = |k: usize| {
                 let spacing = width / (k - 1) as f64;

@@ -98,6 +98,17 @@ pub fn check(
         updates: 0,
         holds: 0,
     };
+    // The paper model's pixel constants at each segment's samples, once for the pass.
+    let mut paper_pixels = std::collections::BTreeMap::new();
+    for seg in plan.active() {
+        let pixels = seg
+            .sample_px()
+            .iter()
+            .map(|&n| Reference.pixel(&scene.camera, f64::from(n)))
+            .collect::<Result<Vec<_>, _>>()
+            .map_err(|e| e.name().to_string())?;
+        paper_pixels.insert(seg.index, pixels);
+    }
     let boresight = core_math::EarthCamera {
         p1_m: 0.0,
         ..scene.earth_camera(&scene.segments[0])
@@ -145,9 +156,6 @@ pub fn check(
         let hold = attitude.roll_rate_rad_s == 0.0 && attitude.pitch_rate_rad_s == 0.0;
         r.holds += usize::from(hold);
         for o in &fresh {
-            let Some(seg) = plan.active().iter().find(|s| s.index == o.index) else {
-                continue;
-            };
             let Some(gold) = exact.segments.iter().flatten().find(|g| g.index == o.index) else {
                 continue;
             };
@@ -158,11 +166,9 @@ pub fn check(
             // The paper's period: |v_P| of the round-Earth model at the same pixels.
             if let Some(u) = &paper_update {
                 let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
-                for &n in seg.sample_px() {
-                    let p = Reference
-                        .pixel(&scene.camera, f64::from(n))
-                        .map_err(|e| e.name().to_string())?;
-                    if let Ok(m) = Reference.motion(u, &p) {
+                let pixels = paper_pixels.get(&o.index).map_or(&[][..], Vec::as_slice);
+                for p in pixels {
+                    if let Ok(m) = Reference.motion(u, p) {
                         lo = lo.min(m.speed_mps());
                         hi = hi.max(m.speed_mps());
                     }
