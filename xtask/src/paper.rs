@@ -12,13 +12,13 @@
 //! Conventions: paper pixel p (0 = near point, 60 000 = far point, rolling left) is
 //! array offset n = p - 30 000; velocities are reported as magnitudes in mm/s.
 
-use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use core_math::{
     mtf_mismatch, Backend, Camera, Geometry, ImageMotion, Reference, StageRule, EARTH_RATE_RAD_S,
 };
 
+use crate::csv::Writer;
 use crate::plot::{Legend, Plot, Series};
 
 /// Section 5's camera: f = 555 mm, A = 13 um.
@@ -417,23 +417,22 @@ fn self_check() -> Result<(), String> {
 fn fig5(out: &mut Out) -> Result<(), String> {
     let rolls = [0.0, 15.0, 25.0];
     let g0s = deg_steps(G0_MAX_DEG, 90);
-    let mut csv = String::from(GENERATED);
-    csv.push_str("# |v| in mm/s; min/max over gamma0 in [0, 90] deg by 1 deg\n");
-    csv.push_str("paper_pixel,n_px,field_angle_deg");
+    let mut header = ["paper_pixel", "n_px", "field_angle_deg"]
+        .map(String::from)
+        .to_vec();
     for phi in rolls {
-        write!(
-            csv,
-            ",phi{phi}_g0_0_mm_s,phi{phi}_g0_90_mm_s,phi{phi}_min_mm_s,phi{phi}_max_mm_s"
-        )
-        .unwrap();
+        header.extend(["g0_0", "g0_90", "min", "max"].map(|q| format!("phi{phi}_{q}_mm_s")));
     }
-    csv.push('\n');
+    let mut csv = Writer::new(
+        &format!("{GENERATED}# |v| in mm/s; min/max over gamma0 in [0, 90] deg by 1 deg\n"),
+        &header,
+    )?;
     let mut lines: Vec<Vec<(f64, f64)>> = vec![Vec::new(); 2 * rolls.len()];
     for k in 0..=240 {
         let px = 250.0 * k as f64;
         let n = px - CENTRE_PX;
         let field = (n * CAMERA.pixel_m / CAMERA.focal_m).atan().to_degrees();
-        write!(csv, "{px:.0},{n:.0},{field:.6}").unwrap();
+        let mut row = vec![format!("{px:.0}"), format!("{n:.0}"), format!("{field:.6}")];
         for (j, &phi) in rolls.iter().enumerate() {
             let speeds: Vec<f64> = g0s
                 .iter()
@@ -441,13 +440,13 @@ fn fig5(out: &mut Out) -> Result<(), String> {
                 .collect::<Result<_, _>>()?;
             let r = Range::of(speeds.iter().copied()).ok_or("non-finite speed")?;
             let (s0, s90) = (speeds[0], speeds[speeds.len() - 1]);
-            write!(csv, ",{s0:.6},{s90:.6},{:.6},{:.6}", r.min, r.max).unwrap();
+            row.extend([s0, s90, r.min, r.max].map(|v| format!("{v:.6}")));
             lines[2 * j].push((px, s0));
             lines[2 * j + 1].push((px, s90));
         }
-        csv.push('\n');
+        csv.row(&row)?;
     }
-    out.write("fig5_velocity_across_array.csv", csv.as_bytes())?;
+    out.write("fig5_velocity_across_array.csv", &csv.into_bytes()?)?;
 
     let mut plot = Plot::new(
         "Fig. 5: image-motion speed across the array (rolling left)",
@@ -478,25 +477,24 @@ fn fig5(out: &mut Out) -> Result<(), String> {
 
 fn fig67(out: &mut Out, stem: &str, paper_px: f64, title: &str) -> Result<Range, String> {
     let rows = grid(paper_px)?;
-    let mut csv = String::from(GENERATED);
-    writeln!(
-        csv,
-        "# paper pixel {paper_px:.0} (n = {:.0}); v1 = dP1/dt (along track), v2 = dP2/dt (along the array), signed, mm/s",
-        paper_px - CENTRE_PX
-    )
-    .unwrap();
-    csv.push_str("phi_deg,gamma0_deg,v1_mm_s,v2_mm_s,speed_mm_s\n");
+    let mut csv = Writer::new(
+        &format!(
+            "{GENERATED}# paper pixel {paper_px:.0} (n = {:.0}); v1 = dP1/dt (along track), v2 = dP2/dt (along the array), signed, mm/s\n",
+            paper_px - CENTRE_PX
+        ),
+        &["phi_deg", "gamma0_deg", "v1_mm_s", "v2_mm_s", "speed_mm_s"],
+    )?;
     for (phi, g0, m) in &rows {
-        writeln!(
-            csv,
-            "{phi:.1},{g0:.1},{:.6},{:.6},{:.6}",
-            mm_s(m.v1_mps),
-            mm_s(m.v2_mps),
-            mm_s(m.speed_mps())
-        )
-        .unwrap();
+        let speeds = [m.v1_mps, m.v2_mps, m.speed_mps()].map(|v| format!("{:.6}", mm_s(v)));
+        csv.row(
+            &[
+                [format!("{phi:.1}"), format!("{g0:.1}")].as_slice(),
+                &speeds,
+            ]
+            .concat(),
+        )?;
     }
-    out.write(&format!("{stem}.csv"), csv.as_bytes())?;
+    out.write(&format!("{stem}.csv"), &csv.into_bytes()?)?;
     let range = Range::of(rows.iter().map(|r| mm_s(r.2.speed_mps()))).ok_or("non-finite speed")?;
 
     let mut plot = Plot::new(title, "roll angle phi (deg)", "speed v_P (mm/s)")
@@ -522,26 +520,33 @@ fn fig67(out: &mut Out, stem: &str, paper_px: f64, title: &str) -> Result<Range,
 fn fig8(out: &mut Out) -> Result<(f64, u32, f64), String> {
     let sweep = MismatchSweep::new(|g| motion(FAR_PX, 25.0, g).ok().map(|m| mm_s(m.speed_mps())))
         .ok_or("far point at 25 deg misses the Earth")?;
-    let mut csv = String::from(GENERATED);
-    csv.push_str("# far point, phi = 25 deg; line period set for |v| at gamma0 = 0 and held;\n");
-    csv.push_str("# rel_mismatch = (v - v(0)) / v(0); MTF = sinc(pi M rel / 2) (Eq. 19)\n");
-    csv.push_str("gamma0_deg,speed_mm_s,rel_mismatch");
-    for m in FIG8_STAGES {
-        write!(csv, ",mtf_M{m}").unwrap();
-    }
-    csv.push('\n');
+    let mut header = ["gamma0_deg", "speed_mm_s", "rel_mismatch"]
+        .map(String::from)
+        .to_vec();
+    header.extend(FIG8_STAGES.map(|m| format!("mtf_M{m}")));
+    let mut csv = Writer::new(
+        &format!(
+            "{GENERATED}# far point, phi = 25 deg; line period set for |v| at gamma0 = 0 and held;\n\
+             # rel_mismatch = (v - v(0)) / v(0); MTF = sinc(pi M rel / 2) (Eq. 19)\n"
+        ),
+        &header,
+    )?;
     let mut curves: Vec<Vec<(f64, f64)>> = vec![Vec::new(); FIG8_STAGES.len()];
     for (k, &g) in sweep.g0_deg.iter().enumerate() {
         let rel = sweep.rel[k];
-        write!(csv, "{g:.0},{:.6},{rel:.8}", sweep.speed_mm_s[k]).unwrap();
+        let mut row = vec![
+            format!("{g:.0}"),
+            format!("{:.6}", sweep.speed_mm_s[k]),
+            format!("{rel:.8}"),
+        ];
         for (j, &m) in FIG8_STAGES.iter().enumerate() {
             let mtf = mtf_mismatch(m, rel).map_err(|e| format!("{e:?}"))?;
-            write!(csv, ",{mtf:.6}").unwrap();
+            row.push(format!("{mtf:.6}"));
             curves[j].push((g, mtf));
         }
-        csv.push('\n');
+        csv.row(&row)?;
     }
-    out.write("fig8_mtf_mismatch.csv", csv.as_bytes())?;
+    out.write("fig8_mtf_mismatch.csv", &csv.into_bytes()?)?;
 
     let mut plot = Plot::new(
         "Fig. 8: MTF_mismatch, far point, phi = 25 deg",
@@ -575,13 +580,12 @@ fn summary(
     max_m: u32,
     worst: f64,
 ) -> Result<(), String> {
-    let mut csv = String::from(GENERATED);
-    writeln!(
-        csv,
-        "# H = 645 km, f = 555 mm, A = 13 um, R = 6370 km, i0 = {INCLINATION_DEG} deg, GM = 3.986004418e14, omega = {EARTH_RATE_RAD_S}; reference chain"
-    )
-    .unwrap();
-    csv.push_str("quantity,paper,ours,unit,definition\n");
+    let mut csv = Writer::new(
+        &format!(
+            "{GENERATED}# H = 645 km, f = 555 mm, A = 13 um, R = 6370 km, i0 = {INCLINATION_DEG} deg, GM = 3.986004418e14, omega = {EARTH_RATE_RAD_S}; reference chain\n"
+        ),
+        &["quantity", "paper", "ours", "unit", "definition"],
+    )?;
     let rows: Vec<(&str, String, String, &str, &str)> = vec![
         (
             "near_min",
@@ -662,9 +666,9 @@ fn summary(
         ),
     ];
     for (q, p, o, u, d) in rows {
-        writeln!(csv, "{q},{p},{o},{u},\"{d}\"").unwrap();
+        csv.row(&[q, &p, &o, u, d])?;
     }
-    out.write("summary.csv", csv.as_bytes())?;
+    out.write("summary.csv", &csv.into_bytes()?)?;
     println!(
         "near [{:.3}, {:.3}] mm/s, {:.2} %; far [{:.3}, {:.3}] mm/s, {:.2} %; MTF(M=48) {:.4}; max M {}",
         near.min,
@@ -699,23 +703,33 @@ fn implied_rel(mtf: f64, stages: u32) -> f64 {
 
 /// Each candidate explanation on the Figs. 6-8 quantities.
 fn hypotheses(out: &mut Out) -> Result<(), String> {
-    let mut csv = String::from(GENERATED);
-    csv.push_str("# what the paper's numbers would be under each suspected mistake (Eq. 14 route, v2 from the chain); empty = the line of sight misses the Earth somewhere\n");
-    csv.push_str("variant,near_min_mm_s,near_max_mm_s,near_change_pct,far_min_mm_s,far_max_mm_s,far_change_pct,far_phi25_worst_rel_pct,mtf_M48,max_stages\n");
-    writeln!(
-        csv,
-        "paper,{:.2},{:.2},{:.1},{:.2},{:.2},{:.1},{:.3},{:.3},{}",
-        published::NEAR_MIN,
-        published::NEAR_MAX,
-        published::NEAR_CHANGE_PCT,
-        published::FAR_MIN,
-        published::FAR_MAX,
-        published::FAR_CHANGE_PCT,
-        100.0 * implied_rel(published::MTF_M48, 48),
-        published::MTF_M48,
-        published::MAX_STAGES
-    )
-    .unwrap();
+    let mut csv = Writer::new(
+        &format!("{GENERATED}# what the paper's numbers would be under each suspected mistake (Eq. 14 route, v2 from the chain); empty = the line of sight misses the Earth somewhere\n"),
+        &[
+            "variant",
+            "near_min_mm_s",
+            "near_max_mm_s",
+            "near_change_pct",
+            "far_min_mm_s",
+            "far_max_mm_s",
+            "far_change_pct",
+            "far_phi25_worst_rel_pct",
+            "mtf_M48",
+            "max_stages",
+        ],
+    )?;
+    csv.row(&[
+        "paper".to_string(),
+        fmt2(published::NEAR_MIN),
+        fmt2(published::NEAR_MAX),
+        format!("{:.1}", published::NEAR_CHANGE_PCT),
+        fmt2(published::FAR_MIN),
+        fmt2(published::FAR_MAX),
+        format!("{:.1}", published::FAR_CHANGE_PCT),
+        format!("{:.3}", 100.0 * implied_rel(published::MTF_M48, 48)),
+        format!("{:.3}", published::MTF_M48),
+        published::MAX_STAGES.to_string(),
+    ])?;
     let rolls = deg_steps(ROLL_MAX_DEG, ROLL_STEPS);
     let g0s = deg_steps(G0_MAX_DEG, G0_STEPS);
     for v in VARIANTS {
@@ -727,31 +741,29 @@ fn hypotheses(out: &mut Out) -> Result<(), String> {
                 .collect();
             all.and_then(Range::of)
         };
-        write!(csv, "\"{}\"", v.name).unwrap();
+        // Empty fields where the line of sight misses the Earth.
+        let mut row = vec![v.name.to_string()];
         for r in [range_at(NEAR_PX), range_at(FAR_PX)] {
-            match r {
-                Some(r) => write!(
-                    csv,
-                    ",{:.3},{:.3},{:.2}",
-                    r.min,
-                    r.max,
-                    r.change_over_min_pct()
-                )
-                .unwrap(),
-                None => csv.push_str(",,,"),
-            }
+            row.extend(match r {
+                Some(r) => [
+                    format!("{:.3}", r.min),
+                    format!("{:.3}", r.max),
+                    format!("{:.2}", r.change_over_min_pct()),
+                ],
+                None => Default::default(),
+            });
         }
-        match MismatchSweep::new(|g| v.speed_mm_s(FAR_PX, 25.0, g)) {
-            Some(s) => writeln!(
-                csv,
-                ",{:.3},{:.4},{}",
-                100.0 * s.worst_rel(),
-                s.min_mtf(48)?,
-                s.max_stages()?
-            )
-            .unwrap(),
-            None => csv.push_str(",,,\n"),
-        }
+        row.extend(
+            match MismatchSweep::new(|g| v.speed_mm_s(FAR_PX, 25.0, g)) {
+                Some(s) => [
+                    format!("{:.3}", 100.0 * s.worst_rel()),
+                    format!("{:.4}", s.min_mtf(48)?),
+                    s.max_stages()?.to_string(),
+                ],
+                None => Default::default(),
+            },
+        );
+        csv.row(&row)?;
     }
-    out.write("hypotheses.csv", csv.as_bytes())
+    out.write("hypotheses.csv", &csv.into_bytes()?)
 }

@@ -488,10 +488,11 @@ fn print_table(
     );
     if csv {
         eprintln!("report: {notes}");
-        println!("{}", HEADER.join(","));
+        let mut out = crate::csv::Writer::new("", &HEADER)?;
         for r in &rows {
-            println!("{}", r.join(","));
+            out.row(r)?;
         }
+        print!("{}", out.into_string()?);
     } else {
         println!("{notes}\n");
         println!("| {} |", HEADER.join(" | "));
