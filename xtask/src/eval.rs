@@ -26,35 +26,38 @@ pub const INPUT_COLUMNS: [&str; 8] = [
 ];
 pub const OUTPUT_COLUMNS: [&str; 5] = ["v1_mps", "v2_mps", "v_mps", "line_period_s", "error"];
 
-pub fn run(args: &[String]) -> Result<(), String> {
-    let mut backend = None;
-    let mut input = None;
-    let mut model = "sphere".to_string();
-    let mut it = args.iter();
-    while let Some(a) = it.next() {
-        match a.as_str() {
-            "--backend" => backend = it.next().cloned(),
-            "--input" => input = it.next().cloned(),
-            "--model" => model = it.next().cloned().unwrap_or_default(),
-            other => return Err(format!("eval: unknown argument `{other}`")),
-        }
-    }
-    let backends = match model.as_str() {
-        "sphere" => "reference|f64|f32|fixed",
-        "earth" => earth::BACKENDS,
-        other => return Err(format!("eval: unknown model `{other}` (sphere|earth)")),
-    };
-    let backend = backend.ok_or(format!("eval: --backend <{backends}> is required"))?;
-    let input = input.ok_or("eval: --input CASES.csv is required")?;
+/// The Earth of a model.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Model {
+    /// The paper's round Earth
+    Sphere,
+    /// The real-Earth model of shared/EARTH-MODEL.md (WGS 84)
+    Earth,
+}
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// The model's Earth
+    #[arg(long, value_enum, default_value_t = Model::Sphere)]
+    model: Model,
+    /// The implementation to run (earth: no fixed)
+    #[arg(long, value_parser = ["reference", "f64", "f32", "fixed"])]
+    backend: String,
+    /// The cases: a CSV file whose header names the model's input columns (`-`: stdin)
+    #[arg(long, value_name = "CASES.csv")]
+    input: String,
+}
+
+pub fn run(args: &Args) -> Result<(), String> {
+    let (backend, input) = (&args.backend, &args.input);
     let text = if input == "-" {
         std::io::read_to_string(std::io::stdin()).map_err(|e| format!("reading stdin: {e}"))?
     } else {
-        std::fs::read_to_string(&input).map_err(|e| format!("reading {input}: {e}"))?
+        std::fs::read_to_string(input).map_err(|e| format!("reading {input}: {e}"))?
     };
-    let out = if model == "earth" {
-        earth::eval_csv(&backend, &text)?
-    } else {
-        eval_csv(&backend, &text)?
+    let out = match args.model {
+        Model::Earth => earth::eval_csv(backend, &text)?,
+        Model::Sphere => eval_csv(backend, &text)?,
     };
     print!("{out}");
     Ok(())
