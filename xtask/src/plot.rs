@@ -23,6 +23,7 @@ use plotters::coord::ranged1d::{
     BoldPoints, KeyPointHint, NoDefaultFormatting, Ranged, ValueFormatter,
 };
 use plotters::coord::types::RangedCoordf64;
+use plotters::coord::Shift;
 use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 
@@ -268,36 +269,9 @@ impl Plot {
     fn render(&self) -> Result<Vec<u8>, String> {
         check_size(self.width, self.height, (200, 150))?;
         let (x_axis, y_axis) = self.axes()?;
-        font_ready()?;
-        let mut pixels = vec![255u8; self.width as usize * self.height as usize * 3];
-        {
-            let root = BitMapBackend::with_buffer(&mut pixels, (self.width, self.height))
-                .into_drawing_area();
-            let mut chart = ChartBuilder::on(&root)
-                .caption(&self.title, text(TITLE_PX))
-                .margin(MARGIN)
-                .margin_right(right_margin(&root, &x_axis)?)
-                .x_label_area_size(X_LABEL_AREA)
-                .y_label_area_size(y_label_area(&root, &y_axis)?)
-                .build_cartesian_2d(x_axis.clone(), y_axis.clone())
-                .map_err(drawing)?;
-            let (x_fmt, y_fmt) = (|v: &f64| x_axis.label(*v), |v: &f64| y_axis.label(*v));
-            chart
-                .configure_mesh()
-                .x_desc(&self.x_label)
-                .y_desc(&self.y_label)
-                .x_labels(MAX_TICKS)
-                .y_labels(MAX_TICKS)
-                .x_label_formatter(&x_fmt)
-                .y_label_formatter(&y_fmt)
-                .label_style(text(LABEL_PX))
-                .axis_desc_style(text(DESC_PX))
-                .set_all_tick_mark_size(TICK_PX)
-                .bold_line_style(GRID)
-                .light_line_style(GRID_MINOR)
-                .max_light_lines(1)
-                .draw()
-                .map_err(drawing)?;
+        render_rgb((self.width, self.height), &self.title, |_, body| {
+            let names = (self.x_label.as_str(), self.y_label.as_str());
+            let mut chart = labelled_chart(body, (&x_axis, &y_axis), names, true)?;
             frame(&chart)?;
             for (i, s) in self.series.iter().enumerate() {
                 let style = s.style(i);
@@ -344,9 +318,8 @@ impl Plot {
                     .draw()
                     .map_err(drawing)?;
             }
-            root.present().map_err(drawing)?;
-        }
-        Ok(pixels)
+            Ok(())
+        })
     }
 
     /// The drawable stretches of a series, in plotted units.
@@ -394,6 +367,64 @@ fn y_label_area<DB: DrawingBackend>(
         widest = widest.max(w);
     }
     Ok(widest + DESC_PX as u32 + 24)
+}
+
+/// The drawing area of a figure (RGB pixels in memory).
+type Area<'a> = DrawingArea<BitMapBackend<'a>, Shift>;
+
+/// A figure of `width` x `height` pixels with `title` on top: `draw` gets the whole
+/// figure and the part under the title. Returns the RGB pixels, row by row.
+fn render_rgb(
+    (width, height): (u32, u32),
+    title: &str,
+    draw: impl FnOnce(&Area<'_>, &Area<'_>) -> Result<(), String>,
+) -> Result<Vec<u8>, String> {
+    font_ready()?;
+    let mut pixels = vec![255u8; width as usize * height as usize * 3];
+    {
+        let root = BitMapBackend::with_buffer(&mut pixels, (width, height)).into_drawing_area();
+        let body = root.titled(title, text(TITLE_PX)).map_err(drawing)?;
+        draw(&root, &body)?;
+        root.present().map_err(drawing)?;
+    }
+    Ok(pixels)
+}
+
+/// A chart of `x` against `y` on `area`, both axes named (`names`) with tick labels and
+/// tick marks; with `grid`, grid lines at the ticks (minor ones too on a decade axis).
+fn labelled_chart<'a, 'b>(
+    area: &'a Area<'b>,
+    (x, y): (&Axis, &Axis),
+    (x_name, y_name): (&str, &str),
+    grid: bool,
+) -> Result<ChartContext<'a, BitMapBackend<'b>, Cartesian2d<Axis, Axis>>, String> {
+    let mut chart = ChartBuilder::on(area)
+        .margin(MARGIN)
+        .margin_right(right_margin(area, x)?)
+        .x_label_area_size(X_LABEL_AREA)
+        .y_label_area_size(y_label_area(area, y)?)
+        .build_cartesian_2d(x.clone(), y.clone())
+        .map_err(drawing)?;
+    let (x_fmt, y_fmt) = (|v: &f64| x.label(*v), |v: &f64| y.label(*v));
+    let mut mesh = chart.configure_mesh();
+    mesh.x_desc(x_name)
+        .y_desc(y_name)
+        .x_labels(MAX_TICKS)
+        .y_labels(MAX_TICKS)
+        .x_label_formatter(&x_fmt)
+        .y_label_formatter(&y_fmt)
+        .label_style(text(LABEL_PX))
+        .axis_desc_style(text(DESC_PX))
+        .set_all_tick_mark_size(TICK_PX);
+    if grid {
+        mesh.bold_line_style(GRID)
+            .light_line_style(GRID_MINOR)
+            .max_light_lines(1);
+    } else {
+        mesh.disable_mesh();
+    }
+    mesh.draw().map_err(drawing)?;
+    Ok(chart)
 }
 
 /// Room right of the plot for half of the last x tick label, centred on the frame.

@@ -18,8 +18,8 @@ use std::path::Path;
 use plotters::prelude::*;
 
 use super::{
-    check_size, drawing, encode_png, font_ready, text, write_png, y_label_area, Axis, Rgb, DESC_PX,
-    LABEL_PX, MARGIN, MAX_TICKS, TICK_PX, TITLE_PX, X_LABEL_AREA,
+    check_size, drawing, encode_png, labelled_chart, render_rgb, text, write_png, y_label_area,
+    Area, Axis, Rgb, DESC_PX, LABEL_PX, MARGIN, MAX_TICKS, TICK_PX, X_LABEL_AREA,
 };
 
 /// Colour of a cell without a value.
@@ -196,57 +196,27 @@ impl Heatmap {
         let x_axis = Self::axis(self.x_range, self.x_decades)?;
         let y_axis = Self::axis(self.y_range, self.y_decades)?;
         let z_axis = Self::axis(self.z_range, self.z_decades)?;
-        font_ready()?;
-        let mut pixels = vec![255u8; self.width as usize * self.height as usize * 3];
-        {
-            let root = BitMapBackend::with_buffer(&mut pixels, (self.width, self.height))
-                .into_drawing_area();
-            let body = root.titled(&self.title, text(TITLE_PX)).map_err(drawing)?;
-            let bar_labels = y_label_area(&root, &z_axis)?;
+        render_rgb((self.width, self.height), &self.title, |root, body| {
+            let bar_labels = y_label_area(root, &z_axis)?;
             let strip = MARGIN + BAR_PX + bar_labels + MARGIN;
             if strip + 200 > self.width {
                 return Err("heatmap too narrow for its colour bar".into());
             }
             let (map_area, bar_area) = body.split_horizontally(self.width - strip);
-            self.draw_map(&map_area, x_axis, y_axis)?;
+            self.draw_map(&map_area, &x_axis, &y_axis)?;
             self.draw_bar(&bar_area, z_axis, bar_labels)?;
             if self.values.iter().any(|v| !v.is_some_and(f64::is_finite))
                 && !self.missing_label.is_empty()
             {
-                self.draw_missing_swatch(&root)?;
+                self.draw_missing_swatch(root)?;
             }
-            root.present().map_err(drawing)?;
-        }
-        Ok(pixels)
+            Ok(())
+        })
     }
 
-    fn draw_map<DB: DrawingBackend>(
-        &self,
-        area: &DrawingArea<DB, plotters::coord::Shift>,
-        x_axis: Axis,
-        y_axis: Axis,
-    ) -> Result<(), String> {
-        let mut chart = ChartBuilder::on(area)
-            .margin(MARGIN)
-            .x_label_area_size(X_LABEL_AREA)
-            .y_label_area_size(y_label_area(area, &y_axis)?)
-            .build_cartesian_2d(x_axis.clone(), y_axis.clone())
-            .map_err(drawing)?;
-        let (x_fmt, y_fmt) = (|v: &f64| x_axis.label(*v), |v: &f64| y_axis.label(*v));
-        chart
-            .configure_mesh()
-            .disable_mesh()
-            .x_desc(&self.x_label)
-            .y_desc(&self.y_label)
-            .x_labels(MAX_TICKS)
-            .y_labels(MAX_TICKS)
-            .x_label_formatter(&x_fmt)
-            .y_label_formatter(&y_fmt)
-            .label_style(text(LABEL_PX))
-            .axis_desc_style(text(DESC_PX))
-            .set_all_tick_mark_size(TICK_PX)
-            .draw()
-            .map_err(drawing)?;
+    fn draw_map(&self, area: &Area<'_>, x_axis: &Axis, y_axis: &Axis) -> Result<(), String> {
+        let names = (self.x_label.as_str(), self.y_label.as_str());
+        let mut chart = labelled_chart(area, (x_axis, y_axis), names, false)?;
         let (x0, x1) = self.x_range;
         let (y0, y1) = self.y_range;
         let (dx, dy) = ((x1 - x0) / self.nx as f64, (y1 - y0) / self.ny as f64);
@@ -276,12 +246,7 @@ impl Heatmap {
 
     /// The colour bar: z from bottom to top, ticks and the z label on its right, each z
     /// mark a black line with a white core across it.
-    fn draw_bar<DB: DrawingBackend>(
-        &self,
-        area: &DrawingArea<DB, plotters::coord::Shift>,
-        z_axis: Axis,
-        labels_px: u32,
-    ) -> Result<(), String> {
+    fn draw_bar(&self, area: &Area<'_>, z_axis: Axis, labels_px: u32) -> Result<(), String> {
         let (z0, z1) = self.z_range;
         let mut chart = ChartBuilder::on(area)
             .margin(MARGIN)
@@ -323,10 +288,7 @@ impl Heatmap {
     }
 
     /// A grey square and `missing_label` in the bottom right corner of the figure.
-    fn draw_missing_swatch<DB: DrawingBackend>(
-        &self,
-        root: &DrawingArea<DB, plotters::coord::Shift>,
-    ) -> Result<(), String> {
+    fn draw_missing_swatch(&self, root: &Area<'_>) -> Result<(), String> {
         let style = text(LABEL_PX);
         let (tw, th) = root
             .estimate_text_size(&self.missing_label, &style)
