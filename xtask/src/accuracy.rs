@@ -7,6 +7,8 @@ mod earth;
 
 use core_math::{Backend, Camera, Geometry, Reference, CLOSED_F32, CLOSED_F64};
 
+use crate::eval::Model;
+
 /// Unit roundoff of f32.
 pub(crate) const U32: f64 = f32::EPSILON as f64 / 2.0;
 
@@ -41,21 +43,20 @@ struct Stat {
     refused: u64,
 }
 
-pub fn run(args: &[String]) -> Result<(), String> {
-    let quick = args.iter().any(|a| a == "--quick");
-    let mut it = args.iter();
-    let mut model = "sphere";
-    while let Some(a) = it.next() {
-        match a.as_str() {
-            "--quick" => {}
-            "--model" => model = it.next().map(String::as_str).unwrap_or(""),
-            other => return Err(format!("accuracy: unknown argument `{other}`")),
-        }
-    }
-    match model {
-        "sphere" => {}
-        "earth" => return earth::run(quick),
-        other => return Err(format!("accuracy: unknown model `{other}` (sphere|earth)")),
+#[derive(clap::Args)]
+pub struct Args {
+    /// A coarser grid (a few seconds)
+    #[arg(long)]
+    quick: bool,
+    /// The model's Earth
+    #[arg(long, value_enum, default_value_t = Model::Sphere)]
+    model: Model,
+}
+
+pub fn run(args: &Args) -> Result<(), String> {
+    let quick = args.quick;
+    if args.model == Model::Earth {
+        return earth::run(quick);
     }
     let t0 = std::time::Instant::now();
     let stats = sweep(quick);

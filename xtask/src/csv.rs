@@ -1,5 +1,9 @@
-//! A minimal CSV reader for numeric case files: a header line, comma-separated fields,
-//! no quoting (the case files hold numbers and simple labels only).
+//! CSV through the `csv` crate: tables read by column name, and documents written with
+//! a `#` preamble (what generated them, the units) ahead of the header.
+//!
+//! Numbers are handed over as text: each caller formats its own (the shortest text that
+//! reads back to the same value, or a fixed number of decimals), and quoting is the
+//! crate's (only where a field needs it).
 
 /// A parsed table: the header and the rows, each as the trimmed field texts.
 pub struct Table {
@@ -8,17 +12,22 @@ pub struct Table {
 }
 
 impl Table {
+    /// A header line, then rows of any length; blank lines and `#` lines are skipped.
     pub fn parse(text: &str) -> Result<Table, String> {
-        let mut lines = text.lines().map(str::trim).filter(|l| !l.is_empty());
-        let header = lines
-            .next()
-            .ok_or("empty input: expected a header line")?
-            .split(',')
-            .map(|s| s.trim().to_string())
-            .collect();
-        let rows = lines
-            .map(|l| l.split(',').map(|s| s.trim().to_string()).collect())
-            .collect();
+        let mut reader = ::csv::ReaderBuilder::new()
+            .trim(::csv::Trim::All)
+            .flexible(true)
+            .comment(Some(b'#'))
+            .from_reader(text.as_bytes());
+        let record = |r: &::csv::StringRecord| r.iter().map(str::to_string).collect::<Vec<_>>();
+        let header = record(reader.headers().map_err(|e| format!("csv: {e}"))?);
+        if header.is_empty() {
+            return Err("empty input: expected a header line".into());
+        }
+        let rows = reader
+            .records()
+            .map(|r| r.map(|r| record(&r)).map_err(|e| format!("csv: {e}")))
+            .collect::<Result<_, _>>()?;
         Ok(Table { header, rows })
     }
 
@@ -35,19 +44,59 @@ impl Table {
     }
 }
 
+/// A CSV document being written: `preamble` (whole `#` lines), the header, the rows.
+pub struct Writer(::csv::Writer<Vec<u8>>);
+
+impl Writer {
+    pub fn new<H: AsRef<str>>(preamble: &str, header: &[H]) -> Result<Writer, String> {
+        let mut w = Writer(::csv::Writer::from_writer(preamble.as_bytes().to_vec()));
+        w.row(header)?;
+        Ok(w)
+    }
+
+    pub fn row<F: AsRef<str>>(&mut self, fields: &[F]) -> Result<(), String> {
+        self.0
+            .write_record(fields.iter().map(|f| f.as_ref()))
+            .map_err(|e| format!("csv: {e}"))
+    }
+
+    pub fn into_bytes(self) -> Result<Vec<u8>, String> {
+        self.0.into_inner().map_err(|e| format!("csv: {e}"))
+    }
+
+    pub fn into_string(self) -> Result<String, String> {
+        String::from_utf8(self.into_bytes()?).map_err(|e| format!("csv: {e}"))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
     #[test]
     fn columns_in_any_order_and_extras_ignored() {
-        let t = Table::parse("b, a ,extra\n1,2,x\n\n3,4,y\n").unwrap();
+        let t = Table::parse("# made by hand\nb, a ,extra\n1,2,x\n\n3,4,\"y, z\"\n").unwrap();
         assert_eq!(t.columns(&["a", "b"]).unwrap(), vec![1, 0]);
         assert_eq!(t.rows.len(), 2);
-        assert_eq!(t.rows[1], vec!["3", "4", "y"]);
+        assert_eq!(t.rows[1], vec!["3", "4", "y, z"]);
         assert!(t
             .columns(&["c"])
             .unwrap_err()
             .contains("missing column `c`"));
+        assert!(Table::parse("\n").is_err());
+    }
+
+    #[test]
+    fn writes_what_it_reads() {
+        let mut w = Writer::new("# units: m\n", &["name", "x"]).unwrap();
+        w.row(&["plain", "0.1"]).unwrap();
+        w.row(&["with, comma", "1e-7"]).unwrap();
+        let text = w.into_string().unwrap();
+        assert_eq!(
+            text,
+            "# units: m\nname,x\nplain,0.1\n\"with, comma\",1e-7\n"
+        );
+        let t = Table::parse(&text).unwrap();
+        assert_eq!(t.rows[1], vec!["with, comma", "1e-7"]);
     }
 }

@@ -19,9 +19,6 @@ use core_math::{
 
 use motion::{Orbit, Scenario, Spheroid};
 
-const USAGE: &str =
-    "cargo xtask ellipsoid [--print]   (--print: markdown to stdout, doc untouched)";
-
 /// The orbit of the default pass (`cargo xtask run`): circular, 645 km over the
 /// controller's round Earth, sun-synchronous inclination.
 const ALTITUDE_M: f64 = 645e3;
@@ -539,14 +536,15 @@ fn replace_between(doc: &str, begin: &str, end: &str, block: &str) -> Option<Str
     Some(format!("{}{block}{}", &doc[..b], &doc[e..]))
 }
 
-pub fn run(args: &[String]) -> Result<(), String> {
-    let mut print_only = false;
-    for a in args {
-        match a.as_str() {
-            "--print" => print_only = true,
-            other => return Err(format!("ellipsoid: unknown argument `{other}` ({USAGE})")),
-        }
-    }
+#[derive(clap::Args)]
+pub struct Args {
+    /// The markdown blocks to stdout, docs/earth-model.md untouched
+    #[arg(long)]
+    print: bool,
+}
+
+pub fn run(args: &Args) -> Result<(), String> {
+    let print_only = args.print;
     let t0 = Instant::now();
     let s = summary()?;
     let block = render(&s)?;

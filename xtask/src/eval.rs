@@ -11,7 +11,7 @@ use core_math::{
     FIXED,
 };
 
-use crate::csv::Table;
+use crate::csv::{Table, Writer};
 
 /// Input columns, in the order the model takes them.
 pub const INPUT_COLUMNS: [&str; 8] = [
@@ -26,35 +26,38 @@ pub const INPUT_COLUMNS: [&str; 8] = [
 ];
 pub const OUTPUT_COLUMNS: [&str; 5] = ["v1_mps", "v2_mps", "v_mps", "line_period_s", "error"];
 
-pub fn run(args: &[String]) -> Result<(), String> {
-    let mut backend = None;
-    let mut input = None;
-    let mut model = "sphere".to_string();
-    let mut it = args.iter();
-    while let Some(a) = it.next() {
-        match a.as_str() {
-            "--backend" => backend = it.next().cloned(),
-            "--input" => input = it.next().cloned(),
-            "--model" => model = it.next().cloned().unwrap_or_default(),
-            other => return Err(format!("eval: unknown argument `{other}`")),
-        }
-    }
-    let backends = match model.as_str() {
-        "sphere" => "reference|f64|f32|fixed",
-        "earth" => earth::BACKENDS,
-        other => return Err(format!("eval: unknown model `{other}` (sphere|earth)")),
-    };
-    let backend = backend.ok_or(format!("eval: --backend <{backends}> is required"))?;
-    let input = input.ok_or("eval: --input CASES.csv is required")?;
+/// The Earth of a model.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Model {
+    /// The paper's round Earth
+    Sphere,
+    /// The real-Earth model of shared/EARTH-MODEL.md (WGS 84)
+    Earth,
+}
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// The model's Earth
+    #[arg(long, value_enum, default_value_t = Model::Sphere)]
+    model: Model,
+    /// The implementation to run (earth: no fixed)
+    #[arg(long, value_parser = ["reference", "f64", "f32", "fixed"])]
+    backend: String,
+    /// The cases: a CSV file whose header names the model's input columns (`-`: stdin)
+    #[arg(long, value_name = "CASES.csv")]
+    input: String,
+}
+
+pub fn run(args: &Args) -> Result<(), String> {
+    let (backend, input) = (&args.backend, &args.input);
     let text = if input == "-" {
         std::io::read_to_string(std::io::stdin()).map_err(|e| format!("reading stdin: {e}"))?
     } else {
-        std::fs::read_to_string(&input).map_err(|e| format!("reading {input}: {e}"))?
+        std::fs::read_to_string(input).map_err(|e| format!("reading {input}: {e}"))?
     };
-    let out = if model == "earth" {
-        earth::eval_csv(&backend, &text)?
-    } else {
-        eval_csv(&backend, &text)?
+    let out = match args.model {
+        Model::Earth => earth::eval_csv(backend, &text)?,
+        Model::Sphere => eval_csv(backend, &text)?,
     };
     print!("{out}");
     Ok(())
@@ -85,18 +88,31 @@ fn write_rows<const N: usize>(
     outputs: &[&str],
     mut eval_row: impl FnMut(&[String]) -> Result<[String; N], EvalError>,
 ) -> Result<String, String> {
-    let mut out = format!("{},{}\n", table.header.join(","), outputs.join(","));
-    let empty = ",".repeat(N);
+    let header: Vec<&str> = table
+        .header
+        .iter()
+        .map(String::as_str)
+        .chain(outputs.iter().copied())
+        .collect();
+    let mut out = Writer::new("", &header)?;
     for row in &table.rows {
-        let tail = match eval_row(row) {
-            Ok(nums) => format!("{},", nums.join(",")),
-            Err(EvalError::Model(e)) => format!("{empty}{}", e.name()),
-            Err(EvalError::Unparsable) => format!("{empty}unparsable_input"),
+        let (nums, error) = match eval_row(row) {
+            Ok(nums) => (nums, ""),
+            Err(EvalError::Model(e)) => (std::array::from_fn(|_| String::new()), e.name()),
+            Err(EvalError::Unparsable) => {
+                (std::array::from_fn(|_| String::new()), "unparsable_input")
+            }
             Err(EvalError::Usage(msg)) => return Err(msg),
         };
-        out.push_str(&format!("{},{tail}\n", row.join(",")));
+        let fields: Vec<&str> = row
+            .iter()
+            .chain(&nums)
+            .map(String::as_str)
+            .chain([error])
+            .collect();
+        out.row(&fields)?;
     }
-    Ok(out)
+    out.into_string()
 }
 
 enum EvalError {
@@ -191,54 +207,65 @@ bad_focal,0,0,97.98,0,645000,0,13e-6,6370000
 garbled,x,0,97.98,0,645000,0.555,13e-6,6370000
 ";
 
-    fn field<'a>(line: &'a str, header: &str, name: &str) -> &'a str {
-        let i = header.split(',').position(|h| h == name).unwrap();
-        line.split(',').nth(i).unwrap()
+    /// An output (header and rows), read back by column name.
+    pub(super) struct Out(Table);
+
+    impl Out {
+        pub(super) fn of(text: &str) -> Out {
+            Out(Table::parse(text).unwrap())
+        }
+
+        pub(super) fn rows(&self) -> usize {
+            self.0.rows.len()
+        }
+
+        /// Field `name` of row `row` (0: the first after the header).
+        pub(super) fn field(&self, row: usize, name: &str) -> &str {
+            &self.0.rows[row][self.0.columns(&[name]).unwrap()[0]]
+        }
+
+        pub(super) fn num(&self, row: usize, name: &str) -> f64 {
+            self.field(row, name).parse().unwrap()
+        }
+
+        pub(super) fn header(&self) -> String {
+            self.0.header.join(",")
+        }
     }
 
     #[test]
     fn one_row_per_input_row_with_typed_errors() {
         for backend in ["reference", "f64", "f32", "fixed"] {
-            let out = eval_csv(backend, CASES).unwrap();
-            let lines: Vec<&str> = out.lines().collect();
-            assert_eq!(lines.len(), 6);
-            let h = lines[0];
-            assert!(h.ends_with("v1_mps,v2_mps,v_mps,line_period_s,error"));
-            assert_eq!(
-                field(lines[1], h, "case"),
-                "nadir",
-                "extra columns are kept"
-            );
-            assert_eq!(field(lines[1], h, "error"), "");
-            assert_eq!(field(lines[3], h, "error"), "line_of_sight_misses_earth");
-            assert_eq!(field(lines[3], h, "v1_mps"), "");
-            assert_eq!(field(lines[4], h, "error"), "non_positive_focal_length");
-            assert_eq!(field(lines[5], h, "error"), "unparsable_input");
+            let out = Out::of(&eval_csv(backend, CASES).unwrap());
+            assert_eq!(out.rows(), 5);
+            assert!(out
+                .header()
+                .ends_with("v1_mps,v2_mps,v_mps,line_period_s,error"));
+            assert_eq!(out.field(0, "case"), "nadir", "extra columns are kept");
+            assert_eq!(out.field(0, "error"), "");
+            assert_eq!(out.field(2, "error"), "line_of_sight_misses_earth");
+            assert_eq!(out.field(2, "v1_mps"), "");
+            assert_eq!(out.field(3, "error"), "non_positive_focal_length");
+            assert_eq!(out.field(4, "error"), "unparsable_input");
         }
         assert!(eval_csv("f16", CASES).is_err());
     }
 
     #[test]
     fn backends_agree_and_period_is_pixel_over_speed() {
-        let r = eval_csv("reference", CASES).unwrap();
-        let f = eval_csv("f32", CASES).unwrap();
-        let h = r.lines().next().unwrap().to_string();
-        for (lr, lf) in r.lines().zip(f.lines()).skip(1).take(2) {
-            let (vr, vf): (f64, f64) = (
-                field(lr, &h, "v_mps").parse().unwrap(),
-                field(lf, &h, "v_mps").parse().unwrap(),
+        let r = Out::of(&eval_csv("reference", CASES).unwrap());
+        let f = Out::of(&eval_csv("f32", CASES).unwrap());
+        let x = Out::of(&eval_csv("fixed", CASES).unwrap());
+        for row in 0..2 {
+            let (vr, vf, vx) = (
+                r.num(row, "v_mps"),
+                f.num(row, "v_mps"),
+                x.num(row, "v_mps"),
             );
             assert!((vf - vr).abs() / vr < 1e-6, "{vf} vs {vr}");
-            let t: f64 = field(lr, &h, "line_period_s").parse().unwrap();
-            assert!((t - 13e-6 / vr).abs() < 1e-15 * t);
-        }
-        let x = eval_csv("fixed", CASES).unwrap();
-        for (lr, lx) in r.lines().zip(x.lines()).skip(1).take(2) {
-            let (vr, vx): (f64, f64) = (
-                field(lr, &h, "v_mps").parse().unwrap(),
-                field(lx, &h, "v_mps").parse().unwrap(),
-            );
             assert!((vx - vr).abs() / vr < 2e-6, "fixed {vx} vs {vr}");
+            let t = r.num(row, "line_period_s");
+            assert!((t - 13e-6 / vr).abs() < 1e-15 * t);
         }
     }
 }

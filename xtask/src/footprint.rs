@@ -8,6 +8,8 @@
 
 use std::path::Path;
 
+use object::{Object, ObjectSection, SectionFlags};
+
 use crate::target::build_bin_with;
 
 /// Loadable bytes of the footprint binary built for `variant`.
@@ -31,60 +33,48 @@ pub fn variant_bytes(variants: &[&str]) -> Result<Vec<u64>, String> {
         .collect()
 }
 
-/// Bytes of every section an ELF32 image loads from flash: allocated (`SHF_ALLOC`) and
+/// Bytes of every section an ELF image loads from flash: allocated (`SHF_ALLOC`) and
 /// with contents in the file (not `SHT_NOBITS`): vector table, code, constants and the
 /// initial image of `.data`.
 pub fn flash_bytes(elf: &Path) -> Result<u64, String> {
     let bytes = std::fs::read(elf).map_err(|e| format!("reading {}: {e}", elf.display()))?;
-    loadable_bytes(&bytes)
-        .ok_or_else(|| format!("{}: not a little-endian ELF32 image", elf.display()))
+    loadable_bytes(&bytes).map_err(|e| format!("{}: {e}", elf.display()))
 }
 
-fn loadable_bytes(b: &[u8]) -> Option<u64> {
-    const SHF_ALLOC: u32 = 0x2;
-    const SHT_NOBITS: u32 = 8;
-    // ELF32, little-endian.
-    if b.get(..6)? != b"\x7fELF\x01\x01" {
-        return None;
-    }
-    let u16_at = |o: usize| Some(u16::from_le_bytes(b.get(o..o + 2)?.try_into().ok()?));
-    let u32_at = |o: usize| Some(u32::from_le_bytes(b.get(o..o + 4)?.try_into().ok()?));
-    let shoff = u32_at(0x20)? as usize;
-    let shentsize = u16_at(0x2E)? as usize;
-    let shnum = u16_at(0x30)? as usize;
-    let mut total = 0u64;
-    for i in 0..shnum {
-        let sh = shoff + i * shentsize;
-        let (kind, flags, size) = (u32_at(sh + 4)?, u32_at(sh + 8)?, u32_at(sh + 20)?);
-        if flags & SHF_ALLOC != 0 && kind != SHT_NOBITS {
-            total += u64::from(size);
-        }
-    }
-    Some(total)
+fn loadable_bytes(elf: &[u8]) -> Result<u64, object::Error> {
+    let file = object::File::parse(elf)?;
+    Ok(file
+        .sections()
+        .filter(|s| {
+            let alloc = matches!(s.flags(), SectionFlags::Elf { sh_flags }
+                if sh_flags & u64::from(object::elf::SHF_ALLOC) != 0);
+            // A NOBITS section (.bss) has no bytes in the file.
+            alloc && s.file_range().is_some()
+        })
+        .map(|s| s.size())
+        .sum())
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    /// An ELF32 header and three section headers built by hand: a loadable PROGBITS
-    /// section, a NOBITS one (.bss) and a non-allocated one (debug info).
+    /// An ARM object with code, initialised data, .bss and debug info: only the first
+    /// two load from flash.
     #[test]
     fn only_allocated_sections_with_contents_count() {
-        let shoff = 52usize;
-        let mut b = vec![0u8; shoff + 3 * 40];
-        b[..6].copy_from_slice(b"\x7fELF\x01\x01");
-        b[0x20..0x24].copy_from_slice(&(shoff as u32).to_le_bytes());
-        b[0x2E..0x30].copy_from_slice(&40u16.to_le_bytes());
-        b[0x30..0x32].copy_from_slice(&3u16.to_le_bytes());
-        let sections = [(1u32, 0x6u32, 1000u32), (8, 0x3, 500), (1, 0x0, 7000)];
-        for (i, (kind, flags, size)) in sections.into_iter().enumerate() {
-            let sh = shoff + i * 40;
-            b[sh + 4..sh + 8].copy_from_slice(&kind.to_le_bytes());
-            b[sh + 8..sh + 12].copy_from_slice(&flags.to_le_bytes());
-            b[sh + 20..sh + 24].copy_from_slice(&size.to_le_bytes());
-        }
-        assert_eq!(loadable_bytes(&b), Some(1000));
-        assert_eq!(loadable_bytes(b"not an elf"), None);
+        use object::write::Object as Writer;
+        use object::{Architecture, BinaryFormat, Endianness, SectionKind};
+        let mut elf = Writer::new(BinaryFormat::Elf, Architecture::Arm, Endianness::Little);
+        let text = elf.add_section(vec![], b".text".to_vec(), SectionKind::Text);
+        elf.append_section_data(text, &[0; 1000], 4);
+        let data = elf.add_section(vec![], b".data".to_vec(), SectionKind::Data);
+        elf.append_section_data(data, &[1; 24], 4);
+        let bss = elf.add_section(vec![], b".bss".to_vec(), SectionKind::UninitializedData);
+        elf.append_section_bss(bss, 500, 4);
+        let debug = elf.add_section(vec![], b".debug_info".to_vec(), SectionKind::Debug);
+        elf.append_section_data(debug, &[2; 7000], 1);
+        assert_eq!(loadable_bytes(&elf.write().unwrap()).unwrap(), 1024);
+        assert!(loadable_bytes(b"not an elf").is_err());
     }
 }

@@ -1,6 +1,8 @@
 //! Host tasks, run as `cargo xtask <command>`.
 //!
-//! Each command is one module; `main` only dispatches.
+//! Each command is one module. A command with options declares them as a clap `Args`
+//! struct next to its `run` (one field per option, its doc comment the `--help` text);
+//! `main` only parses and dispatches. A new option is a new field there.
 
 mod accuracy;
 mod csv;
@@ -17,54 +19,107 @@ mod test_cmd;
 
 use std::process::ExitCode;
 
-const USAGE: &str = "usage: cargo xtask <command>
+use clap::{Parser, Subcommand};
 
-commands:
-  eval [--model sphere|earth] --backend <reference|f64|f32|fixed> --input CASES.csv
-                                                         evaluate cases, CSV to stdout (earth: no fixed)
-  accuracy [--quick] [--model sphere|earth]              f32/f64 error sweep against the reference
-  paper                                                  regenerate docs/paper/ (Figs. 5-8)
-  test                                                   every check CI runs
-  run [--short] [--telemetry FILE.csv] [--debug]         a pass through the firmware under QEMU (docs/telemetry.md)
-      [--plot PNG] [--every S] [--segments 0,5,9|all]
-      [--export-telemetry FILE.csv] [--demo]             (--demo: the default-scene demo)
-  bench                                                  guest instructions per evaluation (QEMU plugin)
-  report [--csv] [--cases N] [--seed S] [--no-bench]     error against run time per backend (runs the bench)
-  stability [--quick]                                    regenerate docs/stability.md and its maps
-  ellipsoid [--print]                                    round-Earth model error against WGS 84, cost of each
-                                                         simplification against the real-Earth model
-  qemu ELF                                               cargo runner: ELF under QEMU, defmt decoded
-";
+/// Host tasks of the TDI line-rate controller: evaluation, sweeps, figures, the
+/// firmware under QEMU, and every check CI runs.
+#[derive(Parser)]
+#[command(bin_name = "cargo xtask", arg_required_else_help = true)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Evaluate a model on cases from a CSV file; CSV to stdout
+    Eval(eval::Args),
+    /// f32/f64 error sweep against the reference (docs/accuracy.md)
+    Accuracy(accuracy::Args),
+    /// Regenerate docs/paper/ (Figs. 5-8; docs/paper-reproduction.md)
+    Paper(paper::Args),
+    /// Every check CI runs
+    Test,
+    /// A pass through the firmware under QEMU (docs/telemetry.md), or the demo
+    Run(target::RunArgs),
+    /// Guest instructions per evaluation, from a QEMU plugin (docs/bench.md)
+    Bench,
+    /// Error against run time per backend; runs the bench (docs/error-vs-runtime.md)
+    Report(report::Args),
+    /// Regenerate docs/stability.md and its maps
+    Stability(stability::Args),
+    /// Round-Earth model error against WGS 84, cost of each simplification (docs/earth-model.md)
+    Ellipsoid(ellipsoid::Args),
+    /// Cargo runner for thumbv7em-none-eabihf: an ELF under QEMU, its defmt log decoded
+    Qemu {
+        /// The ELF, then any arguments cargo passes on (ignored: the firmware takes none)
+        #[arg(
+            value_name = "ELF",
+            required = true,
+            num_args = 1..,
+            trailing_var_arg = true,
+            allow_hyphen_values = true
+        )]
+        args: Vec<String>,
+    },
+}
 
 fn main() -> ExitCode {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    let Some(cmd) = args.first() else {
-        eprint!("{USAGE}");
-        return ExitCode::from(2);
-    };
-    let rest = &args[1..];
-    let result = match cmd.as_str() {
-        "eval" => eval::run(rest),
-        "accuracy" => accuracy::run(rest),
-        "paper" => paper::run(rest),
-        "test" => test_cmd::run(rest),
-        "run" => target::run(rest),
-        "bench" => target::bench(rest),
-        "report" => report::run(rest),
-        "qemu" => target::qemu(rest),
-        "stability" => stability::run(rest),
-        "ellipsoid" => ellipsoid::run(rest),
-        "help" | "--help" | "-h" => {
-            print!("{USAGE}");
-            Ok(())
-        }
-        other => Err(format!("unknown command `{other}`\n{USAGE}")),
+    let result = match Cli::parse().command {
+        Command::Eval(args) => eval::run(&args),
+        Command::Accuracy(args) => accuracy::run(&args),
+        Command::Paper(args) => paper::run(&args),
+        Command::Test => test_cmd::run(),
+        Command::Run(args) => target::run(&args),
+        Command::Bench => target::bench(),
+        Command::Report(args) => report::run(&args),
+        Command::Stability(args) => stability::run(&args),
+        Command::Ellipsoid(args) => ellipsoid::run(&args),
+        Command::Qemu { args } => target::qemu(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("xtask: {e}");
             ExitCode::FAILURE
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::CommandFactory;
+
+    #[test]
+    fn the_command_line_is_consistent() {
+        Cli::command().debug_assert();
+    }
+
+    /// The spellings the docs use parse, and misspelt or out-of-range ones are refused.
+    #[test]
+    fn documented_command_lines_parse() {
+        for (line, ok) in [
+            ("eval --model earth --backend f32 --input -", true),
+            ("accuracy --model earth --quick", true),
+            ("paper --out /tmp/paper", true),
+            ("run --every 1 --segments all --plot x.png --debug", true),
+            ("run --segments 0,5,9 --telemetry t.csv --short", true),
+            ("report --csv --cases 2000 --seed 0x5EED --no-bench", true),
+            ("stability --quick", true),
+            ("ellipsoid --print", true),
+            ("qemu firmware.elf --quiet --test-threads 1", true),
+            ("test", true),
+            ("bench", true),
+            ("run --segment all", false),
+            ("run --every 0", false),
+            ("run --segments 1,x", false),
+            ("report --seed x", false),
+            ("eval --backend f16 --input -", false),
+            ("frobnicate", false),
+        ] {
+            let args = std::iter::once("xtask").chain(line.split(' '));
+            assert_eq!(Cli::try_parse_from(args).is_ok(), ok, "{line}");
         }
     }
 }

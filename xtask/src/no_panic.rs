@@ -411,96 +411,10 @@ fn decode_branch(hw1: u16, hw2: Option<u16>, addr: u64) -> (usize, Option<u64>) 
     (2, None)
 }
 
-/// A readable name for a Rust symbol: legacy (`_ZN..E`) and the plain-path cases of v0
-/// (`_R...`) mangling, enough for the functions of this report; anything else as is.
+/// A readable name for a Rust symbol (legacy or v0 mangling), without the hash;
+/// anything else as is.
 fn demangle(name: &str) -> String {
-    demangle_legacy(name)
-        .or_else(|| demangle_v0(name))
-        .unwrap_or_else(|| name.to_string())
-}
-
-fn demangle_legacy(name: &str) -> Option<String> {
-    let mut rest = name.strip_prefix("_ZN")?.strip_suffix('E')?;
-    let mut parts = Vec::new();
-    while !rest.is_empty() {
-        let digits = rest.bytes().take_while(u8::is_ascii_digit).count();
-        let len: usize = rest.get(..digits)?.parse().ok()?;
-        let part = rest.get(digits..digits.checked_add(len)?)?;
-        rest = rest.get(digits + len..)?;
-        parts.push(part);
-    }
-    // Drop the trailing hash (`h` and 16 hex digits).
-    if parts
-        .last()
-        .is_some_and(|p| p.len() == 17 && p.starts_with('h'))
-    {
-        parts.pop();
-    }
-    // A part that starts with an escape has a `_` in front of it.
-    let parts: Vec<&str> = parts
-        .iter()
-        .map(|p| p.strip_prefix("_$").map_or(*p, |_| &p[1..]))
-        .collect();
-    let mut out = parts.join("::");
-    for (from, to) in [
-        ("$LT$", "<"),
-        ("$GT$", ">"),
-        ("$RF$", "&"),
-        ("$BP$", "*"),
-        ("$SP$", "@"),
-        ("$C$", ","),
-        ("$u20$", " "),
-        ("$u27$", "'"),
-        ("$u3b$", ";"),
-        ("$u5b$", "["),
-        ("$u5d$", "]"),
-        ("$u7b$", "{"),
-        ("$u7d$", "}"),
-        ("$u7e$", "~"),
-        ("..", "::"),
-    ] {
-        out = out.replace(from, to);
-    }
-    Some(out)
-}
-
-fn demangle_v0(name: &str) -> Option<String> {
-    let mut parts = Vec::new();
-    let mut rest = name.strip_prefix("_R")?;
-    // Nested paths: N <namespace> <path> <identifier>, down to a crate root C.
-    let mut depth = 0;
-    while let Some(r) = rest.strip_prefix('N') {
-        rest = r.get(1..)?;
-        depth += 1;
-    }
-    let r = rest.strip_prefix('C')?;
-    let (krate, mut r) = v0_ident(v0_disambiguator(r)?)?;
-    parts.push(krate);
-    for _ in 0..depth {
-        let (ident, next) = v0_ident(v0_disambiguator(r)?)?;
-        parts.push(ident);
-        r = next;
-    }
-    Some(parts.join("::"))
-}
-
-/// Skips an optional `s<base-62>_` disambiguator.
-fn v0_disambiguator(s: &str) -> Option<&str> {
-    match s.strip_prefix('s') {
-        Some(r) => Some(r.split_once('_')?.1),
-        None => Some(s),
-    }
-}
-
-/// `<decimal length> [_] <bytes>`; punycode (`u` prefix) is not handled.
-fn v0_ident(s: &str) -> Option<(&str, &str)> {
-    let digits = s.bytes().take_while(u8::is_ascii_digit).count();
-    let len: usize = s.get(..digits)?.parse().ok()?;
-    let mut r = s.get(digits..)?;
-    if let Some(stripped) = r.strip_prefix('_') {
-        r = stripped;
-    }
-    Some((r.get(..len)?, r.get(len..)?))
+    format!("{:#}", rustc_demangle::demangle(name))
 }
 
 #[cfg(test)]

@@ -1,10 +1,9 @@
-//! A small line-plot renderer to PNG: title, axis labels, several labelled series,
-//! linear or logarithmic y axis, a legend.
+//! Line plots and heatmaps to PNG, drawn by `plotters` on its bitmap backend.
 //!
-//! Pure Rust and self-contained: the text is the public-domain 8x8 bitmap font of the
-//! `font8x8` crate (drawn at twice its size), the lines are anti-aliased by distance to
-//! the segment, and the image is encoded by the `png` crate. No system library or font
-//! file is needed, and the same plot gives the same bytes on every run.
+//! Reproducible by construction: the text is set in the DejaVu Sans file bundled in
+//! `xtask/fonts/` (loaded through plotters' `ab_glyph` feature, so no system font is ever
+//! looked up) and the pixels are encoded by the `png` crate without a time stamp. The
+//! same plot gives the same bytes on every run and every machine.
 //!
 //! ```ignore
 //! Plot::new("Title", "x (unit)", "y (unit)")
@@ -16,7 +15,17 @@
 // A helper for several commands: not every option is used by every build of them.
 #![allow(dead_code)]
 
+use std::ops::Range;
 use std::path::Path;
+use std::sync::OnceLock;
+
+use plotters::coord::ranged1d::{
+    BoldPoints, KeyPointHint, NoDefaultFormatting, Ranged, ValueFormatter,
+};
+use plotters::coord::types::RangedCoordf64;
+use plotters::coord::Shift;
+use plotters::element::DashedPathElement;
+use plotters::prelude::*;
 
 pub mod heatmap;
 
@@ -37,12 +46,44 @@ pub const PALETTE: [Rgb; 10] = [
     [23, 190, 207],
 ];
 
-const WHITE: Rgb = [255, 255, 255];
-const BLACK: Rgb = [0, 0, 0];
-const GRID: Rgb = [225, 225, 225];
-/// Pixels per font pixel (the font is 8x8).
-const TEXT_SCALE: i32 = 2;
-const GLYPH: i32 = 8 * TEXT_SCALE;
+const GRID: RGBColor = RGBColor(225, 225, 225);
+const GRID_MINOR: RGBColor = RGBColor(242, 242, 242);
+
+/// Text sizes (pixels per em) of the title, the axis names and the tick labels.
+const TITLE_PX: f64 = 26.0;
+const DESC_PX: f64 = 22.0;
+const LABEL_PX: f64 = 20.0;
+/// Length of the tick marks (pixels); the labels stand twice that from the axis.
+const TICK_PX: u32 = 6;
+/// Room around the figure and between its parts (pixels).
+const MARGIN: u32 = 14;
+/// At most this many labelled ticks per axis (plotters picks 1-2-5 steps within it).
+const MAX_TICKS: usize = 10;
+
+/// The bundled font, registered with plotters as its default family once per process.
+fn font_ready() -> Result<(), String> {
+    static READY: OnceLock<Result<(), String>> = OnceLock::new();
+    READY
+        .get_or_init(|| {
+            const TTF: &[u8] = include_bytes!("../fonts/DejaVuSans.ttf");
+            plotters::style::register_font("sans-serif", FontStyle::Normal, TTF)
+                .map_err(|_| "the bundled font xtask/fonts/DejaVuSans.ttf is unreadable".into())
+        })
+        .clone()
+}
+
+fn text(px: f64) -> TextStyle<'static> {
+    TextStyle::from(("sans-serif", px).into_font()).color(&BLACK)
+}
+
+fn rgb(c: Rgb) -> RGBColor {
+    RGBColor(c[0], c[1], c[2])
+}
+
+/// Any plotters error as our error text.
+fn drawing<E: std::fmt::Debug>(e: E) -> String {
+    format!("plotting: {e:?}")
+}
 
 /// One labelled curve.
 #[derive(Clone, Debug)]
@@ -53,7 +94,7 @@ pub struct Series {
     /// None: the next palette colour.
     pub colour: Option<Rgb>,
     pub dashed: bool,
-    /// Line width in pixels.
+    /// Line width in pixels (drawn to the nearest whole pixel).
     pub width: f64,
 }
 
@@ -88,6 +129,11 @@ impl Series {
         self.width = w;
         self
     }
+
+    fn style(&self, index: usize) -> ShapeStyle {
+        let colour = self.colour.unwrap_or(PALETTE[index % PALETTE.len()]);
+        rgb(colour).stroke_width(self.width.round().max(1.0) as u32)
+    }
 }
 
 /// Where the legend box goes inside the plot area.
@@ -109,7 +155,7 @@ pub struct Plot {
     pub log_y: bool,
     pub width: u32,
     pub height: u32,
-    /// None: from the data, widened to whole tick steps.
+    /// None: the data's extent (y with a margin of 5 %).
     pub x_range: Option<(f64, f64)>,
     pub y_range: Option<(f64, f64)>,
     pub legend: Legend,
@@ -165,509 +211,451 @@ impl Plot {
 
     /// Renders and encodes as an 8-bit RGB PNG.
     pub fn to_png(&self) -> Result<Vec<u8>, String> {
-        let canvas = self.render()?;
-        canvas.to_png()
+        encode_png(self.width, self.height, &self.render()?)
     }
 
     /// Renders and writes a PNG file.
     pub fn save(&self, path: &Path) -> Result<(), String> {
-        let bytes = self.to_png()?;
-        std::fs::write(path, bytes).map_err(|e| format!("writing {}: {e}", path.display()))
+        write_png(path, &self.to_png()?)
     }
 
-    /// Renders to an RGB canvas.
-    pub fn render(&self) -> Result<Canvas, String> {
-        if self.width < 200 || self.height < 150 || self.width > 8000 || self.height > 8000 {
-            return Err(format!(
-                "plot size {}x{} out of range",
-                self.width, self.height
-            ));
+    /// A y value as plotted: log10 of it on a log axis; None where it cannot be drawn.
+    fn plotted_y(&self, y: f64) -> Option<f64> {
+        match self.log_y {
+            true if y > 0.0 => Some(y.log10()).filter(|v| v.is_finite()),
+            true => None,
+            false => Some(y).filter(|v| v.is_finite()),
         }
-        let usable = |y: f64| y.is_finite() && (!self.log_y || y > 0.0);
-        let (mut xs, mut ys) = (Vec::new(), Vec::new());
-        for s in &self.series {
-            for &(x, y) in &s.points {
-                if x.is_finite() && usable(y) {
-                    xs.push(x);
-                    ys.push(if self.log_y { y.log10() } else { y });
-                }
-            }
-        }
-        let x_axis = match self.x_range {
-            Some((lo, hi)) => Axis::linear_fixed(lo, hi)?,
-            None => Axis::linear_auto(&xs)?,
+    }
+
+    fn axes(&self) -> Result<(Axis, Axis), String> {
+        let points = || self.series.iter().flat_map(|s| &s.points);
+        let drawable = || {
+            points().filter_map(|&(x, y)| Some((x, self.plotted_y(y)?)).filter(|p| p.0.is_finite()))
         };
-        let y_axis = match (self.y_range, self.log_y) {
-            (Some((lo, hi)), false) => Axis::linear_fixed(lo, hi)?,
-            (None, false) => Axis::linear_auto(&ys)?,
+        let x = match self.x_range {
+            Some((lo, hi)) => Axis::linear(lo, hi)?,
+            None => {
+                let (lo, hi) = extent(drawable().map(|p| p.0)).ok_or("no finite data to plot")?;
+                Axis::linear(lo, hi)?
+            }
+        };
+        let y = match (self.y_range, self.log_y) {
+            (Some((lo, hi)), false) => Axis::linear(lo, hi)?,
             (Some((lo, hi)), true) => {
                 if !(lo > 0.0 && hi > lo) {
                     return Err("log y range must be positive".into());
                 }
-                Axis::log(lo.log10(), hi.log10())
+                Axis::decades(lo.log10(), hi.log10())?
             }
-            (None, true) => {
-                let (lo, hi) = min_max(&ys).ok_or("no positive data for a log axis")?;
-                let pad = ((hi - lo) * 0.05).max(0.02);
-                Axis::log(lo - pad, hi + pad)
+            (None, log) => {
+                let (lo, hi) = extent(drawable().map(|p| p.1)).ok_or(if log {
+                    "no positive data for a log axis"
+                } else {
+                    "no finite data to plot"
+                })?;
+                let pad = 0.05 * (hi - lo);
+                if log {
+                    Axis::decades(lo - pad.max(0.02), hi + pad.max(0.02))?
+                } else {
+                    Axis::linear(lo - pad, hi + pad)?
+                }
             }
         };
-
-        // Layout, all in pixels.
-        let (w, h) = (self.width as i32, self.height as i32);
-        let y_tick_chars = y_axis.ticks.iter().map(|t| t.1.len()).max().unwrap_or(1) as i32;
-        let left = 12 + GLYPH + 12 + y_tick_chars * GLYPH + 10;
-        // Room for half of the last x tick label.
-        let last_x_chars = x_axis.ticks.last().map_or(0, |t| t.1.len()) as i32;
-        let right = (last_x_chars * GLYPH / 2 + 12).max(30);
-        let top = 14 + GLYPH + 18;
-        let bottom = 10 + GLYPH + 12 + GLYPH + 14;
-        let (px0, px1, py0, py1) = (left, w - right, top, h - bottom);
-        if px1 - px0 < 50 || py1 - py0 < 50 {
-            return Err("plot area too small for the labels".into());
-        }
-        let map_x =
-            |x: f64| px0 as f64 + (x - x_axis.lo) / (x_axis.hi - x_axis.lo) * (px1 - px0) as f64;
-        let map_y =
-            |y: f64| py1 as f64 - (y - y_axis.lo) / (y_axis.hi - y_axis.lo) * (py1 - py0) as f64;
-
-        let mut c = Canvas::new(self.width, self.height);
-        // Grid and ticks.
-        for (v, label) in &x_axis.ticks {
-            let x = map_x(*v).round() as i32;
-            c.vline(x, py0, py1, GRID);
-            c.vline(x, py1, py1 + 5, BLACK);
-            let tw = label.len() as i32 * GLYPH;
-            c.text(x - tw / 2, py1 + 10, label, BLACK);
-        }
-        for &v in &y_axis.minor {
-            let y = map_y(v).round() as i32;
-            c.hline(px0, px1, y, [240, 240, 240]);
-            c.hline(px0 - 3, px0, y, BLACK);
-        }
-        for (v, label) in &y_axis.ticks {
-            let y = map_y(*v).round() as i32;
-            c.hline(px0, px1, y, GRID);
-            c.hline(px0 - 6, px0, y, BLACK);
-            let tw = label.len() as i32 * GLYPH;
-            c.text(px0 - 10 - tw, y - GLYPH / 2, label, BLACK);
-        }
-        // Series, clipped to the plot area.
-        let clip = (px0 as f64, py0 as f64, px1 as f64, py1 as f64);
-        for (i, s) in self.series.iter().enumerate() {
-            let colour = s.colour.unwrap_or(PALETTE[i % PALETTE.len()]);
-            let mut path: Vec<(f64, f64)> = Vec::new();
-            let flush = |path: &mut Vec<(f64, f64)>, c: &mut Canvas| {
-                c.polyline(path, s.width, colour, s.dashed, clip);
-                path.clear();
-            };
-            for &(x, y) in &s.points {
-                if x.is_finite() && usable(y) {
-                    let yv = if self.log_y { y.log10() } else { y };
-                    path.push((map_x(x), map_y(yv)));
-                } else {
-                    flush(&mut path, &mut c);
-                }
-            }
-            flush(&mut path, &mut c);
-        }
-        // Frame.
-        c.hline(px0, px1, py0, BLACK);
-        c.hline(px0, px1, py1, BLACK);
-        c.vline(px0, py0, py1, BLACK);
-        c.vline(px1, py0, py1, BLACK);
-        // Title and axis labels.
-        let tw = self.title.len() as i32 * GLYPH;
-        c.text((w - tw) / 2, 14, &self.title, BLACK);
-        let xw = self.x_label.len() as i32 * GLYPH;
-        c.text((px0 + px1 - xw) / 2, h - 14 - GLYPH, &self.x_label, BLACK);
-        let yw = self.y_label.len() as i32 * GLYPH;
-        c.text_up(12, (py0 + py1 + yw) / 2, &self.y_label, BLACK);
-        self.draw_legend(&mut c, (px0, py0, px1, py1));
-        Ok(c)
+        Ok((x, y))
     }
 
-    fn draw_legend(&self, c: &mut Canvas, (px0, py0, px1, py1): (i32, i32, i32, i32)) {
-        let entries: Vec<(usize, &Series)> = self
-            .series
-            .iter()
-            .enumerate()
-            .filter(|(_, s)| !s.label.is_empty())
-            .collect();
-        if entries.is_empty() || self.legend == Legend::None {
-            return;
-        }
-        let sample = 40;
-        let row = GLYPH + 8;
-        let chars = entries
-            .iter()
-            .map(|(_, s)| s.label.len())
-            .max()
-            .unwrap_or(0) as i32;
-        let bw = 10 + sample + 8 + chars * GLYPH + 10;
-        let bh = 8 + row * entries.len() as i32;
-        let (bx, by) = match self.legend {
-            Legend::TopRight => (px1 - 10 - bw, py0 + 10),
-            Legend::TopLeft => (px0 + 10, py0 + 10),
-            Legend::BottomRight => (px1 - 10 - bw, py1 - 10 - bh),
-            Legend::BottomLeft | Legend::None => (px0 + 10, py1 - 10 - bh),
-        };
-        c.fill_rect(bx, by, bw, bh, WHITE);
-        c.hline(bx, bx + bw, by, BLACK);
-        c.hline(bx, bx + bw, by + bh, BLACK);
-        c.vline(bx, by, by + bh, BLACK);
-        c.vline(bx + bw, by, by + bh, BLACK);
-        let clip = (0.0, 0.0, c.width as f64, c.height as f64);
-        for (k, (i, s)) in entries.iter().enumerate() {
-            let colour = s.colour.unwrap_or(PALETTE[i % PALETTE.len()]);
-            let y = by + 8 + row * k as i32 + GLYPH / 2;
-            let seg = [
-                ((bx + 10) as f64, y as f64),
-                ((bx + 10 + sample) as f64, y as f64),
-            ];
-            c.polyline(&seg, s.width, colour, s.dashed, clip);
-            c.text(bx + 10 + sample + 8, y - GLYPH / 2, &s.label, BLACK);
-        }
-    }
-}
-
-fn min_max(v: &[f64]) -> Option<(f64, f64)> {
-    let mut it = v.iter().copied();
-    let first = it.next()?;
-    Some(it.fold((first, first), |(lo, hi), x| (lo.min(x), hi.max(x))))
-}
-
-/// An axis in plotted units (log10 of the value for a log axis).
-struct Axis {
-    lo: f64,
-    hi: f64,
-    /// (position, label)
-    ticks: Vec<(f64, String)>,
-    /// Unlabelled minor positions (log axis only).
-    minor: Vec<f64>,
-}
-
-/// A "nice" step (1, 2 or 5 times a power of ten) for about `target` intervals.
-fn nice_step(span: f64, target: f64) -> f64 {
-    let raw = span / target;
-    let mag = 10f64.powf(raw.log10().floor());
-    let r = raw / mag;
-    let m = if r < 1.5 {
-        1.0
-    } else if r < 3.0 {
-        2.0
-    } else if r < 7.0 {
-        5.0
-    } else {
-        10.0
-    };
-    m * mag
-}
-
-fn decimals(step: f64) -> usize {
-    let d = -(step.log10() + 1e-9).floor();
-    if d > 0.0 {
-        d as usize
-    } else {
-        0
-    }
-}
-
-impl Axis {
-    fn linear_auto(data: &[f64]) -> Result<Axis, String> {
-        let (mut lo, mut hi) = min_max(data).ok_or("no finite data to plot")?;
-        if hi - lo < 1e-12 * (1.0 + lo.abs()) {
-            lo -= 0.5 * (1.0 + lo.abs());
-            hi += 0.5 * (1.0 + hi.abs());
-        }
-        let step = nice_step(hi - lo, 6.0);
-        let lo = (lo / step - 1e-9).floor() * step;
-        let hi = (hi / step + 1e-9).ceil() * step;
-        Ok(Axis::linear_with_step(lo, hi, step))
-    }
-
-    fn linear_fixed(lo: f64, hi: f64) -> Result<Axis, String> {
-        if !(lo.is_finite() && hi.is_finite() && hi > lo) {
-            return Err(format!("bad axis range [{lo}, {hi}]"));
-        }
-        Ok(Axis::linear_with_step(lo, hi, nice_step(hi - lo, 6.0)))
-    }
-
-    fn linear_with_step(lo: f64, hi: f64, step: f64) -> Axis {
-        let d = decimals(step);
-        let mut ticks = Vec::new();
-        let mut k = (lo / step - 1e-9).ceil() as i64;
-        loop {
-            let v = k as f64 * step;
-            if v > hi + step * 1e-9 {
-                break;
-            }
-            // Avoid "-0.0".
-            let v = if v.abs() < step * 1e-9 { 0.0 } else { v };
-            ticks.push((v, format!("{v:.d$}")));
-            k += 1;
-        }
-        Axis {
-            lo,
-            hi,
-            ticks,
-            minor: Vec::new(),
-        }
-    }
-
-    /// A log10 axis from 10^lo to 10^hi: labelled decades, 2 and 5 as well when the
-    /// span is short, the other integers as minor lines.
-    fn log(lo: f64, hi: f64) -> Axis {
-        let (d0, d1) = (lo.floor() as i32, hi.ceil() as i32);
-        let few = hi - lo < 2.5;
-        let mut ticks = Vec::new();
-        let mut minor = Vec::new();
-        for d in d0..=d1 {
-            for m in 1..10 {
-                let v = m as f64 * 10f64.powi(d);
-                let p = v.log10();
-                if p < lo - 1e-9 || p > hi + 1e-9 {
-                    continue;
-                }
-                if m == 1 || (few && (m == 2 || m == 5)) {
-                    ticks.push((p, log_label(m, d)));
-                } else {
-                    minor.push(p);
-                }
-            }
-        }
-        Axis {
-            lo,
-            hi,
-            ticks,
-            minor,
-        }
-    }
-}
-
-fn log_label(m: i32, d: i32) -> String {
-    if (-3..=4).contains(&d) {
-        let v = m as f64 * 10f64.powi(d);
-        let dec = if d < 0 { (-d) as usize } else { 0 };
-        format!("{v:.dec$}")
-    } else if m == 1 {
-        format!("1e{d}")
-    } else {
-        format!("{m}e{d}")
-    }
-}
-
-/// An RGB raster.
-pub struct Canvas {
-    pub width: u32,
-    pub height: u32,
-    pub rgb: Vec<u8>,
-}
-
-impl Canvas {
-    pub fn new(width: u32, height: u32) -> Self {
-        Canvas {
-            width,
-            height,
-            rgb: vec![255; width as usize * height as usize * 3],
-        }
-    }
-
-    /// Mixes `colour` into pixel (x, y) with weight `alpha` in [0, 1].
-    fn blend(&mut self, x: i32, y: i32, colour: Rgb, alpha: f64) {
-        if x < 0 || y < 0 || x >= self.width as i32 || y >= self.height as i32 || alpha <= 0.0 {
-            return;
-        }
-        let a = alpha.min(1.0);
-        let i = (y as usize * self.width as usize + x as usize) * 3;
-        for (px, &c) in self.rgb[i..i + 3].iter_mut().zip(colour.iter()) {
-            let old = *px as f64;
-            *px = (old + (c as f64 - old) * a).round() as u8;
-        }
-    }
-
-    fn set(&mut self, x: i32, y: i32, colour: Rgb) {
-        self.blend(x, y, colour, 1.0);
-    }
-
-    fn hline(&mut self, x0: i32, x1: i32, y: i32, colour: Rgb) {
-        for x in x0.min(x1)..=x0.max(x1) {
-            self.set(x, y, colour);
-        }
-    }
-
-    fn vline(&mut self, x: i32, y0: i32, y1: i32, colour: Rgb) {
-        for y in y0.min(y1)..=y0.max(y1) {
-            self.set(x, y, colour);
-        }
-    }
-
-    fn fill_rect(&mut self, x: i32, y: i32, w: i32, h: i32, colour: Rgb) {
-        for yy in y..=y + h {
-            self.hline(x, x + w, yy, colour);
-        }
-    }
-
-    /// An anti-aliased polyline of width `width`, optionally dashed (dash length
-    /// measured along the path), clipped to (x0, y0, x1, y1).
-    fn polyline(
-        &mut self,
-        pts: &[(f64, f64)],
-        width: f64,
-        colour: Rgb,
-        dashed: bool,
-        clip: (f64, f64, f64, f64),
-    ) {
-        let half = 0.5 * width;
-        let (dash_on, dash_period) = (10.0, 16.0);
-        if pts.len() == 1 {
-            let (x, y) = pts[0];
-            self.disc(x, y, half + 0.5, colour, clip);
-            return;
-        }
-        let mut s0 = 0.0;
-        // Each pixel takes the largest coverage over all segments, so that joints are
-        // not painted twice.
-        let mut cover: std::collections::BTreeMap<(i32, i32), f64> = Default::default();
-        for w in pts.windows(2) {
-            let ((ax, ay), (bx, by)) = (w[0], w[1]);
-            let (dx, dy) = (bx - ax, by - ay);
-            let len2 = dx * dx + dy * dy;
-            let len = len2.sqrt();
-            let r = half + 1.0;
-            let xa = (ax.min(bx) - r).floor().max(clip.0) as i32;
-            let xb = (ax.max(bx) + r).ceil().min(clip.2) as i32;
-            let ya = (ay.min(by) - r).floor().max(clip.1) as i32;
-            let yb = (ay.max(by) + r).ceil().min(clip.3) as i32;
-            for y in ya..=yb {
-                for x in xa..=xb {
-                    let (px, py) = (x as f64, y as f64);
-                    let t = if len2 > 0.0 {
-                        (((px - ax) * dx + (py - ay) * dy) / len2).clamp(0.0, 1.0)
+    /// The RGB pixels, row by row.
+    fn render(&self) -> Result<Vec<u8>, String> {
+        check_size(self.width, self.height, (200, 150))?;
+        let (x_axis, y_axis) = self.axes()?;
+        render_rgb((self.width, self.height), &self.title, |_, body| {
+            let names = (self.x_label.as_str(), self.y_label.as_str());
+            let mut chart = labelled_chart(body, (&x_axis, &y_axis), names, true)?;
+            frame(&chart)?;
+            for (i, s) in self.series.iter().enumerate() {
+                let style = s.style(i);
+                for (k, run) in self.runs(s).into_iter().enumerate() {
+                    let labelled = k == 0 && !s.label.is_empty();
+                    if s.dashed {
+                        let a = chart
+                            .draw_series([DashedPathElement::new(run, 10, 6, style)])
+                            .map_err(drawing)?;
+                        if labelled {
+                            a.label(&s.label).legend(move |(x, y)| {
+                                DashedPathElement::new([(x, y), (x + 30, y)], 10, 6, style)
+                            });
+                        }
                     } else {
-                        0.0
-                    };
-                    if dashed && (s0 + t * len) % dash_period > dash_on {
-                        continue;
-                    }
-                    let (qx, qy) = (ax + t * dx - px, ay + t * dy - py);
-                    let d = (qx * qx + qy * qy).sqrt();
-                    let a = (half + 0.5 - d).clamp(0.0, 1.0);
-                    if a > 0.0 {
-                        let e = cover.entry((y, x)).or_insert(0.0);
-                        *e = e.max(a);
-                    }
-                }
-            }
-            s0 += len;
-        }
-        for ((y, x), a) in cover {
-            self.blend(x, y, colour, a);
-        }
-    }
-
-    fn disc(&mut self, cx: f64, cy: f64, r: f64, colour: Rgb, clip: (f64, f64, f64, f64)) {
-        let xa = (cx - r - 1.0).floor().max(clip.0) as i32;
-        let xb = (cx + r + 1.0).ceil().min(clip.2) as i32;
-        let ya = (cy - r - 1.0).floor().max(clip.1) as i32;
-        let yb = (cy + r + 1.0).ceil().min(clip.3) as i32;
-        for y in ya..=yb {
-            for x in xa..=xb {
-                let d = ((x as f64 - cx).powi(2) + (y as f64 - cy).powi(2)).sqrt();
-                self.blend(x, y, colour, (r + 0.5 - d).clamp(0.0, 1.0));
-            }
-        }
-    }
-
-    /// The 8x8 glyph of `ch` (printable ASCII; anything else is drawn as '?').
-    fn glyph(ch: char) -> [u8; 8] {
-        let code = if ch.is_ascii() && !ch.is_ascii_control() {
-            ch as usize
-        } else {
-            '?' as usize
-        };
-        font8x8::legacy::BASIC_LEGACY[code]
-    }
-
-    /// Text left to right with its top-left corner at (x, y).
-    fn text(&mut self, x: i32, y: i32, s: &str, colour: Rgb) {
-        self.glyph_pixels(s, colour, |i, gx, gy| (x + i * GLYPH + gx, y + gy));
-    }
-
-    /// Text rotated a quarter turn anticlockwise (reading upward), starting at the
-    /// bottom-left corner (x, y).
-    fn text_up(&mut self, x: i32, y: i32, s: &str, colour: Rgb) {
-        // Glyph column gx goes up, glyph row gy goes right.
-        self.glyph_pixels(s, colour, |i, gx, gy| (x + gy, y - i * GLYPH - gx));
-    }
-
-    /// Sets every pixel of the glyphs of `s`, scaled by TEXT_SCALE; `place` maps
-    /// (character index, scaled glyph column, scaled glyph row) to the canvas.
-    fn glyph_pixels(&mut self, s: &str, colour: Rgb, place: impl Fn(i32, i32, i32) -> (i32, i32)) {
-        for (i, ch) in s.chars().enumerate() {
-            let g = Self::glyph(ch);
-            for (gy, bits) in g.iter().enumerate() {
-                for gx in 0..8 {
-                    if bits & (1 << gx) != 0 {
-                        for sy in 0..TEXT_SCALE {
-                            for sx in 0..TEXT_SCALE {
-                                let (px, py) = place(
-                                    i as i32,
-                                    gx * TEXT_SCALE + sx,
-                                    gy as i32 * TEXT_SCALE + sy,
-                                );
-                                self.set(px, py, colour);
-                            }
+                        let a = chart
+                            .draw_series([PathElement::new(run, style)])
+                            .map_err(drawing)?;
+                        if labelled {
+                            a.label(&s.label).legend(move |(x, y)| {
+                                PathElement::new([(x, y), (x + 30, y)], style)
+                            });
                         }
                     }
                 }
             }
-        }
+            let position = match self.legend {
+                Legend::TopRight => SeriesLabelPosition::UpperRight,
+                Legend::TopLeft => SeriesLabelPosition::UpperLeft,
+                Legend::BottomRight => SeriesLabelPosition::LowerRight,
+                Legend::BottomLeft => SeriesLabelPosition::LowerLeft,
+                Legend::None => SeriesLabelPosition::Coordinate(0, 0),
+            };
+            let labelled = self.series.iter().any(|s| !s.label.is_empty());
+            if labelled && self.legend != Legend::None {
+                chart
+                    .configure_series_labels()
+                    .position(position)
+                    .margin(10)
+                    .legend_area_size(40)
+                    .label_font(text(LABEL_PX))
+                    .background_style(WHITE)
+                    .border_style(BLACK)
+                    .draw()
+                    .map_err(drawing)?;
+            }
+            Ok(())
+        })
     }
 
-    /// Encodes as an 8-bit RGB PNG (no time stamp: the bytes depend only on the pixels).
-    pub fn to_png(&self) -> Result<Vec<u8>, String> {
-        let mut out = Vec::new();
-        {
-            let mut enc = png::Encoder::new(&mut out, self.width, self.height);
-            enc.set_color(png::ColorType::Rgb);
-            enc.set_depth(png::BitDepth::Eight);
-            enc.set_compression(png::Compression::High);
-            let mut w = enc.write_header().map_err(|e| format!("png: {e}"))?;
-            w.write_image_data(&self.rgb)
-                .map_err(|e| format!("png: {e}"))?;
-            w.finish().map_err(|e| format!("png: {e}"))?;
+    /// The drawable stretches of a series, in plotted units.
+    fn runs(&self, s: &Series) -> Vec<Vec<(f64, f64)>> {
+        let mut runs = vec![Vec::new()];
+        for &(x, y) in &s.points {
+            match self.plotted_y(y).filter(|_| x.is_finite()) {
+                Some(y) => runs.last_mut().into_iter().for_each(|r| r.push((x, y))),
+                None => runs.push(Vec::new()),
+            }
         }
-        Ok(out)
+        runs.retain(|r| !r.is_empty());
+        runs
     }
+}
+
+/// The smallest and largest of `values`.
+fn extent(values: impl Iterator<Item = f64>) -> Option<(f64, f64)> {
+    values.fold(None, |acc, v| match acc {
+        None => Some((v, v)),
+        Some((lo, hi)) => Some((v.min(lo), v.max(hi))),
+    })
+}
+
+fn check_size(width: u32, height: u32, (min_w, min_h): (u32, u32)) -> Result<(), String> {
+    if width < min_w || height < min_h || width > 8000 || height > 8000 {
+        return Err(format!("plot size {width}x{height} out of range"));
+    }
+    Ok(())
+}
+
+/// Height under the plot: one line of tick labels and one of the axis name.
+const X_LABEL_AREA: u32 = (LABEL_PX + DESC_PX + 24.0) as u32;
+
+/// Width left of the plot: the widest tick label and the (rotated) axis name.
+fn y_label_area<DB: DrawingBackend>(
+    area: &DrawingArea<DB, plotters::coord::Shift>,
+    axis: &Axis,
+) -> Result<u32, String> {
+    let mut widest = 0;
+    for v in axis.key_points(BoldPoints(MAX_TICKS)) {
+        let (w, _) = area
+            .estimate_text_size(&axis.label(v), &text(LABEL_PX))
+            .map_err(drawing)?;
+        widest = widest.max(w);
+    }
+    Ok(widest + DESC_PX as u32 + 24)
+}
+
+/// The drawing area of a figure (RGB pixels in memory).
+type Area<'a> = DrawingArea<BitMapBackend<'a>, Shift>;
+
+/// A figure of `width` x `height` pixels with `title` on top: `draw` gets the whole
+/// figure and the part under the title. Returns the RGB pixels, row by row.
+fn render_rgb(
+    (width, height): (u32, u32),
+    title: &str,
+    draw: impl FnOnce(&Area<'_>, &Area<'_>) -> Result<(), String>,
+) -> Result<Vec<u8>, String> {
+    font_ready()?;
+    let mut pixels = vec![255u8; width as usize * height as usize * 3];
+    {
+        let root = BitMapBackend::with_buffer(&mut pixels, (width, height)).into_drawing_area();
+        let body = root.titled(title, text(TITLE_PX)).map_err(drawing)?;
+        draw(&root, &body)?;
+        root.present().map_err(drawing)?;
+    }
+    Ok(pixels)
+}
+
+/// A chart of `x` against `y` on `area`, both axes named (`names`) with tick labels and
+/// tick marks; with `grid`, grid lines at the ticks (minor ones too on a decade axis).
+fn labelled_chart<'a, 'b>(
+    area: &'a Area<'b>,
+    (x, y): (&Axis, &Axis),
+    (x_name, y_name): (&str, &str),
+    grid: bool,
+) -> Result<ChartContext<'a, BitMapBackend<'b>, Cartesian2d<Axis, Axis>>, String> {
+    let mut chart = ChartBuilder::on(area)
+        .margin(MARGIN)
+        .margin_right(right_margin(area, x)?)
+        .x_label_area_size(X_LABEL_AREA)
+        .y_label_area_size(y_label_area(area, y)?)
+        .build_cartesian_2d(x.clone(), y.clone())
+        .map_err(drawing)?;
+    let (x_fmt, y_fmt) = (|v: &f64| x.label(*v), |v: &f64| y.label(*v));
+    let mut mesh = chart.configure_mesh();
+    mesh.x_desc(x_name)
+        .y_desc(y_name)
+        .x_labels(MAX_TICKS)
+        .y_labels(MAX_TICKS)
+        .x_label_formatter(&x_fmt)
+        .y_label_formatter(&y_fmt)
+        .label_style(text(LABEL_PX))
+        .axis_desc_style(text(DESC_PX))
+        .set_all_tick_mark_size(TICK_PX);
+    if grid {
+        mesh.bold_line_style(GRID)
+            .light_line_style(GRID_MINOR)
+            .max_light_lines(1);
+    } else {
+        mesh.disable_mesh();
+    }
+    mesh.draw().map_err(drawing)?;
+    Ok(chart)
+}
+
+/// Room right of the plot for half of the last x tick label, centred on the frame.
+fn right_margin<DB: DrawingBackend>(
+    area: &DrawingArea<DB, plotters::coord::Shift>,
+    x_axis: &Axis,
+) -> Result<u32, String> {
+    let last = x_axis.key_points(BoldPoints(MAX_TICKS)).pop();
+    let (w, _) = area
+        .estimate_text_size(
+            &last.map_or(String::new(), |v| x_axis.label(v)),
+            &text(LABEL_PX),
+        )
+        .map_err(drawing)?;
+    Ok(MARGIN.max(w / 2 + 6))
+}
+
+/// A black frame around the plot area (the mesh draws only the left and bottom axes).
+fn frame<DB: DrawingBackend>(
+    chart: &ChartContext<'_, DB, Cartesian2d<Axis, Axis>>,
+) -> Result<(), String> {
+    let (x, y) = (chart.x_range(), chart.y_range());
+    chart
+        .plotting_area()
+        .draw(&Rectangle::new([(x.start, y.start), (x.end, y.end)], BLACK))
+        .map_err(drawing)
+}
+
+/// An axis in plotted units: the value itself, or log10 of it on a decade axis, whose
+/// ticks fall on decades (also on 2 and 5 times a decade when it spans few) with the
+/// other whole multiples as minor grid lines. Linear ticks are plotters' own.
+#[derive(Clone, Debug)]
+pub struct Axis {
+    lo: f64,
+    hi: f64,
+    decades: bool,
+}
+
+impl Axis {
+    pub fn linear(lo: f64, hi: f64) -> Result<Axis, String> {
+        Axis::new(lo, hi, false)
+    }
+
+    pub fn decades(lo: f64, hi: f64) -> Result<Axis, String> {
+        Axis::new(lo, hi, true)
+    }
+
+    fn new(lo: f64, hi: f64, decades: bool) -> Result<Axis, String> {
+        if !(lo.is_finite() && hi.is_finite()) {
+            return Err(format!("bad axis range [{lo}, {hi}]"));
+        }
+        // A flat extent (one value) still gets an axis around it.
+        let (lo, hi) = if hi - lo > 1e-12 * (1.0 + lo.abs()) {
+            (lo, hi)
+        } else if hi >= lo {
+            (lo - 0.5 * (1.0 + lo.abs()), hi + 0.5 * (1.0 + hi.abs()))
+        } else {
+            return Err(format!("bad axis range [{lo}, {hi}]"));
+        };
+        Ok(Axis { lo, hi, decades })
+    }
+
+    /// Labelled tick positions, and the minor ones too when `minor`.
+    fn ticks(&self, max: usize, minor: bool) -> Vec<f64> {
+        if !self.decades {
+            let plain = RangedCoordf64::from(self.lo..self.hi);
+            return plain.key_points(BoldPoints(max));
+        }
+        let few = self.hi - self.lo < 2.5;
+        let mut ticks = Vec::new();
+        for d in self.lo.floor() as i32..=self.hi.ceil() as i32 {
+            for m in 1..10 {
+                let p = (m as f64).log10() + d as f64;
+                let inside = p >= self.lo - 1e-9 && p <= self.hi + 1e-9;
+                let labelled = m == 1 || (few && (m == 2 || m == 5));
+                if inside && (labelled || minor) {
+                    ticks.push(p);
+                }
+            }
+        }
+        ticks
+    }
+
+    /// The text of the tick at `v`: on a decade axis the value 10^v (plain from 0.001 to
+    /// 10000, as 1e-5 beyond); on a linear one with the decimals its tick step needs.
+    pub fn label(&self, v: f64) -> String {
+        if self.decades {
+            let d = v.floor();
+            let m = 10f64.powf(v - d).round() as i32;
+            let (m, d) = if m == 10 {
+                (1, d as i32 + 1)
+            } else {
+                (m, d as i32)
+            };
+            return if (-3..=4).contains(&d) {
+                let dec = (-d).max(0) as usize;
+                format!("{:.dec$}", m as f64 * 10f64.powi(d))
+            } else {
+                format!("{m}e{d}")
+            };
+        }
+        let ticks = self.ticks(MAX_TICKS, false);
+        let step = ticks
+            .windows(2)
+            .map(|w| w[1] - w[0])
+            .fold(f64::INFINITY, f64::min);
+        let dec = if step.is_finite() {
+            (-(step.log10() + 1e-9).floor()).max(0.0) as usize
+        } else {
+            0
+        };
+        // Avoid "-0.0".
+        let v = if v.abs() < 1e-9 * (self.hi - self.lo) {
+            0.0
+        } else {
+            v
+        };
+        format!("{v:.dec$}")
+    }
+}
+
+impl Ranged for Axis {
+    type FormatOption = NoDefaultFormatting;
+    type ValueType = f64;
+
+    fn map(&self, v: &f64, (from, to): (i32, i32)) -> i32 {
+        let t = (v - self.lo) / (self.hi - self.lo);
+        (f64::from(from) + t * f64::from(to - from)).round() as i32
+    }
+
+    fn key_points<H: KeyPointHint>(&self, hint: H) -> Vec<f64> {
+        let minor = hint.weight().allow_light_points() && hint.max_num_points() > 0;
+        self.ticks(hint.bold_points(), minor)
+    }
+
+    fn range(&self) -> Range<f64> {
+        self.lo..self.hi
+    }
+}
+
+impl ValueFormatter<f64> for Axis {
+    fn format_ext(&self, v: &f64) -> String {
+        self.label(*v)
+    }
+}
+
+/// Encodes RGB pixels as an 8-bit RGB PNG (no time stamp: the bytes depend only on the
+/// pixels).
+fn encode_png(width: u32, height: u32, rgb: &[u8]) -> Result<Vec<u8>, String> {
+    let mut out = Vec::new();
+    let mut enc = png::Encoder::new(&mut out, width, height);
+    enc.set_color(png::ColorType::Rgb);
+    enc.set_depth(png::BitDepth::Eight);
+    enc.set_compression(png::Compression::High);
+    let mut w = enc.write_header().map_err(|e| format!("png: {e}"))?;
+    w.write_image_data(rgb).map_err(|e| format!("png: {e}"))?;
+    w.finish().map_err(|e| format!("png: {e}"))?;
+    Ok(out)
+}
+
+fn write_png(path: &Path, bytes: &[u8]) -> Result<(), String> {
+    std::fs::write(path, bytes).map_err(|e| format!("writing {}: {e}", path.display()))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    #[test]
-    fn nice_steps() {
-        assert_eq!(nice_step(10.0, 5.0), 2.0);
-        assert_eq!(nice_step(1.0, 6.0), 0.2);
-        assert_eq!(nice_step(90.0, 6.0), 20.0);
+    fn sample() -> Plot {
+        Plot::new("t", "x (s)", "y (m)")
+            .series(Series::line("a", vec![(0.0, 1.0), (1.0, 2.0), (2.0, 1.5)]))
+            .series(Series::line("b", vec![(0.0, 0.5), (2.0, 0.7)]).dashed())
     }
 
+    /// The figures under docs/ are committed: regenerating one must give the same bytes.
     #[test]
     fn renders_deterministically() {
-        let p = Plot::new("t", "x (s)", "y (m)")
-            .series(Series::line("a", vec![(0.0, 1.0), (1.0, 2.0), (2.0, 1.5)]))
-            .series(Series::line("b", vec![(0.0, 0.5), (2.0, 0.7)]).dashed());
-        let a = p.to_png().unwrap();
-        let b = p.to_png().unwrap();
-        assert_eq!(a, b);
+        let a = sample().to_png().unwrap();
+        assert_eq!(a, sample().to_png().unwrap());
         assert_eq!(&a[1..4], b"PNG");
-        let log = p.clone().log_y(true).to_png().unwrap();
-        assert!(!log.is_empty());
+        let log = sample().log_y(true);
+        assert_eq!(log.to_png().unwrap(), log.to_png().unwrap());
+    }
+
+    /// Text is drawn (dark pixels in the title band), so the bundled font was found.
+    #[test]
+    fn draws_the_title_in_the_bundled_font() {
+        let mut p = sample();
+        p.title = "TITLE OF THE PLOT".into();
+        let rgb = p.render().unwrap();
+        let band = &rgb[..p.width as usize * 3 * 40];
+        let dark = band
+            .chunks(3)
+            .filter(|px| px.iter().all(|&c| c < 100))
+            .count();
+        assert!(dark > 100, "{dark} dark pixels in the title band");
     }
 
     #[test]
     fn refuses_empty() {
-        assert!(Plot::new("t", "x", "y").render().is_err());
+        assert!(Plot::new("t", "x", "y").to_png().is_err());
+        assert!(Plot::new("t", "x", "y")
+            .log_y(true)
+            .series(Series::line("neg", vec![(0.0, -1.0), (1.0, 0.0)]))
+            .to_png()
+            .is_err());
+    }
+
+    #[test]
+    fn ticks_and_labels() {
+        let d = Axis::decades(-15.0, -2.0).unwrap();
+        let labelled = d.ticks(MAX_TICKS, false);
+        assert_eq!(labelled.len(), 14);
+        assert_eq!(d.label(labelled[0]), "1e-15");
+        assert_eq!(d.label(-2.0), "0.01");
+        assert_eq!(d.label(3.0), "1000");
+        let short = Axis::decades(-0.5, 1.0).unwrap();
+        let texts: Vec<String> = short
+            .ticks(MAX_TICKS, false)
+            .iter()
+            .map(|&v| short.label(v))
+            .collect();
+        assert_eq!(texts, ["0.5", "1", "2", "5", "10"]);
+        assert!(d.ticks(MAX_TICKS, true).len() > 100);
+        let lin = Axis::linear(0.0, 1.0).unwrap();
+        let texts: Vec<String> = lin
+            .ticks(MAX_TICKS, false)
+            .iter()
+            .map(|&v| lin.label(v))
+            .collect();
+        assert_eq!(texts, ["0.0", "0.2", "0.4", "0.6", "0.8", "1.0"]);
+        assert!(Axis::linear(1.0, 0.0).is_err());
     }
 }

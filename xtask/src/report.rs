@@ -28,7 +28,6 @@ use core_math::{
 use crate::target::{bench_counts, BenchCounts};
 use core_math::sample::SplitMix64 as Rng;
 
-const USAGE: &str = "usage: report [--csv] [--cases N] [--seed S] [--no-bench]";
 const DEFAULT_CASES: usize = 200_000;
 const DEFAULT_SEED: u64 = 0x5EED_2013_0605_0750;
 const CAMERA: Camera = Camera {
@@ -133,32 +132,25 @@ struct EarthF32Split {
     all: usize,
 }
 
-pub fn run(args: &[String]) -> Result<(), String> {
-    let mut csv = false;
-    let mut bench = true;
-    let mut cases = DEFAULT_CASES;
-    let mut seed = DEFAULT_SEED;
-    let mut it = args.iter();
-    while let Some(a) = it.next() {
-        match a.as_str() {
-            "--csv" => csv = true,
-            "--no-bench" => bench = false,
-            "--cases" => {
-                cases = it
-                    .next()
-                    .and_then(|v| v.parse().ok())
-                    .filter(|&n| n > 0)
-                    .ok_or_else(|| format!("report: --cases needs a positive count ({USAGE})"))?;
-            }
-            "--seed" => {
-                seed = it
-                    .next()
-                    .and_then(|v| parse_seed(v))
-                    .ok_or_else(|| format!("report: --seed needs an integer ({USAGE})"))?;
-            }
-            other => return Err(format!("report: unknown argument `{other}` ({USAGE})")),
-        }
-    }
+#[derive(clap::Args)]
+pub struct Args {
+    /// The table as CSV on stdout (the notes on stderr); the doc is not rewritten
+    #[arg(long)]
+    csv: bool,
+    /// Cases in each sample (only the default rewrites the doc)
+    #[arg(long, value_name = "N", default_value_t = DEFAULT_CASES, value_parser = positive)]
+    cases: usize,
+    /// Seed of the samples, decimal or 0x hex [default: the doc's]
+    #[arg(long, value_name = "S", value_parser = parse_seed)]
+    seed: Option<u64>,
+    /// Errors only: no instruction counts or flash bytes (no QEMU, no firmware builds)
+    #[arg(long)]
+    no_bench: bool,
+}
+
+pub fn run(args: &Args) -> Result<(), String> {
+    let (csv, bench, cases) = (args.csv, !args.no_bench, args.cases);
+    let seed = args.seed.unwrap_or(DEFAULT_SEED);
     let sample = sweep(seed, cases);
     let (counts, flash) = if bench {
         let names: Vec<&str> = VARIANTS.iter().map(|v| v.name).collect();
@@ -258,11 +250,19 @@ fn write_artefacts(rows: &[[String; 7]], trailer: &str) -> Result<(), String> {
     Ok(())
 }
 
-fn parse_seed(v: &str) -> Option<u64> {
+fn parse_seed(v: &str) -> Result<u64, String> {
     match v.strip_prefix("0x") {
-        Some(hex) => u64::from_str_radix(&hex.replace('_', ""), 16).ok(),
-        None => v.parse().ok(),
+        Some(hex) => u64::from_str_radix(&hex.replace('_', ""), 16),
+        None => v.parse(),
     }
+    .map_err(|e| format!("not a decimal or 0x hex integer: {e}"))
+}
+
+fn positive(v: &str) -> Result<usize, String> {
+    v.parse()
+        .ok()
+        .filter(|&n| n > 0)
+        .ok_or_else(|| "not a positive count".to_string())
 }
 
 /// One case whose line of sight meets the Earth (per the reference), geometry rounded to
@@ -488,10 +488,11 @@ fn print_table(
     );
     if csv {
         eprintln!("report: {notes}");
-        println!("{}", HEADER.join(","));
+        let mut out = crate::csv::Writer::new("", &HEADER)?;
         for r in &rows {
-            println!("{}", r.join(","));
+            out.row(r)?;
         }
+        print!("{}", out.into_string()?);
     } else {
         println!("{notes}\n");
         println!("| {} |", HEADER.join(" | "));

@@ -33,7 +33,6 @@ pub const C_FIXED: f64 = 1.0;
 const DOC: &str = "docs/stability.md";
 const PNG_DIR: &str = "docs/stability";
 const TEMPLATE: &str = include_str!("stability/template.md");
-const USAGE: &str = "usage: cargo xtask stability [--quick]";
 
 /// Letters the document uses for the maps, in [`MAPS`] order.
 const LETTERS: [&str; 3] = ["A", "B", "C"];
@@ -52,14 +51,15 @@ pub fn sweep_all(coarse: Option<(usize, usize)>) -> Vec<Map> {
 /// `--quick`: a third of the cells in each direction, two sub-samples each.
 const QUICK: (usize, usize) = (3, 2);
 
-pub fn run(args: &[String]) -> Result<(), String> {
-    let mut quick = false;
-    for a in args {
-        match a.as_str() {
-            "--quick" => quick = true,
-            other => return Err(format!("stability: unknown argument `{other}` ({USAGE})")),
-        }
-    }
+#[derive(clap::Args)]
+pub struct Args {
+    /// A third of the cells each way, 2 sub-samples: the summary tables only, no files
+    #[arg(long)]
+    quick: bool,
+}
+
+pub fn run(args: &Args) -> Result<(), String> {
+    let quick = args.quick;
     let t0 = Instant::now();
     let maps = sweep_all(if quick { Some(QUICK) } else { None });
     let secs = t0.elapsed().as_secs_f64();

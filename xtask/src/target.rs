@@ -30,61 +30,62 @@ pub const TARGET: &str = "thumbv7em-none-eabihf";
 /// A core without an FPU (Cortex-M3), for the fixed-point backend's build check.
 pub const NO_FPU_TARGET: &str = "thumbv7m-none-eabi";
 
-/// `cargo xtask run [--demo] [--debug] [--short] [--telemetry FILE] [--plot PNG]
-/// [--every S] [--segments LIST|all] [--export-telemetry FILE]`: a pass through the firmware under QEMU (docs/telemetry.md),
-/// or the default-scene demo.
-pub fn run(args: &[String]) -> Result<(), String> {
-    const USAGE: &str = "usage: run [--demo] [--debug] [--short] [--telemetry FILE.csv] [--plot FILE.png] [--every SECONDS] [--segments 0,5,9|all] [--export-telemetry FILE.csv]";
-    let mut release = true;
-    let mut demo = false;
-    let mut short = false;
-    let mut telemetry = None;
-    let mut plot = None;
-    let mut export = None;
-    let mut every_s = pass::TABLE_EVERY_S;
-    let mut segments = pass::TABLE_SEGMENTS.to_vec();
-    let mut it = args.iter();
-    while let Some(a) = it.next() {
-        let mut value = |name: &str| {
-            it.next()
-                .map(PathBuf::from)
-                .ok_or_else(|| format!("run: {name} needs a file name ({USAGE})"))
-        };
-        match a.as_str() {
-            "--debug" => release = false,
-            "--release" => release = true,
-            "--demo" => demo = true,
-            "--short" => short = true,
-            "--telemetry" => telemetry = Some(value("--telemetry")?),
-            "--plot" => plot = Some(value("--plot")?),
-            "--export-telemetry" => export = Some(value("--export-telemetry")?),
-            "--every" => {
-                every_s = it
-                    .next()
-                    .and_then(|v| v.parse().ok())
-                    .filter(|&v: &u64| v > 0)
-                    .ok_or_else(|| format!("run: --every needs whole seconds > 0 ({USAGE})"))?
-            }
-            "--segments" => {
-                let v = it
-                    .next()
-                    .ok_or_else(|| format!("run: --segments needs a list ({USAGE})"))?;
-                segments = if v == "all" {
-                    (0..16).collect()
-                } else {
-                    v.split(',')
-                        .map(|x| x.trim().parse::<u8>())
-                        .collect::<Result<_, _>>()
-                        .map_err(|_| format!("run: bad segment list `{v}` ({USAGE})"))?
-                };
-            }
-            other => return Err(format!("run: unknown argument `{other}` ({USAGE})")),
-        }
+/// `cargo xtask run`'s options.
+#[derive(clap::Args)]
+pub struct RunArgs {
+    /// The default-scene demo (one synthetic NAV frame, no UART) instead of a pass
+    #[arg(long)]
+    demo: bool,
+    /// The firmware's dev profile instead of release
+    #[arg(long)]
+    debug: bool,
+    /// The release profile (the default)
+    #[arg(long, hide = true, conflicts_with = "debug")]
+    release: bool,
+    /// The end-to-end test's 1-minute pass instead of the 10-minute default
+    #[arg(long)]
+    short: bool,
+    /// Play this NAV telemetry (docs/telemetry.md) instead of the default pass
+    #[arg(long, value_name = "FILE.csv")]
+    telemetry: Option<PathBuf>,
+    /// Write the line-period plot here [default: target/pass/line-periods.png]
+    #[arg(long, value_name = "FILE.png")]
+    plot: Option<PathBuf>,
+    /// Seconds between the table's rows
+    #[arg(long, value_name = "SECONDS", default_value_t = pass::TABLE_EVERY_S,
+          value_parser = clap::value_parser!(u64).range(1..))]
+    every: u64,
+    /// The table's segments: indices, or all [default: 0,5,9]
+    #[arg(long, value_name = "0,5,9|all", value_parser = parse_segments)]
+    segments: Option<Segments>,
+    /// Only write the default pass's NAV samples as telemetry CSV
+    #[arg(long, value_name = "FILE.csv")]
+    export_telemetry: Option<PathBuf>,
+}
+
+/// Segment indices given on the command line (one value, not a list of arguments).
+#[derive(Clone, Debug)]
+pub struct Segments(Vec<u8>);
+
+fn parse_segments(v: &str) -> Result<Segments, String> {
+    if v == "all" {
+        return Ok(Segments((0..16).collect()));
     }
-    if let Some(path) = export {
-        return pass::export(&path);
+    v.split(',')
+        .map(|x| x.trim().parse::<u8>())
+        .collect::<Result<_, _>>()
+        .map(Segments)
+        .map_err(|_| format!("`{v}` is not a list of segment indices like 0,5,9"))
+}
+
+/// `cargo xtask run`: a pass through the firmware under QEMU (docs/telemetry.md), or the
+/// default-scene demo.
+pub fn run(args: &RunArgs) -> Result<(), String> {
+    let release = !args.debug;
+    if let Some(path) = &args.export_telemetry {
+        return pass::export(path);
     }
-    if demo {
+    if args.demo {
         ensure_target_tools()?;
         let elf = build_bin("firmware", "demo", release, &[])?;
         let outcome = qemu::run_elf(&elf, &qemu::Options::default())?;
@@ -92,11 +93,14 @@ pub fn run(args: &[String]) -> Result<(), String> {
     }
     pass::run(&pass::RunOptions {
         release,
-        short,
-        telemetry,
-        plot,
-        every_s,
-        segments,
+        short: args.short,
+        telemetry: args.telemetry.clone(),
+        plot: args.plot.clone(),
+        every_s: args.every,
+        segments: args
+            .segments
+            .clone()
+            .map_or(pass::TABLE_SEGMENTS.to_vec(), |s| s.0),
     })
 }
 

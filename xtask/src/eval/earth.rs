@@ -155,6 +155,7 @@ where
 
 #[cfg(test)]
 mod tests {
+    use super::super::tests::Out;
     use super::*;
 
     /// A 645 km sun-synchronous state (circular: 7 016 137 m, 7 537.5 m/s), then the same
@@ -170,35 +171,22 @@ bad_focal,7016137,0,0,0,-1046.6,7464.5,0,0,0,0,0,0,0,0,13e-6,0,,
 garbled,7016137,0,0,0,-1046.6,7464.5,x,0,0,0,0,0,0,0.555,13e-6,0,,
 ";
 
-    fn field<'a>(line: &'a str, header: &str, name: &str) -> &'a str {
-        let i = header.split(',').position(|h| h == name).unwrap();
-        line.split(',').nth(i).unwrap()
-    }
-
-    fn num(line: &str, header: &str, name: &str) -> f64 {
-        field(line, header, name).parse().unwrap()
-    }
-
     #[test]
     fn one_row_per_input_row_with_typed_errors() {
         for backend in ["reference", "f64", "f32"] {
-            let out = eval_csv(backend, CASES).unwrap();
-            let lines: Vec<&str> = out.lines().collect();
-            assert_eq!(lines.len(), 7);
-            let h = lines[0];
-            assert!(h.ends_with("v1_mps,v2_mps,v_mps,line_period_s,drift_rad,error"));
-            assert_eq!(
-                field(lines[1], h, "case"),
-                "nadir",
-                "extra columns are kept"
-            );
-            for l in &lines[1..4] {
-                assert_eq!(field(l, h, "error"), "", "{l}");
+            let out = Out::of(&eval_csv(backend, CASES).unwrap());
+            assert_eq!(out.rows(), 6);
+            assert!(out
+                .header()
+                .ends_with("v1_mps,v2_mps,v_mps,line_period_s,drift_rad,error"));
+            assert_eq!(out.field(0, "case"), "nadir", "extra columns are kept");
+            for row in 0..3 {
+                assert_eq!(out.field(row, "error"), "", "row {row}");
             }
-            assert_eq!(field(lines[4], h, "error"), "line_of_sight_misses_earth");
-            assert_eq!(field(lines[4], h, "v1_mps"), "");
-            assert_eq!(field(lines[5], h, "error"), "invalid_input");
-            assert_eq!(field(lines[6], h, "error"), "unparsable_input");
+            assert_eq!(out.field(3, "error"), "line_of_sight_misses_earth");
+            assert_eq!(out.field(3, "v1_mps"), "");
+            assert_eq!(out.field(4, "error"), "invalid_input");
+            assert_eq!(out.field(5, "error"), "unparsable_input");
         }
         assert!(eval_csv("fixed", CASES)
             .unwrap_err()
@@ -209,17 +197,16 @@ garbled,7016137,0,0,0,-1046.6,7464.5,x,0,0,0,0,0,0,0.555,13e-6,0,,
     /// The derived outputs follow the definition from v1 and v2, and the backends agree.
     #[test]
     fn derived_outputs_and_agreement() {
-        let r = eval_csv("reference", CASES).unwrap();
-        let f = eval_csv("f32", CASES).unwrap();
-        let h = r.lines().next().unwrap().to_string();
-        for (lr, lf) in r.lines().zip(f.lines()).skip(1).take(3) {
-            let (v1, v2) = (num(lr, &h, "v1_mps"), num(lr, &h, "v2_mps"));
-            assert!((num(lr, &h, "v_mps") - v1.hypot(v2)).abs() <= 1e-16);
-            let t = num(lr, &h, "line_period_s");
+        let r = Out::of(&eval_csv("reference", CASES).unwrap());
+        let f = Out::of(&eval_csv("f32", CASES).unwrap());
+        for row in 0..3 {
+            let (v1, v2) = (r.num(row, "v1_mps"), r.num(row, "v2_mps"));
+            assert!((r.num(row, "v_mps") - v1.hypot(v2)).abs() <= 1e-16);
+            let t = r.num(row, "line_period_s");
             assert!((t - 13e-6 / v1.abs()).abs() <= 1e-15 * t);
-            assert!((num(lr, &h, "drift_rad") - (v2 / v1).atan()).abs() <= 1e-15);
-            let d = (num(lf, &h, "v1_mps") - v1).hypot(num(lf, &h, "v2_mps") - v2);
-            assert!(d / v1.hypot(v2) < 2e-6, "{lf} vs {lr}");
+            assert!((r.num(row, "drift_rad") - (v2 / v1).atan()).abs() <= 1e-15);
+            let d = (f.num(row, "v1_mps") - v1).hypot(f.num(row, "v2_mps") - v2);
+            assert!(d / v1.hypot(v2) < 2e-6, "row {row}");
         }
     }
 }

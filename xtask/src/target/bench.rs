@@ -36,10 +36,7 @@ impl BenchCounts {
 }
 
 /// `cargo xtask bench`: measure, then print every region.
-pub fn bench(args: &[String]) -> Result<(), String> {
-    if let Some(a) = args.first() {
-        return Err(format!("bench: unknown argument `{a}` (usage: bench)"));
-    }
+pub fn bench() -> Result<(), String> {
     let counts = measure(false)?;
     let overhead = counts.overhead;
     println!();

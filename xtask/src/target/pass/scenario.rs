@@ -800,33 +800,26 @@ pub fn from_csv(path: &std::path::Path, tick_us: u64) -> Result<Pass, String> {
 
 /// Writes the pass's NAV samples as a telemetry CSV file.
 pub fn to_csv(pass: &Pass, path: &std::path::Path) -> Result<(), String> {
-    let mut out = format!(
-        "# {} (see docs/telemetry.md)\n{}\n",
-        pass.name,
-        CSV_COLUMNS.join(",")
-    );
+    let preamble = format!("# {} (see docs/telemetry.md)\n", pass.name);
+    let mut out = crate::csv::Writer::new(&preamble, &CSV_COLUMNS)?;
     for s in &pass.samples {
         let (r, v, a) = (
             s.nav.state.position_m,
             s.nav.state.velocity_mps,
             s.nav.attitude,
         );
-        out.push_str(&format!(
-            "{},{:?},{:?},{:?},{:?},{:?},{:?},{:?},{:?},{:?},{:?},{:?},{:?}\n",
-            s.t_us as f64 * 1e-6,
-            r[0],
-            r[1],
-            r[2],
-            v[0],
-            v[1],
-            v[2],
+        let state = [r[0], r[1], r[2], v[0], v[1], v[2]].map(|x| format!("{x:?}"));
+        let attitude = [
             a.roll_rad,
             a.pitch_rad,
             a.yaw_rad,
             a.roll_rate_rad_s,
             a.pitch_rate_rad_s,
-            a.yaw_rate_rad_s
-        ));
+            a.yaw_rate_rad_s,
+        ]
+        .map(|x| format!("{x:?}"));
+        let t = (s.t_us as f64 * 1e-6).to_string();
+        out.row(&[[t].as_slice(), &state, &attitude].concat())?;
     }
-    std::fs::write(path, out).map_err(|e| format!("writing {}: {e}", path.display()))
+    std::fs::write(path, out.into_bytes()?).map_err(|e| format!("writing {}: {e}", path.display()))
 }
