@@ -538,10 +538,20 @@ impl Controller {
             if (m.v1_mps > 0.0) != reversed {
                 return Err(Fault::PeriodOutOfRange);
             }
+            // Comparisons, not f32::min/max: those are software calls on this core
+            // (fminf/fmaxf, NaN handling), a tenth of the update. A NaN would be skipped
+            // by both alike; `motion` refuses a NaN v1 in any case.
             let v = m.v1_mps.abs();
-            v_min = v_min.min(v);
-            v_max = v_max.max(v);
-            tan_max = tan_max.max((m.v2_mps / m.v1_mps).abs());
+            if v < v_min {
+                v_min = v;
+            }
+            if v > v_max {
+                v_max = v;
+            }
+            let tan = (m.v2_mps / m.v1_mps).abs();
+            if tan > tan_max {
+                tan_max = tan;
+            }
         }
         // The period minimising the worst relative mismatch over [v_min, v_max]: the
         // line speed equal to the harmonic mean of the extremes, i.e. the mean of the
@@ -559,7 +569,8 @@ impl Controller {
         let (v_lo, v_hi) = (v_min - seg.interpolation_mps, v_max + seg.interpolation_mps);
         let stages = u32::from(seg.tdi_stages);
         let (worst_mismatch, mtf, max_stages) = if v_lo > 0.0 {
-            let worst = (v_line / v_lo - 1.0).abs().max((1.0 - v_line / v_hi).abs());
+            let (below, above) = ((v_line / v_lo - 1.0).abs(), (1.0 - v_line / v_hi).abs());
+            let worst = if below > above { below } else { above };
             let half_pi_m = core::f32::consts::FRAC_PI_2 * stages as f32;
             // Past the sinc's first zero no contrast is left; its negative lobe is a
             // phase reversal, not an MTF below 0.
@@ -614,13 +625,9 @@ fn inside_envelope(a: &Attitude<f32>, env: &AttitudeEnvelope, back_s: f32, ahead
         && angle_ok(a.pitch_rad, a.pitch_rate_rad_s, env.max_pitch_rad)
 }
 
-/// atan(t) (rad): the odd series to t^9 where drift angles live (|t| <= 0.2: error
-/// below 0.2^11/11 = 1.9e-9 rad, under f32's rounding of the result), libm beyond.
+/// The drift angle atan(t) (rad) of a drift tangent t = v2/v1: `core_math::trig::atan_f32`
+/// (2.2 ulp, a tenth of libm's `atanf` cost here), which the drift smear of keystoned
+/// outer segments (|t| up to 0.3 at 20 deg of pitch) needs beyond any short series.
 pub fn drift_angle_rad(t: f32) -> f32 {
-    if t.abs() <= 0.2 {
-        let t2 = t * t;
-        t * (1.0 - t2 * (1.0 / 3.0 - t2 * (0.2 - t2 * (1.0 / 7.0 - t2 * (1.0 / 9.0)))))
-    } else {
-        libm::atanf(t)
-    }
+    core_math::trig::atan_f32(t)
 }

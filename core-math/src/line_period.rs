@@ -50,7 +50,9 @@ pub fn line_period_ticks<T: Real>(period_s: T, clock_hz: T) -> Result<Ticks<T>, 
     // Half up, from the exact fraction: `floor(exact + 0.5)` would round the sum first
     // (0.5 - 1 ulp + 0.5 gives 1.0; in f32 an odd integer above 2^23 plus 0.5 ties to
     // the even one above).
-    let whole = exact.floor();
+    // exact > 0: truncation is the floor (saturating at u32::MAX, which the range check
+    // below then refuses), without the software `floorf` of this core.
+    let whole = T::from_u32(exact.to_u32());
     let nearest = if exact - whole >= T::from_f64(0.5) {
         whole + T::ONE
     } else {

@@ -217,6 +217,53 @@ fn stage_limit_with_drift_is_the_largest_count_meeting_the_floor() {
         }
     }
     assert_eq!(checked, 12_000);
+    // Counts from one stage to MAX_STAGE_LIMIT (mismatch and drift down to 1e-9, where
+    // the guess is tens of thousands of stages off and the fallback answers): the
+    // guess-and-check rule agrees with the bracket-and-bisection one in f64, and in
+    // f32 its count meets the floor while the next one does not, to f32 rounding.
+    let mut large_counts = 0;
+    for floor in [0.25, 0.5, 0.9, 0.99] {
+        let rule = StageRule::<f64>::new(floor).unwrap();
+        let rule32 = StageRule::<f32>::new(floor).unwrap();
+        for _ in 0..3_000 {
+            let e = 10f64.powf(-9.0 + 8.0 * next()) * if next() < 0.1 { 0.0 } else { 1.0 };
+            let t = 10f64.powf(-9.0 + 8.0 * next()) * if next() < 0.1 { 0.0 } else { 1.0 };
+            let limit = if next() < 0.5 {
+                core_math::mtf::MAX_STAGE_LIMIT
+            } else {
+                1 + (next() * 1_000.0) as u32
+            };
+            let got = rule.max_stages_with_drift(e, t, limit).unwrap();
+            let bisected = rule
+                .max_stages_with_drift_by_bisection(e, t, limit)
+                .unwrap();
+            assert_eq!(
+                got, bisected,
+                "floor {floor}, e {e:e}, t {t:e}, limit {limit}"
+            );
+            if got > 10_000 && got < limit {
+                large_counts += 1;
+            }
+            let got32 = rule32
+                .max_stages_with_drift(e as f32, t as f32, limit)
+                .unwrap();
+            let tol = 1e-6;
+            assert!(
+                got32 == 0 || product(got32, e, t) >= floor - tol,
+                "f32 {got32}"
+            );
+            assert!(
+                got32 >= limit.min(core_math::mtf::MAX_STAGE_LIMIT)
+                    || product(got32 + 1, e, t) < floor + tol,
+                "f32 {got32}: the next count meets the floor too (e {e:e}, t {t:e})"
+            );
+        }
+    }
+    eprintln!("counts over 10 000 stages checked: {large_counts} (the guess alone cannot reach most of them)");
+    assert!(
+        large_counts > 100,
+        "too few large counts: the fallback went unexercised"
+    );
     // No drift: the same as the mismatch-only rule.
     let rule = StageRule::<f64>::new(0.95).unwrap();
     for e in [0.0, 1e-4, 3.7e-3, 0.02] {
