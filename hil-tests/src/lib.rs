@@ -91,8 +91,30 @@ pub mod golden {
         pub host_f32: Result<(u32, f32), ModelError>,
     }
 
+    /// The f64 reference of one segment at one controller update.
+    #[derive(Clone, Copy, Debug)]
+    pub struct SegmentGold {
+        pub index: u8,
+        /// Sample pixels in the host's plan of the scene.
+        pub samples: usize,
+        /// The line period in ticks before rounding to whole ticks.
+        pub ticks_exact: f64,
+        /// atan(v2 / v1) at the segment's centre pixel (rad).
+        pub drift_rad: f64,
+    }
+
+    /// The f64 reference of one controller update (`controller::golden::update`).
+    #[derive(Clone, Copy, Debug)]
+    pub struct UpdateGolden {
+        pub name: &'static str,
+        pub segments: &'static [SegmentGold],
+        pub yaw_request_rad: Option<f64>,
+    }
+
     include!(concat!(env!("OUT_DIR"), "/golden.rs"));
 }
+
+pub mod controller_cases;
 
 pub mod checks;
 
