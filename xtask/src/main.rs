@@ -28,7 +28,11 @@ commands:
   run [--short] [--telemetry FILE.csv] [--debug]         a pass through the firmware under QEMU (docs/telemetry.md)
       [--plot PNG] [--every S] [--segments 0,5,9|all]
       [--export-telemetry FILE.csv] [--demo]             (--demo: the default-scene demo)
-  bench                                                  guest instructions per evaluation (QEMU plugin)
+      [--board mps2-an386|stm32f405]                     (the board and its QEMU machine: docs/target.md)
+  bench [--board mps2-an386|stm32f405]                   guest instructions per evaluation (QEMU plugin)
+  size [--board mps2-an386|stm32f405]                    flash and static RAM of the flight binary, per board
+  flash [--board stm32f405] [--bin firmware|demo]        a real board through probe-rs (docs/target.md)
+        [--debug] [--print-command]
   report [--csv] [--cases N] [--seed S] [--no-bench]     error against run time per backend (runs the bench)
   stability [--quick]                                    regenerate docs/stability.md and its maps
   ellipsoid [--print]                                    round-Earth model error against WGS 84, cost of each
@@ -50,6 +54,8 @@ fn main() -> ExitCode {
         "test" => test_cmd::run(rest),
         "run" => target::run(rest),
         "bench" => target::bench(rest),
+        "size" => target::size(rest),
+        "flash" => target::flash(rest),
         "report" => report::run(rest),
         "qemu" => target::qemu(rest),
         "stability" => stability::run(rest),
