@@ -36,6 +36,10 @@ pub mod stm32f405;
 #[cfg(feature = "stm32f405")]
 pub use stm32f405::{take, Clock, LineClock, Link, LINK, NAME};
 
+/// The telemetry link's speed (baud), 8N1: the ground link's, the same on every board
+/// (QEMU ignores it).
+pub const LINK_BAUD: u32 = 115_200;
+
 /// A monotonic time source: microseconds since the board was brought up.
 pub trait Monotonic {
     /// Never decreases (between two calls less than one wrap of the board's counter

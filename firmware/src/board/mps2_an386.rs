@@ -17,7 +17,7 @@ use core::sync::atomic::{AtomicBool, Ordering};
 
 use embedded_hal_nb::serial::{ErrorKind, ErrorType, Read, Write};
 
-use super::{BoardError, Extended, Monotonic, Parts};
+use super::{BoardError, Extended, Monotonic, Parts, LINK_BAUD};
 use crate::line_clock::ReloadRegister;
 use crate::link::RxWait;
 
@@ -30,8 +30,6 @@ pub type Link = Uart;
 pub type LineClock = Timer;
 pub type Clock = FreeRunning;
 
-/// Telemetry link speed (QEMU ignores it; a board's ground-support link would use it).
-const BAUD: u32 = 115_200;
 /// mps2-an386 UART0 base address.
 const UART0_BASE: usize = 0x4000_4000;
 /// mps2-an386 TIMER0 base address.
@@ -51,8 +49,13 @@ pub fn take() -> Result<Parts<Link, LineClock, Clock>, BoardError> {
     }
     // SAFETY: the guard above lets this run once, so nothing else owns UART0, TIMER0
     // or TIMER1, and the firmware uses no interrupt handler.
-    let (link, line_clock, clock) =
-        unsafe { (Uart::uart0(BAUD), Timer::timer0(), FreeRunning::timer1()) };
+    let (link, line_clock, clock) = unsafe {
+        (
+            Uart::uart0(LINK_BAUD),
+            Timer::timer0(),
+            FreeRunning::timer1(),
+        )
+    };
     Ok(Parts {
         link,
         line_clock,

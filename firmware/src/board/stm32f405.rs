@@ -28,7 +28,7 @@ use stm32f4xx_hal::serial::{self, Event, RxISR, Serial};
 use stm32f4xx_hal::timer::{CounterUs, Timer};
 use stm32f4xx_hal::Listen;
 
-use super::{BoardError, Extended, Monotonic, Parts};
+use super::{BoardError, Extended, Monotonic, Parts, LINK_BAUD};
 use crate::line_clock::ReloadRegister;
 use crate::link::RxWait;
 
@@ -40,9 +40,6 @@ pub const LINK: &str = "USART1";
 pub type Link = Usart1;
 pub type LineClock = Tim2Reload;
 pub type Clock = Tim5Clock;
-
-/// Telemetry link speed (baud).
-const BAUD: u32 = 115_200;
 
 /// Brings the board up: HSI clocks, USART1 at 115 200 Bd with its receive interrupt as a
 /// wake-up source, TIM2 stopped until its first period, TIM5 counting. Call once.
@@ -56,7 +53,7 @@ pub fn take() -> Result<Parts<Link, LineClock, Clock>, BoardError> {
         .USART1
         .serial(
             (gpioa.pa9, gpioa.pa10),
-            serial::Config::default().baudrate(BAUD.bps()),
+            serial::Config::default().baudrate(LINK_BAUD.bps()),
             &mut rcc,
         )
         .map_err(|_| BoardError::SerialConfig)?;
