@@ -1,7 +1,8 @@
-//! Relinks when the memory layout changes. The linker takes `memory.x` from the
-//! workspace root (the directory cargo runs rustc and so the linker in; cortex-m-rt's
-//! `link.x` INCLUDEs it from there before any search path): see docs/target.md.
+//! Selects the board's memory layout (`memory/select.rs`): see docs/target.md, "Boards".
+include!("memory/select.rs");
+
 fn main() {
-    println!("cargo:rerun-if-changed=../memory.x");
+    select_memory_x(std::path::Path::new("memory"));
+    println!("cargo:rerun-if-changed=memory/select.rs");
     println!("cargo:rerun-if-changed=build.rs");
 }

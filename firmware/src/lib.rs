@@ -2,7 +2,7 @@
 //!
 //! The firmware (`src/main.rs`) is the telemetry-driven line-rate controller, one
 //! module per step of the story:
-//! - telemetry in: [`link`] (the [`link::ByteLink`] trait: a UART, byte by byte, never
+//! - telemetry in: [`link`] (an `embedded-hal-nb` serial port, byte by byte, never
 //!   waiting) and [`telemetry`] (the loop: bytes through the `controller` crate's
 //!   `Session`, frames back out);
 //! - scene and math: the `controller` crate (the scene in force, its plan, the updates,
@@ -10,9 +10,10 @@
 //! - line periods out: [`line_clock`] (the `controller::LinePeriodSink`: segment 0's
 //!   period into a timer's reload register, the others into a table) and the PERIODS
 //!   frames the session sends;
-//! - the hardware behind those traits: [`cmsdk`] (the mps2-an386's UART0 and TIMER0);
-//! - [`platform`]: panic/fault handlers, exit by semihosting; [`logger`]: the global
-//!   defmt logger (semihosting, never panics);
+//! - the hardware behind those traits: [`board`], one module per board, chosen by cargo
+//!   feature (`mps2-an386`, the default; `stm32f405`); no hardware address outside it;
+//! - [`platform`]: panic/fault handlers, exit by semihosting; `logger`: the global
+//!   defmt logger (semihosting, never panics; `defmt-rtt` replaces it on a real board);
 //!   [`stack`]: the stack's high-water mark (the firmware's RAM use).
 //!
 //! The default-scene demo (`src/bin/demo.rs`, `cargo xtask run --demo`) and the
@@ -23,9 +24,10 @@
 //! indexing that can fail).
 #![no_std]
 
-pub mod cmsdk;
+pub mod board;
 pub mod line_clock;
 pub mod link;
+#[cfg(not(feature = "defmt-rtt"))]
 pub mod logger;
 pub mod platform;
 pub mod stack;

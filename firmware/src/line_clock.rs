@@ -1,18 +1,20 @@
 //! Line periods out: the controller's [`LinePeriodSink`] on this hardware.
 //!
-//! Each detector segment has a line clock: a down-counter on the line clock's
-//! frequency that reloads every period (period = RELOAD + 1 ticks). Segment 0's is a
-//! real register here, the mps2-an386's TIMER0 RELOAD (written, then read back: a
-//! write that does not stick is refused and the controller keeps the segment's last
-//! good period); the other segments' counters do not exist on this machine and are a
-//! table in RAM. What was programmed also goes to the ground in the PERIODS frame
-//! (see [`crate::telemetry`]). On QEMU the timer counts the 25 MHz APB clock, not a
-//! 10 MHz line clock: the point is the register path, not the rate.
+//! Each detector segment has a line clock: a counter on the line clock's frequency
+//! that reloads every period (period = RELOAD + 1 ticks). Segment 0's is a real
+//! register, the board's timer reload register ([`ReloadRegister`]: the mps2-an386's
+//! TIMER0 RELOAD, the STM32F405's TIM2 ARR; written, then read back: a write that does
+//! not stick is refused and the controller keeps the segment's last good period); the
+//! other segments' counters do not exist on these boards and are a table in RAM. What
+//! was programmed also goes to the ground in the PERIODS frame (see
+//! [`crate::telemetry`]). Under QEMU neither timer counts a 10 MHz line clock: the point
+//! is the register path, not the rate.
 
 use controller::scene::MAX_SEGMENTS;
 use controller::LinePeriodSink;
 
-/// A counter's reload register.
+/// A counter's reload register (the board layer's line clock; embedded-hal 1.0 has no
+/// timer traits).
 pub trait ReloadRegister {
     fn set_reload(&mut self, value: u32);
     fn reload(&self) -> u32;

@@ -1,48 +1,66 @@
-//! The telemetry link as the rest of the firmware sees it: one byte at a time, never
-//! waiting. [`ByteLink`] is all a UART driver has to provide (the mps2-an386's CMSDK
-//! UART in [`crate::cmsdk`]; a board's UART, or a host test double, equally).
+//! The telemetry link as the rest of the firmware sees it: an `embedded-hal-nb` serial
+//! port of bytes (`serial::Read<u8>` and `serial::Write<u8>`, never blocking: a busy
+//! or empty port answers `WouldBlock`), plus [`RxWait`], the one thing those traits
+//! lack: a way to sleep until a byte may have arrived. Any board's UART driver, or a
+//! host test double, provides it (the boards: [`crate::board`]).
 
-/// A byte-wide serial link with non-blocking receive and transmit.
-pub trait ByteLink {
-    /// The received byte, if one is waiting.
-    fn read_byte(&mut self) -> Option<u8>;
-    /// Queues `byte` for transmission; false (and nothing queued) when the transmitter
-    /// is still busy with the previous byte.
-    fn try_write_byte(&mut self, byte: u8) -> bool;
-    /// True when the transmitter has taken every queued byte.
-    fn tx_idle(&mut self) -> bool;
-    /// Nothing was received: wait until a byte may have arrived. A UART with a receive
-    /// interrupt sleeps here; the default returns at once (plain polling).
-    fn wait(&mut self) {}
+use embedded_hal_nb::serial::{Read, Write};
+
+/// Sleeping until the receiver may have something. A UART with a receive interrupt
+/// sleeps here (WFI); a plain polled link returns at once.
+pub trait RxWait {
+    fn wait_for_rx(&mut self);
 }
+
+/// Everything the telemetry loop needs of a link.
+pub trait Link: Read<u8> + Write<u8> + RxWait {}
+
+impl<T: Read<u8> + Write<u8> + RxWait> Link for T {}
 
 /// How many times [`send_bounded`] polls a busy transmitter for one byte before it
 /// gives the frame up. Under QEMU a byte leaves in a few polls unless the host stops
 /// reading; on a board size it from the baud rate (one byte at 115 200 Bd is 87 us).
 pub const TX_POLL_LIMIT: u32 = 1_000_000;
 
-/// The transmitter stayed busy for [`TX_POLL_LIMIT`] polls: the rest of the frame was
-/// dropped.
+/// Why a frame was not sent whole.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct TxTimeout;
+pub enum TxError {
+    /// The transmitter stayed busy for [`TX_POLL_LIMIT`] polls: the rest of the frame
+    /// was dropped.
+    Timeout,
+    /// The port reported an error: the rest of the frame was dropped.
+    Link,
+}
 
 /// Sends `bytes`, polling a busy transmitter at most [`TX_POLL_LIMIT`] times per byte:
 /// a link nobody reads costs a bounded delay and the frame, never the main loop.
-pub fn send_bounded<L: ByteLink>(link: &mut L, bytes: &[u8]) -> Result<(), TxTimeout> {
+pub fn send_bounded<L: Write<u8>>(link: &mut L, bytes: &[u8]) -> Result<(), TxError> {
     for &b in bytes {
         let mut polls = 0u32;
-        while !link.try_write_byte(b) {
-            polls += 1;
-            if polls >= TX_POLL_LIMIT {
-                return Err(TxTimeout);
+        loop {
+            match link.write(b) {
+                Ok(()) => break,
+                Err(nb::Error::WouldBlock) => {
+                    polls += 1;
+                    if polls >= TX_POLL_LIMIT {
+                        return Err(TxError::Timeout);
+                    }
+                }
+                Err(nb::Error::Other(_)) => return Err(TxError::Link),
             }
         }
     }
     Ok(())
 }
 
-/// Waits (bounded as [`send_bounded`]) until the transmitter is idle; false if it never
-/// became so.
-pub fn flush_bounded<L: ByteLink>(link: &mut L) -> bool {
-    (0..TX_POLL_LIMIT).any(|_| link.tx_idle())
+/// Waits (bounded as [`send_bounded`]) until the transmitter has sent everything; false
+/// if it never did, or reported an error.
+pub fn flush_bounded<L: Write<u8>>(link: &mut L) -> bool {
+    (0..TX_POLL_LIMIT)
+        .find_map(|_| match link.flush() {
+            Ok(()) => Some(true),
+            Err(nb::Error::WouldBlock) => None,
+            Err(nb::Error::Other(_)) => Some(false),
+        })
+        .unwrap_or(false)
 }

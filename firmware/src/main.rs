@@ -1,40 +1,62 @@
 //! Firmware entry point: the telemetry-driven line-rate controller.
 //!
-//! telemetry in (UART0, [`firmware::telemetry`]) -> scene and math (the `controller`
-//! crate on core-math) -> line periods out ([`firmware::line_clock`]: TIMER0 RELOAD for
-//! segment 0, PERIODS frames to the ground). Runs until the link sends END, then exits
-//! by semihosting (status 0; 1 if the controller could not start).
+//! the board's link, line clock and clock ([`firmware::board`]) -> telemetry in
+//! ([`firmware::telemetry`]) -> scene and math (the `controller` crate on core-math) ->
+//! line periods out ([`firmware::line_clock`]: the board's reload register for segment
+//! 0, PERIODS frames to the ground). Runs until the link sends END, then exits by
+//! semihosting (status 0; 1 if the controller could not start, 2 if a frame or a line
+//! clock write was lost, 3 if the board could not be brought up).
 #![no_std]
 #![no_main]
 
 use controller::{Config, Controller, Scene};
 use cortex_m_rt::entry;
-use firmware::cmsdk::{Timer, Uart};
+use firmware::board::{self, Parts};
 use firmware::line_clock::LineClocks;
 use firmware::{platform, stack, telemetry};
 
-/// Telemetry link speed (QEMU ignores it; a board's ground-support link would use it).
-const BAUD: u32 = 115_200;
-
 #[entry]
 fn main() -> ! {
-    let painted = stack::paint();
+    let Parts {
+        mut link,
+        line_clock,
+        mut clock,
+        timer_clock_hz,
+    } = match board::take() {
+        Ok(parts) => parts,
+        Err(e) => {
+            defmt::error!("board {=str}: {}", board::NAME, e);
+            platform::exit(3)
+        }
+    };
+    // The host's pass player starts sending when it reads this line (a link that is not
+    // enabled yet may drop bytes): keep `telemetry::READY` in it.
     defmt::info!(
-        "tdi-camera firmware {=str}: line-rate controller on UART0",
-        env!("CARGO_PKG_VERSION")
+        "tdi-camera firmware {=str} on {=str}: line-rate controller, {=str} on {=str}",
+        env!("CARGO_PKG_VERSION"),
+        board::NAME,
+        telemetry::READY,
+        board::LINK
     );
-    // SAFETY: `main` runs once and is the only user of UART0 and TIMER0.
-    let (mut uart, timer) = unsafe { (Uart::uart0(BAUD), Timer::timer0()) };
-    let mut clocks = LineClocks::new(timer);
+    let mut clocks = LineClocks::new(line_clock);
     let code = match Controller::new(Config::default(), Scene::paper_default()) {
         Ok(controller) => {
-            let summary = telemetry::run(&mut uart, &mut clocks, controller);
-            if summary.tx_dropped == 0 && clocks.errors == 0 {
+            let line_clock_hz = controller.plan().line_clock_hz;
+            if timer_clock_hz as f32 != line_clock_hz {
+                defmt::info!(
+                    "segment 0's timer counts at {=u32} Hz here, the scene's line clock is {=f32} Hz: the reload register is programmed, the rate is not the line clock's",
+                    timer_clock_hz,
+                    line_clock_hz
+                );
+            }
+            let summary = telemetry::run(&mut link, &mut clocks, &mut clock, controller);
+            if summary.tx_dropped == 0 && summary.rx_errors == 0 && clocks.errors == 0 {
                 0
             } else {
                 defmt::error!(
-                    "{=u32} downlink frames dropped, {=u32} line clock writes refused",
+                    "{=u32} downlink frames dropped, {=u32} receive errors, {=u32} line clock writes refused",
                     summary.tx_dropped,
+                    summary.rx_errors,
                     clocks.errors
                 );
                 2
@@ -47,7 +69,7 @@ fn main() -> ! {
     };
     defmt::info!(
         "stack high-water mark: {=usize} bytes (controller state {=usize} bytes)",
-        painted.peak(),
+        stack::high_water_mark_bytes(),
         core::mem::size_of::<controller::session::Session>()
     );
     platform::exit(code)

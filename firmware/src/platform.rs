@@ -1,13 +1,16 @@
 //! What ties the application to the chip and the debugger: the defmt logger, the panic
 //! and fault handlers, and the way out.
 //!
-//! Logging goes through semihosting (the global defmt logger in [`crate::logger`]):
-//! under QEMU the host runner (`cargo xtask qemu`) decodes the frames; on a board,
-//! probe-rs does. The exit status reaches QEMU's (and so the runner's) exit status by
-//! semihosting as well.
+//! Logging goes through semihosting (the global defmt logger in `crate::logger`):
+//! under QEMU the host runner (`cargo xtask qemu`) decodes the frames. On a real board
+//! the feature `defmt-rtt` puts the logger in RTT memory instead, where probe-rs reads
+//! it without halting the core. The exit status reaches QEMU's (and so the runner's)
+//! exit status by semihosting, on a board probe-rs's.
 
 use cortex_m as _; // critical-section implementation for the logger
 use cortex_m_rt::{exception, ExceptionFrame};
+#[cfg(feature = "defmt-rtt")]
+use defmt_rtt as _; // the global defmt logger on a real board
 
 /// Exit status of a panic (never expected: the firmware's own paths return `Result`).
 pub const EXIT_PANIC: i32 = 101;

@@ -1,47 +1,32 @@
-//! Stack high-water mark: paint a band below the stack pointer with a pattern at boot,
-//! find later how far down the pattern was overwritten. The firmware has no heap and
-//! only 16 bytes of static data, so this peak is its RAM use.
+//! Stack high-water mark. cortex-m-rt (feature `paint-stack`) paints the whole stack
+//! region, from `_stack_end` (the end of `.bss` and `.uninit`) up to `_stack_start`
+//! (the top of RAM), with [`STACK_PAINT_VALUE`] before `main` runs; the deepest word the
+//! stack has overwritten since is the lowest one that no longer holds the paint. The
+//! firmware has no heap and a few bytes of static data, so this peak is its RAM use.
 
-/// How far below the painting function's stack pointer the band reaches (bytes).
-pub const BAND: usize = 64 * 1024;
-const PATTERN: u32 = 0x5AC3_5AC3;
-/// Left untouched just below the stack pointer (the painting call's own frame).
-const GUARD: usize = 256;
+use cortex_m_rt::STACK_PAINT_VALUE;
 
-/// A painted band: `[low, high)`, and the stack pointer it was measured from.
-pub struct Painted {
-    low: usize,
-    high: usize,
-    top: usize,
+extern "C" {
+    // Symbols of cortex-m-rt's link.x: only their addresses are used.
+    static _stack_end: u32;
+    static _stack_start: u32;
 }
 
-/// Paints the band; call first thing in `main`.
-pub fn paint() -> Painted {
-    let sp = cortex_m::register::msp::read() as usize;
-    let high = sp.saturating_sub(GUARD) & !3;
-    let low = high.saturating_sub(BAND);
+/// Bytes of stack used since reset: from the top of RAM down to the lowest word whose
+/// paint is gone (a word that the stack wrote with the paint value itself would count as
+/// unused: the figure can be low by the few bytes above such a word, never high).
+pub fn high_water_mark_bytes() -> usize {
+    let low = (&raw const _stack_end) as usize;
+    let high = (&raw const _stack_start) as usize;
     let mut p = low;
     while p < high {
-        // SAFETY: [low, high) is RAM below the live stack (the RAM is 4 MiB and
-        // nothing but the stack lives above .bss), not yet used by any frame.
-        unsafe { core::ptr::write_volatile(p as *mut u32, PATTERN) };
+        // SAFETY: [low, high) is the stack region of RAM, word-aligned (link.x asserts
+        // it); below the deepest frame so far nothing is in use, and the scan stops at
+        // the first word above that: it reads, never writes.
+        if unsafe { core::ptr::read_volatile(p as *const u32) } != STACK_PAINT_VALUE {
+            break;
+        }
         p += 4;
     }
-    Painted { low, high, top: sp }
-}
-
-impl Painted {
-    /// Bytes of stack used below the painting point's stack pointer so far (at least
-    /// the band's size if the pattern is gone entirely).
-    pub fn peak(&self) -> usize {
-        let mut p = self.low;
-        while p < self.high {
-            // SAFETY: as in `paint`: RAM, word-aligned, read only.
-            if unsafe { core::ptr::read_volatile(p as *const u32) } != PATTERN {
-                break;
-            }
-            p += 4;
-        }
-        self.top.saturating_sub(p)
-    }
+    high.saturating_sub(p)
 }

@@ -7,48 +7,84 @@
 //! empty, sleeps until the receive interrupt is pending (a new byte, and nothing else,
 //! can wake it: there is nothing else to do before one arrives), and a transmitter that stops taking bytes costs at most
 //! [`crate::link::TX_POLL_LIMIT`] polls per frame, after which the frame is dropped and
-//! counted. Time comes from the telemetry's time tags (NAV and TIME frames): under QEMU
-//! the host player is the time source. On a board the same loop would also call
-//! [`Session::tick`] with the on-board timer's time; the controller is the same.
+//! counted. The controller's time comes from the telemetry's time tags (NAV and TIME
+//! frames): under QEMU the host player is the time source, which keeps a pass
+//! reproducible to the bit. The board's [`Monotonic`] clock times the loop instead: the
+//! longest step (one byte through the session: an update and its PERIODS frame at
+//! worst) is reported at the end of the pass, the figure that says whether a polled
+//! receiver keeps up on a real board. (Letting the board's clock also drive updates
+//! between frames, [`Session::tick`], needs a clock whose rate is right: not QEMU's.)
 
 use controller::session::Session;
 use controller::{Controller, LinePeriodSink, Mode};
+use embedded_hal_nb::serial::{Error as _, ErrorKind};
 
-use crate::link::{flush_bounded, send_bounded, ByteLink};
+use crate::board::Monotonic;
+use crate::link::{flush_bounded, send_bounded, Link};
+
+/// The words of the firmware's first log line that say the link is up: the host's pass
+/// player waits for them before it sends a byte (xtask/src/target/pass.rs).
+pub const READY: &str = "telemetry link ready";
 
 /// How a pass ended.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Summary {
-    /// Downlink frames given up because the transmitter stayed busy.
+    /// Downlink frames given up because the transmitter stayed busy or failed.
     pub tx_dropped: u32,
+    /// Errors the receiver reported (overrun, framing, noise, parity): bytes lost, which
+    /// the decoder then counts as a broken frame.
+    pub rx_errors: u32,
+    /// The longest step of the loop by the board's clock (us).
+    pub longest_step_us: u64,
 }
 
 /// Runs the controller on `link` until an END frame; returns how it went.
-pub fn run<L: ByteLink, S: LinePeriodSink>(
+pub fn run<L: Link, S: LinePeriodSink, C: Monotonic>(
     link: &mut L,
     sink: &mut S,
+    clock: &mut C,
     controller: Controller,
 ) -> Summary {
     let mut session = Session::new(controller);
-    let mut tx_dropped = 0u32;
+    let mut summary = Summary {
+        tx_dropped: 0,
+        rx_errors: 0,
+        longest_step_us: 0,
+    };
     let mut faults = 0u32;
     let mut mode = session.controller.mode();
+    let started_us = clock.now_us();
     loop {
-        let Some(byte) = link.read_byte() else {
-            // Nothing received: sleep until the receiver has something (or return at
-            // once, for a link without an interrupt).
-            link.wait();
-            continue;
+        let byte = match link.read() {
+            Ok(byte) => byte,
+            Err(nb::Error::WouldBlock) => {
+                // Nothing received: sleep until the receiver has something (or return
+                // at once, for a link without an interrupt).
+                link.wait_for_rx();
+                continue;
+            }
+            Err(nb::Error::Other(e)) => {
+                summary.rx_errors = summary.rx_errors.saturating_add(1);
+                defmt::warn!(
+                    "receive error: {=str} ({=u32} so far)",
+                    error_name(e.kind()),
+                    summary.rx_errors
+                );
+                continue;
+            }
         };
+        let step_start_us = clock.now_us();
         let ended = session.feed(&[byte], sink, |frame| {
             if send_bounded(link, frame).is_err() {
-                tx_dropped = tx_dropped.saturating_add(1);
+                summary.tx_dropped = summary.tx_dropped.saturating_add(1);
             }
         });
+        let step_us = clock.now_us().saturating_sub(step_start_us);
+        summary.longest_step_us = summary.longest_step_us.max(step_us);
         report_changes(&session, &mut faults, &mut mode);
         if ended {
             if !flush_bounded(link) {
-                tx_dropped = tx_dropped.saturating_add(1);
+                summary.tx_dropped = summary.tx_dropped.saturating_add(1);
             }
             let c = &session.controller;
             defmt::info!(
@@ -58,10 +94,26 @@ pub fn run<L: ByteLink, S: LinePeriodSink>(
                 c.updates,
                 c.counters.total(),
                 session.decoder.skipped_bytes,
-                tx_dropped,
+                summary.tx_dropped,
             );
-            return Summary { tx_dropped };
+            defmt::info!(
+                "board clock: pass {=u64} us, longest step {=u64} us",
+                clock.now_us().saturating_sub(started_us),
+                summary.longest_step_us
+            );
+            return summary;
         }
+    }
+}
+
+/// A receive error's name, for the log.
+fn error_name(kind: ErrorKind) -> &'static str {
+    match kind {
+        ErrorKind::Overrun => "overrun",
+        ErrorKind::FrameFormat => "framing error",
+        ErrorKind::Parity => "parity error",
+        ErrorKind::Noise => "noise",
+        _ => "other",
     }
 }
 

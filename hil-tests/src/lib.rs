@@ -4,13 +4,18 @@
 //!   host from core-math's f64 reference (and its host-side f32 results).
 //! - the comparison helpers: each logs the case, the expected and the actual value of
 //!   a failure with defmt, and counts failures; each test asserts the count is 0.
-//! - the platform glue: defmt over semihosting, a panic handler that exits with a
-//!   failure status (QEMU's and so cargo's exit status), a HardFault handler.
+//! - the platform glue: defmt over semihosting (RTT with the feature `defmt-rtt`), a
+//!   panic handler that exits with a failure status (QEMU's and so cargo's exit
+//!   status), a HardFault handler.
 #![no_std]
 
-use cortex_m as _; // critical-section implementation for defmt-semihosting
+use cortex_m as _; // critical-section implementation for the defmt logger
 use cortex_m_rt::{exception, ExceptionFrame};
-use defmt_semihosting as _; // the global defmt logger
+// The global defmt logger: semihosting under QEMU, RTT on a real board (by feature).
+#[cfg(feature = "defmt-rtt")]
+use defmt_rtt as _;
+#[cfg(not(feature = "defmt-rtt"))]
+use defmt_semihosting as _;
 
 /// The generated cases (see `build.rs`).
 pub mod golden {

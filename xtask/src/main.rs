@@ -43,7 +43,11 @@ enum Command {
     /// A pass through the firmware under QEMU (docs/telemetry.md), or the demo
     Run(target::RunArgs),
     /// Guest instructions per evaluation, from a QEMU plugin (docs/bench.md)
-    Bench,
+    Bench(target::BenchArgs),
+    /// Flash and static RAM of the release flight binary, per board (docs/target.md)
+    Size(target::SizeArgs),
+    /// The firmware on a real board through probe-rs (docs/target.md)
+    Flash(target::FlashArgs),
     /// Error against run time per backend; runs the bench (docs/error-vs-runtime.md)
     Report(report::Args),
     /// Regenerate docs/stability.md and its maps
@@ -71,7 +75,9 @@ fn main() -> ExitCode {
         Command::Paper(args) => paper::run(&args),
         Command::Test => test_cmd::run(),
         Command::Run(args) => target::run(&args),
-        Command::Bench => target::bench(),
+        Command::Bench(args) => target::bench(&args),
+        Command::Size(args) => target::size(&args),
+        Command::Flash(args) => target::flash(&args),
         Command::Report(args) => report::run(&args),
         Command::Stability(args) => stability::run(&args),
         Command::Ellipsoid(args) => ellipsoid::run(&args),
@@ -105,12 +111,21 @@ mod tests {
             ("paper --out /tmp/paper", true),
             ("run --every 1 --segments all --plot x.png --debug", true),
             ("run --segments 0,5,9 --telemetry t.csv --short", true),
+            ("run --short --release --board stm32f405", true),
+            ("run --demo --board mps2-an386", true),
             ("report --csv --cases 2000 --seed 0x5EED --no-bench", true),
             ("stability --quick", true),
             ("ellipsoid --print", true),
             ("qemu firmware.elf --quiet --test-threads 1", true),
             ("test", true),
             ("bench", true),
+            ("bench --board stm32f405", true),
+            ("size", true),
+            ("size --board mps2-an386", true),
+            ("flash", true),
+            ("flash --board stm32f405 --bin demo --print-command", true),
+            ("run --board stm32f407", false),
+            ("flash --bin bench", false),
             ("run --segment all", false),
             ("run --every 0", false),
             ("run --segments 1,x", false),

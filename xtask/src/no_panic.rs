@@ -29,19 +29,26 @@ struct Build {
     rustc_args: &'static [&'static str],
 }
 
-/// The flight binary, and the real-Earth general form in f32 (its `pixel`, `update` and
-/// `motion`, linked by the footprint binary) until the controller flies it.
-const BUILDS: [Build; 2] = [
+/// The flight binary on each board, and the real-Earth general form in f32 (its
+/// `pixel`, `update` and `motion`, linked by the footprint binary) until the controller
+/// flies it. The features name the board: the builds use no default features.
+const BUILDS: [Build; 3] = [
     Build {
-        what: "the release flight binary",
+        what: "the release flight binary (mps2-an386)",
         bin: "firmware",
-        features: "no-panic-check",
+        features: "mps2-an386,no-panic-check",
+        rustc_args: &[],
+    },
+    Build {
+        what: "the release flight binary (stm32f405, with stm32f4xx-hal)",
+        bin: "firmware",
+        features: "stm32f405,no-panic-check",
         rustc_args: &[],
     },
     Build {
         what: "GENERAL_F32 (the real-Earth f32 form: pixel, update, motion)",
         bin: "footprint",
-        features: "bench,no-panic-check",
+        features: "mps2-an386,bench,no-panic-check",
         rustc_args: &["--cfg", "footprint=\"earth-f32\""],
     },
 ];
@@ -56,6 +63,7 @@ impl Build {
             "--target",
             TARGET,
             "--release",
+            "--no-default-features",
             "--features",
             self.features,
             "--color=never",

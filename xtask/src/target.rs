@@ -1,17 +1,22 @@
 //! The on-target half of the xtask: the firmware under QEMU, the on-target tests, the
 //! instruction counts. See docs/target.md and docs/bench.md.
 //!
-//! - `cargo xtask run`: build the firmware (release) and play a pass through it under
-//!   QEMU (`pass`: telemetry on UART0 through a unix socket, the decoded defmt log on
-//!   stdout, table, plot, reference and fault checks); `--demo` runs the
-//!   default-scene demo instead.
+//! - `cargo xtask run [--board NAME]`: build the firmware (release) for a board
+//!   ([`board`]: `mps2-an386`, the default, or `stm32f405` on QEMU's netduinoplus2) and
+//!   play a pass through it under QEMU (`pass`: telemetry on the board's UART through a
+//!   unix socket, the decoded defmt log on stdout, table, plot, reference and fault
+//!   checks); `--demo` runs the default-scene demo instead.
 //! - `cargo xtask qemu ELF`: the cargo runner for thumbv7em-none-eabihf (QEMU + defmt
 //!   decoding); `.cargo/config.toml` reaches it through `tools/qemu-runner`.
 //! - `cargo xtask bench`: guest instruction counts from a QEMU TCG plugin.
+//! - `cargo xtask size`, `cargo xtask flash`: each board's flash and RAM ([`board`]);
+//!   the flight binary on a real board through probe-rs ([`flash`]).
 //! - [`test_target`]: clippy for the target crates, the hil-tests under QEMU and the
-//!   end-to-end pass test ([`e2e_test`]).
+//!   end-to-end pass test ([`e2e_test`]), on every board.
 
 mod bench;
+mod board;
+mod flash;
 mod pass;
 mod qemu;
 mod tools;
@@ -20,7 +25,10 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
 
-pub use bench::{bench, measure as bench_counts, BenchCounts};
+pub use bench::{bench, measure as bench_counts, BenchArgs, BenchCounts};
+pub use board::{size, SizeArgs};
+use board::{Board, BoardArg};
+pub use flash::{flash, FlashArgs};
 pub use pass::e2e_test;
 pub use qemu::qemu;
 pub use tools::ensure_target_tools;
@@ -33,6 +41,8 @@ pub const NO_FPU_TARGET: &str = "thumbv7m-none-eabi";
 /// `cargo xtask run`'s options.
 #[derive(clap::Args)]
 pub struct RunArgs {
+    #[command(flatten)]
+    board: BoardArg,
     /// The default-scene demo (one synthetic NAV frame, no UART) instead of a pass
     #[arg(long)]
     demo: bool,
@@ -81,17 +91,19 @@ fn parse_segments(v: &str) -> Result<Segments, String> {
 /// `cargo xtask run`: a pass through the firmware under QEMU (docs/telemetry.md), or the
 /// default-scene demo.
 pub fn run(args: &RunArgs) -> Result<(), String> {
+    let board = args.board.board;
     let release = !args.debug;
     if let Some(path) = &args.export_telemetry {
         return pass::export(path);
     }
     if args.demo {
         ensure_target_tools()?;
-        let elf = build_bin("firmware", "demo", release, &[])?;
+        let elf = build_board_bin(board, "firmware", "demo", release, &[])?;
         let outcome = qemu::run_elf(&elf, &qemu::Options::default())?;
         return exit_like(outcome.status);
     }
     pass::run(&pass::RunOptions {
+        board,
         release,
         short: args.short,
         telemetry: args.telemetry.clone(),
@@ -106,29 +118,39 @@ pub fn run(args: &RunArgs) -> Result<(), String> {
 
 /// Every check of the target crates, for `cargo xtask test`: toolchain and QEMU present,
 /// clippy with `-D warnings` on thumbv7em for core-math, controller, firmware and
-/// hil-tests, and on thumbv7m (no FPU) for core-math's fixed-point backend, the hil-tests under QEMU in the test (dev) and release profiles, then the
+/// hil-tests (the firmware for each board, and the STM32F405 with its real-board logger
+/// too), and on thumbv7m (no FPU) for core-math's fixed-point backend; then, on each
+/// board's QEMU machine, the hil-tests in the test (dev) and release profiles and the
 /// end-to-end pass test ([`e2e_test`]).
 pub fn test_target() -> Result<(), String> {
     let started = Instant::now();
     ensure_target_tools()?;
     // core-math with its default backends and as the lean flight build links it (the
-    // f32 closed form only), the controller, then the binaries with every feature.
-    let lints: [&[&str]; 4] = [
+    // f32 closed form only), the controller.
+    let lints: [&[&str]; 3] = [
         &["--package", "core-math", "--lib"],
         &["--package", "core-math", "--lib", "--no-default-features"],
         &["--package", "controller", "--lib"],
-        &[
-            "--package",
-            "firmware",
-            "--package",
-            "hil-tests",
-            "--all-targets",
-            "--all-features",
-        ],
     ];
     for which in lints {
         let mut args = vec!["clippy"];
         args.extend_from_slice(which);
+        args.extend_from_slice(&["--target", TARGET, "--", "-D", "warnings"]);
+        cargo(&args)?;
+    }
+    // The firmware's binaries with every feature but the other boards', for each board;
+    // the hil-tests; and both with the RTT logger of a real STM32F405.
+    let board_lints: [(&str, Board, &[&str]); 5] = [
+        ("firmware", Board::Mps2An386, &["bench", "no-panic-check"]),
+        ("firmware", Board::Stm32f405, &["bench", "no-panic-check"]),
+        ("firmware", Board::Stm32f405, &["defmt-rtt"]),
+        ("hil-tests", Board::DEFAULT, &[]),
+        ("hil-tests", Board::Stm32f405, &["defmt-rtt"]),
+    ];
+    for (package, board, extra) in board_lints {
+        let features = board.cargo_features(extra);
+        let mut args = vec!["clippy", "--package", package, "--all-targets"];
+        args.extend(features.iter().map(String::as_str));
         args.extend_from_slice(&["--target", TARGET, "--", "-D", "warnings"]);
         cargo(&args)?;
     }
@@ -148,15 +170,20 @@ pub fn test_target() -> Result<(), String> {
         "warnings",
     ])?;
     let runner = runner_config()?;
-    for profile in [None, Some("--release")] {
-        let mut args = vec!["test", "--package", "hil-tests", "--target", TARGET];
-        args.extend(runner.iter().map(String::as_str));
-        args.extend(profile);
-        cargo(&args)?;
+    for board in Board::ALL {
+        let features = board.cargo_features(&[]);
+        for profile in [None, Some("--release")] {
+            let mut args = vec!["test", "--package", "hil-tests", "--target", TARGET];
+            args.extend(features.iter().map(String::as_str));
+            args.extend(runner.iter().map(String::as_str));
+            args.extend(profile);
+            cargo(&args)?;
+        }
+        e2e_test(board)?;
     }
-    e2e_test()?;
     eprintln!(
-        "xtask: target checks passed in {:.1} s",
+        "xtask: target checks passed on {} in {:.1} s",
+        board::names(),
         started.elapsed().as_secs_f64()
     );
     Ok(())
@@ -208,19 +235,20 @@ fn runner_config() -> Result<Vec<String>, String> {
     ])
 }
 
-/// Builds one binary of `package` for the target and returns its ELF's path (taken from
-/// cargo's JSON messages, so any target-dir setting is honoured).
-fn build_bin(
+/// Builds one binary of `package` for the target and `board` and returns its ELF's path
+/// (taken from cargo's JSON messages, so any target-dir setting is honoured).
+fn build_board_bin(
+    board: Board,
     package: &str,
     bin: &str,
     release: bool,
     features: &[&str],
 ) -> Result<PathBuf, String> {
-    build_bin_with(package, bin, release, features, &[])
+    build_elf(board, package, bin, release, features, &[])
 }
 
-/// [`build_bin`] with `rustc_args` passed to the compiler for that binary alone
-/// (`cargo rustc ... -- rustc_args`; with none, `cargo build`).
+/// [`build_board_bin`] for the default board with `rustc_args` passed to the compiler
+/// for that binary alone (`cargo rustc ... -- rustc_args`; with none, `cargo build`).
 pub(crate) fn build_bin_with(
     package: &str,
     bin: &str,
@@ -228,45 +256,45 @@ pub(crate) fn build_bin_with(
     features: &[&str],
     rustc_args: &[&str],
 ) -> Result<PathBuf, String> {
-    let mut cmd = cargo_command();
-    cmd.args([
-        if rustc_args.is_empty() {
-            "build"
-        } else {
-            "rustc"
-        },
+    build_elf(Board::DEFAULT, package, bin, release, features, rustc_args)
+}
+
+fn build_elf(
+    board: Board,
+    package: &str,
+    bin: &str,
+    release: bool,
+    features: &[&str],
+    rustc_args: &[&str],
+) -> Result<PathBuf, String> {
+    let subcommand = if rustc_args.is_empty() {
+        "build"
+    } else {
+        "rustc"
+    };
+    let mut args: Vec<String> = [
+        subcommand,
         "--package",
         package,
         "--bin",
         bin,
         "--target",
         TARGET,
-    ])
-    .arg("--message-format=json-render-diagnostics");
-    if !features.is_empty() {
-        cmd.arg("--features").arg(features.join(","));
-    }
+    ]
+    .map(String::from)
+    .to_vec();
+    args.extend(board.cargo_features(features));
     if release {
-        cmd.arg("--release");
+        args.push("--release".into());
     }
+    args.push("--message-format=json-render-diagnostics".into());
     if !rustc_args.is_empty() {
-        cmd.arg("--").args(rustc_args);
+        args.push("--".into());
+        args.extend(rustc_args.iter().map(|a| a.to_string()));
     }
-    eprintln!(
-        "xtask: cargo {} --package {package} --bin {bin} --target {TARGET}{}{}",
-        if rustc_args.is_empty() {
-            "build"
-        } else {
-            "rustc"
-        },
-        if release { " --release" } else { "" },
-        if rustc_args.is_empty() {
-            String::new()
-        } else {
-            format!(" -- {}", rustc_args.join(" "))
-        }
-    );
-    let out = cmd
+    eprintln!("xtask: cargo {}", args.join(" "));
+    let out = cargo_command()
+        .args(&args)
         .stderr(std::process::Stdio::inherit())
         .output()
         .map_err(|e| format!("cannot start cargo: {e}"))?;

@@ -11,7 +11,8 @@ use std::process::Command;
 
 use object::{Object, ObjectSymbol};
 
-use super::{build_bin, ensure_target_tools, qemu, tools, workspace_root};
+use super::board::{Board, BoardArg};
+use super::{build_board_bin, ensure_target_tools, qemu, tools, workspace_root};
 
 const PLUGIN_SOURCE: &str = "tools/qemu-stopwatch/stopwatch.c";
 const LABEL_PREFIX: &str = "BENCH ";
@@ -35,12 +36,16 @@ impl BenchCounts {
     }
 }
 
-/// `cargo xtask bench`: measure, then print every region.
-pub fn bench() -> Result<(), String> {
-    let counts = measure(false)?;
+/// `cargo xtask bench`'s options: the board.
+pub type BenchArgs = BoardArg;
+
+/// `cargo xtask bench`: measure on the board's QEMU machine, then print every region.
+pub fn bench(args: &BenchArgs) -> Result<(), String> {
+    let board = args.board;
+    let counts = measure_on(board, false)?;
     let overhead = counts.overhead;
     println!();
-    println!("guest instructions per region (Cortex-M4 under QEMU {}, release: opt-level 3, fat LTO, codegen-units 1)", counts.qemu_version);
+    println!("guest instructions per region (Cortex-M4 under QEMU {}, board {} ({}), release: opt-level 3, fat LTO, codegen-units 1)", counts.qemu_version, board.name(), board.qemu_machine());
     println!("net = raw - {overhead} (the empty region: markers and black_box). Instructions, not cycles.");
     println!();
     println!("{:>8} {:>8}  region", "net", "raw");
@@ -54,11 +59,16 @@ pub fn bench() -> Result<(), String> {
 /// the parsed counts. The decoded defmt log is echoed as the firmware runs, to stdout or,
 /// with `log_to_stderr`, to stderr.
 pub fn measure(log_to_stderr: bool) -> Result<BenchCounts, String> {
+    measure_on(Board::DEFAULT, log_to_stderr)
+}
+
+/// [`measure`] on `board`.
+fn measure_on(board: Board, log_to_stderr: bool) -> Result<BenchCounts, String> {
     ensure_target_tools()?;
     if !tools::have("gcc") {
         tools::apt_install(&["gcc", "libc6-dev"], "gcc (to build the QEMU plugin)")?;
     }
-    let elf = build_bin("firmware", "bench", true, &["bench"])?;
+    let elf = build_board_bin(board, "firmware", "bench", true, &["bench"])?;
     let dir = elf.parent().ok_or("bench ELF has no folder")?.to_path_buf();
     let plugin = build_plugin(&dir)?;
     let (start, stop) = marker_addresses(&elf)?;
@@ -77,6 +87,7 @@ pub fn measure(log_to_stderr: bool) -> Result<BenchCounts, String> {
         capture: true,
         serial: None,
         log_to_stderr,
+        link_ready: None,
     };
     let outcome = qemu::run_elf(&elf, &options)?;
     if outcome.status != 0 {

@@ -35,7 +35,8 @@ use crate::plot::{Legend, Plot, Series};
 use check::{Downlink, F32_REL_TOLERANCE};
 use scenario::Pass;
 
-use super::{build_bin, ensure_target_tools, qemu, workspace_root};
+use super::board::Board;
+use super::{build_board_bin, ensure_target_tools, qemu, workspace_root};
 
 /// Segments shown in the table by default (first, one of the two central ones, last).
 pub const TABLE_SEGMENTS: [u8; 3] = [0, 5, 9];
@@ -44,6 +45,7 @@ pub const TABLE_EVERY_S: u64 = 10;
 
 /// What `run` was asked to do.
 pub struct RunOptions {
+    pub board: Board,
     pub release: bool,
     /// The end-to-end test's one-minute pass instead of the default one.
     pub short: bool,
@@ -65,7 +67,7 @@ pub fn run(options: &RunOptions) -> Result<(), String> {
         None => scenario::default_pass(tick_us)?,
     };
     ensure_target_tools()?;
-    let elf = build_bin("firmware", "firmware", options.release, &[])?;
+    let elf = build_board_bin(options.board, "firmware", "firmware", options.release, &[])?;
     let result = play(&elf, &pass)?;
     print_table(&pass, &result, options.every_s.max(1), &options.segments);
     let plot = options
@@ -101,14 +103,15 @@ pub fn export(path: &Path) -> Result<(), String> {
 /// The end-to-end test (`cargo xtask test`): a one-minute pass with every kind of
 /// fault through the firmware (release) under QEMU; every period against the
 /// reference, every fault counted, no output changed by a fault.
-pub fn e2e_test() -> Result<(), String> {
+pub fn e2e_test(board: Board) -> Result<(), String> {
     let started = Instant::now();
     let pass = scenario::short_pass(Config::default().update_period_us)?;
-    let elf = build_bin("firmware", "firmware", true, &[])?;
+    let elf = build_board_bin(board, "firmware", "firmware", true, &[])?;
     let result = play(&elf, &pass)?;
     result.finish()?;
     eprintln!(
-        "xtask: end-to-end pass test passed in {:.1} s",
+        "xtask: end-to-end pass test passed on {} in {:.1} s",
+        board.name(),
         started.elapsed().as_secs_f64()
     );
     Ok(())
@@ -400,6 +403,7 @@ fn run_qemu(elf: &Path, uplink: &[u8]) -> Result<(i32, Vec<u8>), String> {
     let _ = std::fs::remove_file(&socket);
     let listener = UnixListener::bind(&socket)
         .map_err(|e| format!("cannot listen on {}: {e}", socket.display()))?;
+    let (link_ready, ready) = std::sync::mpsc::channel();
     let options = qemu::Options {
         extra_args: vec![
             "-chardev".into(),
@@ -408,6 +412,7 @@ fn run_qemu(elf: &Path, uplink: &[u8]) -> Result<(i32, Vec<u8>), String> {
         serial: Some("chardev:telemetry".into()),
         capture: false,
         log_to_stderr: false,
+        link_ready: Some(link_ready),
     };
     let elf_owned = elf.to_path_buf();
     let emulator = std::thread::spawn(move || qemu::run_elf(&elf_owned, &options));
@@ -442,6 +447,11 @@ fn run_qemu(elf: &Path, uplink: &[u8]) -> Result<(i32, Vec<u8>), String> {
     };
     conn.set_nonblocking(false)
         .map_err(|e| format!("socket: {e}"))?;
+    // Not a byte before the firmware says its link is enabled: the STM32F405's USART
+    // drops what arrives earlier (docs/target.md, "Boards").
+    ready
+        .recv_timeout(Duration::from_secs(30))
+        .map_err(|_| "the firmware never said that its telemetry link was ready".to_string())?;
     let mut writer = conn.try_clone().map_err(|e| format!("socket: {e}"))?;
     let data = uplink.to_vec();
     // The firmware reads as fast as it computes; the writer blocks when QEMU's side is

@@ -1,6 +1,10 @@
 //! QEMU as the cargo runner for thumbv7em-none-eabihf, with the defmt stream decoded on
 //! the host (the `defmt-decoder` crate, pinned to 1.2.x in xtask/Cargo.toml).
 //!
+//! The machine is the one of the board the ELF was linked for (its memory layout names
+//! it: [`Board::of_elf`]): `mps2-an386`, or `netduinoplus2` for the STM32F405, so
+//! `cargo run`/`cargo test` with either board's features need no other setting.
+//!
 //! The firmware logs defmt frames to semihosting stdout (`defmt-semihosting`); QEMU
 //! writes them to its stdout (`-semihosting-config target=native`), the UART goes
 //! nowhere (`-serial none`) or to a chardev of the caller's (`Options::serial`: the
@@ -16,8 +20,9 @@ use std::time::{Duration, Instant};
 
 use defmt_decoder::{DecodeError, Frame, Location, Table};
 
+use super::board::Board;
+
 pub const QEMU: &str = "qemu-system-arm";
-pub const MACHINE: &str = "mps2-an386";
 /// Wall-clock limit of one QEMU run unless `TDI_QEMU_TIMEOUT_S` says otherwise: a hung
 /// firmware fails the command instead of blocking it.
 const DEFAULT_TIMEOUT_S: u64 = 300;
@@ -29,13 +34,21 @@ pub struct Options {
     pub extra_args: Vec<String>,
     /// Keep the decoded messages (without level and location) for the caller.
     pub capture: bool,
-    /// QEMU's `-serial` for UART0 (None: `none`, nothing connected), e.g.
+    /// QEMU's `-serial` for the first UART (the board's telemetry link: UART0 of the
+    /// mps2-an386, USART1 of the STM32F405; None: `none`, nothing connected), e.g.
     /// `chardev:ID` with a `-chardev ...,id=ID` in `extra_args`.
     pub serial: Option<String>,
     /// Echo the decoded log to stderr instead of stdout (for commands whose stdout is
     /// data, e.g. `report --csv`).
     pub log_to_stderr: bool,
+    /// Told once, when the firmware logs [`LINK_READY`]: from then on its link takes
+    /// bytes (the STM32F405's USART drops what arrives before it is enabled).
+    pub link_ready: Option<std::sync::mpsc::Sender<()>>,
 }
+
+/// The words of the flight firmware's first log line that say its link is up
+/// (`firmware::telemetry::READY`).
+pub const LINK_READY: &str = "telemetry link ready";
 
 /// What a run gave.
 pub struct Outcome {
@@ -68,26 +81,20 @@ pub fn run_elf(elf: &Path, options: &Options) -> Result<Outcome, String> {
         Some(t) => t.get_locations(&bytes).unwrap_or_default(),
         None => BTreeMap::new(),
     };
+    let board = Board::of_elf(&bytes).map_err(|e| format!("{}: {e}", elf.display()))?;
 
     let mut cmd = Command::new(QEMU);
-    cmd.args([
-        "-cpu",
-        "cortex-m4",
-        "-machine",
-        MACHINE,
-        "-nographic",
-        "-monitor",
-        "none",
-    ])
-    .arg("-serial")
-    .arg(options.serial.as_deref().unwrap_or("none"))
-    .args(["-semihosting-config", "enable=on,target=native"])
-    .args(&options.extra_args)
-    .arg("-kernel")
-    .arg(elf)
-    .stdin(Stdio::null())
-    .stdout(Stdio::piped())
-    .stderr(Stdio::inherit());
+    cmd.args(["-cpu", "cortex-m4", "-machine", board.qemu_machine()])
+        .args(["-nographic", "-monitor", "none"])
+        .arg("-serial")
+        .arg(options.serial.as_deref().unwrap_or("none"))
+        .args(["-semihosting-config", "enable=on,target=native"])
+        .args(&options.extra_args)
+        .arg("-kernel")
+        .arg(elf)
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::inherit());
     let mut child = cmd.spawn().map_err(|e| {
         format!("cannot start {QEMU} (run `cargo xtask run` once to install it): {e}")
     })?;
@@ -100,6 +107,7 @@ pub fn run_elf(elf: &Path, options: &Options) -> Result<Outcome, String> {
         root: super::workspace_root(),
         capture: options.capture,
         log_to_stderr: options.log_to_stderr,
+        link_ready: options.link_ready.clone(),
         messages: Vec::new(),
     };
     let read = match &table {
@@ -165,6 +173,7 @@ struct Printer<'a> {
     root: PathBuf,
     capture: bool,
     log_to_stderr: bool,
+    link_ready: Option<std::sync::mpsc::Sender<()>>,
     messages: Vec<String>,
 }
 
@@ -192,6 +201,12 @@ impl Printer<'_> {
             let mut out = std::io::stdout().lock();
             let _ = writeln!(out, "{line}");
             let _ = out.flush();
+        }
+        if message.contains(LINK_READY) {
+            if let Some(ready) = self.link_ready.take() {
+                // The receiver may have given up already; nothing else to tell.
+                let _ = ready.send(());
+            }
         }
         if self.capture {
             self.messages.push(message);

@@ -2,9 +2,10 @@
 
 use std::process::{Command, Stdio};
 
+use super::board::Board;
 use super::TARGET;
 
-/// The Rust target (rustup) and qemu-system-arm with the mps2-an386 machine. Installs
+/// The Rust target (rustup) and qemu-system-arm with every board's machine. Installs
 /// the target with rustup and QEMU with apt-get when running as root; otherwise an
 /// error that says what to install.
 pub fn ensure_target_tools() -> Result<(), String> {
@@ -112,13 +113,23 @@ fn ensure_qemu() -> Result<(), String> {
         .args(["-machine", "help"])
         .output()
         .map_err(|e| format!("cannot run {}: {e}", super::qemu::QEMU))?;
-    if String::from_utf8_lossy(&machines.stdout).contains(super::qemu::MACHINE) {
+    let listed = String::from_utf8_lossy(&machines.stdout);
+    let missing: Vec<&str> = Board::ALL
+        .iter()
+        .map(|b| b.qemu_machine())
+        .filter(|m| {
+            !listed
+                .lines()
+                .any(|l| l.split_whitespace().next() == Some(*m))
+        })
+        .collect();
+    if missing.is_empty() {
         Ok(())
     } else {
         Err(format!(
-            "{} has no `{}` machine: QEMU 6.0 or newer is needed",
+            "{} lacks the machine(s) {}: QEMU 6.0 or newer is needed",
             super::qemu::QEMU,
-            super::qemu::MACHINE
+            missing.join(", ")
         ))
     }
 }

@@ -1,7 +1,9 @@
-//! The two CMSDK APB peripherals of the mps2-an386 (QEMU's `-machine mps2-an386`) the
-//! controller drives: UART0, the telemetry link, and TIMER0, standing in for segment
-//! 0's line clock. Register maps from the Cortex-M System Design Kit TRM (ARM DDI0479C)
-//! as QEMU models them (hw/char/cmsdk-apb-uart.c, hw/timer/cmsdk-apb-timer.c).
+//! Board `mps2-an386` (the default): QEMU's `-machine mps2-an386`, a Cortex-M4 with FPU
+//! and the Cortex-M System Design Kit's APB peripherals at fixed addresses, driven
+//! directly (there is no HAL for it): UART0, the telemetry link; TIMER0, standing in
+//! for segment 0's line clock; TIMER1, free-running, the [`Monotonic`] clock. Register
+//! maps from the Cortex-M System Design Kit TRM (ARM DDI0479C) as QEMU models them
+//! (hw/char/cmsdk-apb-uart.c, hw/timer/cmsdk-apb-timer.c).
 //!
 //! UART, as modelled by QEMU: a one-byte receive buffer (STATE.RXFULL set on arrival,
 //! cleared by reading DATA) and QEMU offers the next byte only once it is empty, so the
@@ -11,15 +13,56 @@
 //! (STATE.RXOVERRUN) if a byte is not read within one character time: a board build
 //! would read it from the RX interrupt into a ring buffer.
 
+use core::sync::atomic::{AtomicBool, Ordering};
+
+use embedded_hal_nb::serial::{ErrorKind, ErrorType, Read, Write};
+
+use super::{BoardError, Extended, Monotonic, Parts, LINK_BAUD};
 use crate::line_clock::ReloadRegister;
-use crate::link::ByteLink;
+use crate::link::RxWait;
+
+/// The board's name (the cargo feature).
+pub const NAME: &str = "mps2-an386";
+/// The telemetry link's peripheral.
+pub const LINK: &str = "UART0";
+/// The board's telemetry link, segment 0's line clock and clock.
+pub type Link = Uart;
+pub type LineClock = Timer;
+pub type Clock = FreeRunning;
 
 /// mps2-an386 UART0 base address.
-pub const UART0_BASE: usize = 0x4000_4000;
+const UART0_BASE: usize = 0x4000_4000;
 /// mps2-an386 TIMER0 base address.
-pub const TIMER0_BASE: usize = 0x4000_0000;
+const TIMER0_BASE: usize = 0x4000_0000;
+/// mps2-an386 TIMER1 base address.
+const TIMER1_BASE: usize = 0x4000_1000;
 /// The APB clock of UARTs and timers on the mps2-an386 (Hz).
-pub const PCLK_HZ: u32 = 25_000_000;
+const PCLK_HZ: u32 = 25_000_000;
+
+/// Brings the board up: UART0 at 115 200 Bd with its receive interrupt as a wake-up
+/// source, TIMER0 stopped until its first period, TIMER1 running. Call once.
+pub fn take() -> Result<Parts<Link, LineClock, Clock>, BoardError> {
+    // The same guard as a HAL's `Peripherals::take`: a second call gets nothing.
+    static TAKEN: AtomicBool = AtomicBool::new(false);
+    if TAKEN.swap(true, Ordering::Relaxed) {
+        return Err(BoardError::Taken);
+    }
+    // SAFETY: the guard above lets this run once, so nothing else owns UART0, TIMER0
+    // or TIMER1, and the firmware uses no interrupt handler.
+    let (link, line_clock, clock) = unsafe {
+        (
+            Uart::uart0(LINK_BAUD),
+            Timer::timer0(),
+            FreeRunning::timer1(),
+        )
+    };
+    Ok(Parts {
+        link,
+        line_clock,
+        clock,
+        timer_clock_hz: PCLK_HZ,
+    })
+}
 
 mod uart_reg {
     pub const DATA: usize = 0x00;
@@ -35,6 +78,8 @@ mod uart_reg {
     pub const CTRL_TX_EN: u32 = 1 << 0;
     pub const CTRL_RX_EN: u32 = 1 << 1;
     pub const CTRL_RX_INTEN: u32 = 1 << 3;
+    /// STATE: receive overrun (write 1 to clear).
+    pub const STATE_RX_OVERRUN: u32 = 1 << 3;
     /// INTSTATUS: receive interrupt (write 1 to clear).
     pub const INT_RX: u32 = 1 << 1;
 }
@@ -52,6 +97,7 @@ unsafe impl cortex_m::interrupt::InterruptNumber for Uart0Rx {
 
 mod timer_reg {
     pub const CTRL: usize = 0x0;
+    pub const VALUE: usize = 0x4;
     pub const RELOAD: usize = 0x8;
     /// CTRL: counter enable.
     pub const CTRL_EN: u32 = 1 << 0;
@@ -83,12 +129,12 @@ pub struct Uart {
 impl Uart {
     /// UART0 of the mps2-an386, enabled for transmit and receive at `baud` (8N1), its
     /// receive interrupt enabled in the UART and the NVIC but masked in the core
-    /// (PRIMASK): it only wakes the core from [`ByteLink::wait`], no handler runs.
+    /// (PRIMASK): it only wakes the core from [`RxWait::wait_for_rx`], no handler runs.
     ///
     /// # Safety
     /// The caller must be the only owner of UART0 and the only user of interrupts
     /// (this sets PRIMASK for good).
-    pub unsafe fn uart0(baud: u32) -> Uart {
+    unsafe fn uart0(baud: u32) -> Uart {
         let mut uart = Uart {
             regs: Registers { base: UART0_BASE },
         };
@@ -108,32 +154,51 @@ impl Uart {
     }
 }
 
-impl ByteLink for Uart {
-    fn read_byte(&mut self) -> Option<u8> {
-        if self.regs.read(uart_reg::STATE) & uart_reg::STATE_RX_FULL == 0 {
-            return None;
-        }
-        Some(self.regs.read(uart_reg::DATA) as u8)
-    }
+impl ErrorType for Uart {
+    type Error = ErrorKind;
+}
 
-    fn try_write_byte(&mut self, byte: u8) -> bool {
-        if !self.tx_idle() {
-            return false;
+impl Read<u8> for Uart {
+    /// The received byte; an overrun (a byte lost because the previous one was not read
+    /// in time: never under QEMU, whose UART is flow-controlled) is reported once, then
+    /// the byte that is there is read.
+    fn read(&mut self) -> nb::Result<u8, ErrorKind> {
+        let state = self.regs.read(uart_reg::STATE);
+        if state & uart_reg::STATE_RX_OVERRUN != 0 {
+            self.regs.write(uart_reg::STATE, uart_reg::STATE_RX_OVERRUN);
+            return Err(nb::Error::Other(ErrorKind::Overrun));
         }
+        if state & uart_reg::STATE_RX_FULL == 0 {
+            return Err(nb::Error::WouldBlock);
+        }
+        Ok(self.regs.read(uart_reg::DATA) as u8)
+    }
+}
+
+impl Write<u8> for Uart {
+    fn write(&mut self, byte: u8) -> nb::Result<(), ErrorKind> {
+        self.flush()?;
         self.regs.write(uart_reg::DATA, u32::from(byte));
-        true
+        Ok(())
     }
 
-    fn tx_idle(&mut self) -> bool {
-        self.regs.read(uart_reg::STATE) & uart_reg::STATE_TX_FULL == 0
+    /// Done when the one-byte transmit buffer is empty.
+    fn flush(&mut self) -> nb::Result<(), ErrorKind> {
+        if self.regs.read(uart_reg::STATE) & uart_reg::STATE_TX_FULL == 0 {
+            Ok(())
+        } else {
+            Err(nb::Error::WouldBlock)
+        }
     }
+}
 
+impl RxWait for Uart {
     /// Sleeps (WFI) until the receive interrupt is pending. The order makes a lost
     /// wake-up impossible: the pending bit and the UART's interrupt line are cleared
     /// first, then RXFULL is checked, so a byte that arrived before the check is seen
     /// there and one that arrives after it raises the line again and ends the WFI.
     /// (WFI wakes on a pending interrupt even with PRIMASK set.)
-    fn wait(&mut self) {
+    fn wait_for_rx(&mut self) {
         cortex_m::peripheral::NVIC::unpend(Uart0Rx);
         self.regs.write(uart_reg::INTSTATUS, uart_reg::INT_RX);
         if self.regs.read(uart_reg::STATE) & uart_reg::STATE_RX_FULL == 0 {
@@ -153,7 +218,7 @@ impl Timer {
     ///
     /// # Safety
     /// The caller must be the only owner of TIMER0 (call this once).
-    pub unsafe fn timer0() -> Timer {
+    unsafe fn timer0() -> Timer {
         let mut timer = Timer {
             regs: Registers { base: TIMER0_BASE },
         };
@@ -173,5 +238,41 @@ impl ReloadRegister for Timer {
     }
     fn reload(&self) -> u32 {
         self.regs.read(timer_reg::RELOAD)
+    }
+}
+
+/// TIMER1 counting down from 2^32 - 1 on the 25 MHz APB clock, round and round (it wraps
+/// every 172 s), as a [`Monotonic`]: QEMU runs it on its virtual clock, which without
+/// `-icount` follows the host's.
+pub struct FreeRunning {
+    regs: Registers,
+    ticks: Extended,
+}
+
+impl FreeRunning {
+    /// TIMER1 of the mps2-an386, started.
+    ///
+    /// # Safety
+    /// The caller must be the only owner of TIMER1 (call this once).
+    unsafe fn timer1() -> FreeRunning {
+        let mut regs = Registers { base: TIMER1_BASE };
+        regs.write(timer_reg::CTRL, 0);
+        regs.write(timer_reg::RELOAD, u32::MAX);
+        regs.write(timer_reg::VALUE, u32::MAX);
+        regs.write(timer_reg::CTRL, timer_reg::CTRL_EN);
+        let ticks = Extended::new(1 << 32, Self::elapsed(&regs));
+        FreeRunning { regs, ticks }
+    }
+
+    /// Ticks since the count started, modulo 2^32 (the counter counts down).
+    fn elapsed(regs: &Registers) -> u32 {
+        !regs.read(timer_reg::VALUE)
+    }
+}
+
+impl Monotonic for FreeRunning {
+    fn now_us(&mut self) -> u64 {
+        let ticks = self.ticks.update(Self::elapsed(&self.regs));
+        ticks / u64::from(PCLK_HZ / 1_000_000)
     }
 }

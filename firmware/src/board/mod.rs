@@ -1,0 +1,116 @@
+//! The board layer: what the application needs from a board, as traits, and the one
+//! board module the cargo feature selects (docs/target.md, "Boards").
+//!
+//! A board hands the application three things ([`Parts`]):
+//! - the telemetry link: an `embedded-hal-nb` serial port of bytes that can also sleep
+//!   until a byte may have arrived ([`crate::link::Link`]);
+//! - segment 0's line clock: a timer's reload register
+//!   ([`crate::line_clock::ReloadRegister`], the project's own trait: embedded-hal 1.0
+//!   has no timer traits);
+//! - time: a [`Monotonic`] microsecond count.
+//!
+//! Each board module builds these from its hardware and exports the same names: `NAME`,
+//! `LINK`, `take()` and the `Link`, `LineClock` and `Clock` types. The controller, the
+//! session and the telemetry loop see only the traits. No hardware address appears
+//! outside the board modules.
+//!
+//! | feature | module | link | line clock | clock |
+//! |---|---|---|---|---|
+//! | `mps2-an386` (default) | [`mps2_an386`] | CMSDK UART0 | CMSDK TIMER0 RELOAD | CMSDK TIMER1 |
+//! | `stm32f405` | `stm32f405` (stm32f4xx-hal) | USART1 | TIM2 ARR | TIM5 (1 MHz) |
+
+#[cfg(all(feature = "mps2-an386", feature = "stm32f405"))]
+compile_error!(
+    "two boards selected: build with `--no-default-features --features stm32f405` for the STM32F405"
+);
+#[cfg(not(any(feature = "mps2-an386", feature = "stm32f405")))]
+compile_error!("no board selected: enable the feature `mps2-an386` or `stm32f405`");
+
+#[cfg(feature = "mps2-an386")]
+pub mod mps2_an386;
+#[cfg(feature = "mps2-an386")]
+pub use mps2_an386::{take, Clock, LineClock, Link, LINK, NAME};
+
+#[cfg(feature = "stm32f405")]
+pub mod stm32f405;
+#[cfg(feature = "stm32f405")]
+pub use stm32f405::{take, Clock, LineClock, Link, LINK, NAME};
+
+/// The telemetry link's speed (baud), 8N1: the ground link's, the same on every board
+/// (QEMU ignores it).
+pub const LINK_BAUD: u32 = 115_200;
+
+/// A monotonic time source: microseconds since the board was brought up.
+pub trait Monotonic {
+    /// Never decreases (between two calls less than one wrap of the board's counter
+    /// apart: see each board's `Clock`).
+    fn now_us(&mut self) -> u64;
+}
+
+/// What a board hands the application.
+pub struct Parts<L, C, M> {
+    pub link: L,
+    pub line_clock: C,
+    pub clock: M,
+    /// The frequency segment 0's timer counts at (Hz). On QEMU neither board can count
+    /// at the scene's 10 MHz line clock: the reload register path is real, the rate is
+    /// not (docs/target.md).
+    pub timer_clock_hz: u32,
+}
+
+/// Why a board could not be brought up.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BoardError {
+    /// The peripherals were already taken (`take` called twice).
+    Taken,
+    /// The HAL refused the serial port's configuration (baud rate out of reach).
+    SerialConfig,
+    /// The HAL refused a timer's configuration.
+    TimerConfig,
+}
+
+impl defmt::Format for BoardError {
+    fn format(&self, f: defmt::Formatter<'_>) {
+        let what = match self {
+            BoardError::Taken => "peripherals already taken",
+            BoardError::SerialConfig => "serial port configuration refused",
+            BoardError::TimerConfig => "timer configuration refused",
+        };
+        defmt::write!(f, "{=str}", what);
+    }
+}
+
+/// A free-running counter's readings extended to a 64-bit count, for a [`Monotonic`]:
+/// the counter wraps every `modulus` ticks, and each reading adds the ticks since the
+/// previous one (so readings must come less than one wrap apart).
+pub struct Extended {
+    modulus: u64,
+    last: u32,
+    total: u64,
+}
+
+impl Extended {
+    /// A counter wrapping after `modulus` ticks (2^32 for a full 32-bit counter), whose
+    /// current reading is `now`.
+    pub const fn new(modulus: u64, now: u32) -> Extended {
+        Extended {
+            modulus,
+            last: now,
+            total: 0,
+        }
+    }
+
+    /// Ticks since `new`, given the counter's reading `now`.
+    pub fn update(&mut self, now: u32) -> u64 {
+        let (now64, last64) = (u64::from(now), u64::from(self.last));
+        let elapsed = if now64 >= last64 {
+            now64 - last64
+        } else {
+            // Wrapped once: up to the modulus, then from zero.
+            self.modulus.saturating_sub(last64).saturating_add(now64)
+        };
+        self.last = now;
+        self.total = self.total.saturating_add(elapsed);
+        self.total
+    }
+}

@@ -1,0 +1,158 @@
+//! Board `stm32f405`: an STM32F405RG (Cortex-M4F) through `stm32f4xx-hal`. Runs on
+//! QEMU's `netduinoplus2` (an STM32F405RG) and is the route to a real board through
+//! probe-rs (docs/target.md, "Boards" and "A real board").
+//!
+//! - Clock: the internal 16 MHz HSI as reset leaves it (`RCC.constrain()`). QEMU models
+//!   no HSE or PLL (asking for them waits forever for a ready bit); a flight build would
+//!   run the PLL from a crystal so that a timer counts the scene's 10 MHz line clock
+//!   exactly.
+//! - Link: USART1 on PA9 (TX) and PA10 (RX), 115 200 Bd 8N1, through the HAL's
+//!   `embedded-hal-nb` serial port. Its receive interrupt (RXNE) is enabled in the
+//!   USART and the NVIC but masked by PRIMASK: it only ends the loop's WFI.
+//! - Line clock: TIM2 (32-bit) counting the timer clock (PSC 0), segment 0's period in
+//!   its auto-reload register with preload (ARPE), so a new period starts at the end of
+//!   the current line, never in the middle of one.
+//! - Clock: TIM5 (32-bit) as the HAL's 1 MHz counter, free-running.
+//!
+//! Under QEMU the USART is flow-controlled like the mps2's UART (the host's next byte
+//! waits until DR has been read) but drops bytes that arrive before it is enabled, which
+//! is why the firmware announces that the link is ready and the pass player waits for
+//! that line. QEMU's timers count a nominal 1 GHz divided by PSC + 1 whatever the clock
+//! tree: ARR and PSC write and read back (the register path), the rates do not match
+//! the HSI's (the TIM5 "microseconds" run 62.5 times fast).
+
+use embedded_hal_nb::serial::{ErrorType, Read, Write};
+use stm32f4xx_hal::pac::{self, Interrupt, NVIC};
+use stm32f4xx_hal::prelude::*;
+use stm32f4xx_hal::serial::{self, Event, RxISR, Serial};
+use stm32f4xx_hal::timer::{CounterUs, Timer};
+use stm32f4xx_hal::Listen;
+
+use super::{BoardError, Extended, Monotonic, Parts, LINK_BAUD};
+use crate::line_clock::ReloadRegister;
+use crate::link::RxWait;
+
+/// The board's name (the cargo feature).
+pub const NAME: &str = "stm32f405";
+/// The telemetry link's peripheral.
+pub const LINK: &str = "USART1";
+/// The board's telemetry link, segment 0's line clock and clock.
+pub type Link = Usart1;
+pub type LineClock = Tim2Reload;
+pub type Clock = Tim5Clock;
+
+/// Brings the board up: HSI clocks, USART1 at 115 200 Bd with its receive interrupt as a
+/// wake-up source, TIM2 stopped until its first period, TIM5 counting. Call once.
+pub fn take() -> Result<Parts<Link, LineClock, Clock>, BoardError> {
+    let dp = pac::Peripherals::take().ok_or(BoardError::Taken)?;
+    // The clocks as reset leaves them: HSI 16 MHz, every bus undivided (`freeze` would
+    // compute the same from `Config::hsi()`, through PLL set-up code that can panic).
+    let mut rcc = dp.RCC.constrain();
+    let gpioa = dp.GPIOA.split(&mut rcc);
+    let mut serial: Serial<pac::USART1, u8> = dp
+        .USART1
+        .serial(
+            (gpioa.pa9, gpioa.pa10),
+            serial::Config::default().baudrate(LINK_BAUD.bps()),
+            &mut rcc,
+        )
+        .map_err(|_| BoardError::SerialConfig)?;
+    cortex_m::interrupt::disable();
+    serial.listen(Event::RxNotEmpty);
+    NVIC::unpend(Interrupt::USART1);
+    // SAFETY: PRIMASK is set (above) and stays set, so unmasking the line cannot run a
+    // handler or break a critical section: it only wakes the core from WFI.
+    unsafe { NVIC::unmask(Interrupt::USART1) };
+
+    let timer_clock_hz = rcc.clocks.timclk1().raw();
+    let tim2 = Timer::new(dp.TIM2, &mut rcc).release();
+    // SAFETY: 0 is a valid prescaler (count every timer clock tick).
+    tim2.psc().write(|w| unsafe { w.bits(0) });
+    tim2.cr1().modify(|_, w| w.arpe().set_bit());
+
+    let mut tim5 = dp.TIM5.counter_us(&mut rcc);
+    // The longest period the HAL allows, 2^32 - 1 ticks: the counter wraps after that.
+    tim5.start(u32::MAX.micros())
+        .map_err(|_| BoardError::TimerConfig)?;
+    let ticks = Extended::new(u64::from(u32::MAX), tim5.now().ticks());
+
+    Ok(Parts {
+        link: Usart1 { serial },
+        line_clock: Tim2Reload { tim: tim2 },
+        clock: Tim5Clock {
+            counter: tim5,
+            ticks,
+        },
+        timer_clock_hz,
+    })
+}
+
+/// USART1 as the HAL's serial port, with the receive interrupt as a wake-up.
+pub struct Usart1 {
+    serial: Serial<pac::USART1, u8>,
+}
+
+impl ErrorType for Usart1 {
+    type Error = serial::Error;
+}
+
+impl Read<u8> for Usart1 {
+    fn read(&mut self) -> nb::Result<u8, serial::Error> {
+        self.serial.read()
+    }
+}
+
+impl Write<u8> for Usart1 {
+    fn write(&mut self, byte: u8) -> nb::Result<(), serial::Error> {
+        self.serial.write(byte)
+    }
+    fn flush(&mut self) -> nb::Result<(), serial::Error> {
+        self.serial.flush()
+    }
+}
+
+impl RxWait for Usart1 {
+    /// Sleeps (WFI) until USART1's interrupt is pending. As on the mps2: the pending bit
+    /// is cleared first, then RXNE is checked, so a byte that arrived before the check is
+    /// seen there and one that arrives after it pends the interrupt and ends the WFI.
+    fn wait_for_rx(&mut self) {
+        NVIC::unpend(Interrupt::USART1);
+        if !self.serial.is_rx_not_empty() {
+            cortex_m::asm::wfi();
+        }
+    }
+}
+
+/// TIM2's auto-reload register: segment 0's line period.
+pub struct Tim2Reload {
+    tim: pac::TIM2,
+}
+
+impl ReloadRegister for Tim2Reload {
+    /// Sets the period; the first one also loads it at once (update event) and starts
+    /// the counter. Later ones wait in the preload register for the current period's end.
+    fn set_reload(&mut self, value: u32) {
+        // SAFETY: TIM2's ARR takes any 32-bit value.
+        self.tim.arr().write(|w| unsafe { w.bits(value) });
+        if self.tim.cr1().read().cen().bit_is_clear() {
+            self.tim.egr().write(|w| w.ug().set_bit());
+            self.tim.cr1().modify(|_, w| w.cen().set_bit());
+        }
+    }
+    fn reload(&self) -> u32 {
+        self.tim.arr().read().bits()
+    }
+}
+
+/// TIM5 counting microseconds (the HAL's 1 MHz counter), as a [`Monotonic`]. It wraps
+/// every 71.6 minutes.
+pub struct Tim5Clock {
+    counter: CounterUs<pac::TIM5>,
+    ticks: Extended,
+}
+
+impl Monotonic for Tim5Clock {
+    fn now_us(&mut self) -> u64 {
+        self.ticks.update(self.counter.now().ticks())
+    }
+}
