@@ -121,6 +121,9 @@ pub struct Controller {
     pub config: Config,
     scene: Scene,
     plan: Plan,
+    /// Where a new scene's plan is built, in place, before it replaces `plan` (a plan is
+    /// 4.7 KB: kept off the stack, docs/target.md).
+    spare_plan: Plan,
     /// Ground height of each table entry (m): from the scene, then TERRAIN frames.
     heights_m: [f32; MAX_SEGMENTS],
     nav: Option<NavState>,
@@ -151,24 +154,32 @@ pub struct Controller {
 impl Controller {
     /// A controller with `scene` in force (normally [`Scene::paper_default`]).
     pub fn new(config: Config, scene: Scene) -> Result<Controller, Fault> {
-        let plan = Plan::new(&scene, &config)?;
-        Ok(Controller::with_plan(config, scene, plan))
+        let mut c = Controller::blank(config);
+        c.set_scene(scene)?;
+        Ok(c)
     }
 
     /// A controller on the evaluate-everything plan ([`Plan::exhaustive`]): every
     /// segment, the most samples. The baseline the planner is measured against
     /// (`cargo xtask bench`); not for flight.
     pub fn evaluate_everything(config: Config, scene: Scene) -> Result<Controller, Fault> {
-        let plan = Plan::exhaustive(&scene, &config)?;
-        Ok(Controller::with_plan(config, scene, plan))
+        let mut c = Controller::blank(config);
+        c.spare_plan.build_into(&scene, &c.config, true)?;
+        c.install(scene);
+        Ok(c)
     }
 
-    fn with_plan(config: Config, scene: Scene, plan: Plan) -> Controller {
+    /// A controller with no scene (no segment, nothing to compute) until
+    /// [`Controller::set_scene`]: the firmware places one in static memory this way and
+    /// then plans its scene in place, so that no 10 KB controller passes through its
+    /// stack.
+    pub fn blank(config: Config) -> Controller {
         Controller {
             config,
-            heights_m: scene.segments.map(|s| s.ground_h_m),
-            scene,
-            plan,
+            heights_m: [0.0; MAX_SEGMENTS],
+            scene: Scene::paper_default(),
+            plan: Plan::blank(),
+            spare_plan: Plan::blank(),
             nav: None,
             last_time_us: None,
             resync_candidate_us: None,
@@ -185,6 +196,23 @@ impl Controller {
             updates: 0,
             update_mode: Mode::WaitingForNav,
         }
+    }
+
+    /// Puts `scene` in force, planned in place (what a SCENE frame does); on an error
+    /// nothing changes.
+    pub fn set_scene(&mut self, scene: Scene) -> Result<(), Fault> {
+        self.spare_plan.build_into(&scene, &self.config, false)?;
+        self.install(scene);
+        Ok(())
+    }
+
+    /// The spare plan, just built for `scene`, goes in force.
+    fn install(&mut self, scene: Scene) {
+        core::mem::swap(&mut self.plan, &mut self.spare_plan);
+        self.heights_m = scene.segments.map(|s| s.ground_h_m);
+        self.scene = scene;
+        // A new focal plane: nothing of the old one's outputs applies.
+        self.has_output = [false; MAX_SEGMENTS];
     }
 
     pub fn scene(&self) -> &Scene {
@@ -312,13 +340,15 @@ impl Controller {
         Ok(())
     }
 
-    /// The checks `apply` makes, without their effect.
-    fn check_content(&self, frame: &Frame<'_>) -> Result<(), Fault> {
+    /// The checks `apply` makes, without their effect (a SCENE's plan is built in the
+    /// spare plan, which only a successful `set_scene` puts in force).
+    fn check_content(&mut self, frame: &Frame<'_>) -> Result<(), Fault> {
         match frame.kind {
             kind::NAV => self.check_nav(frame).map(|_| ()),
-            kind::SCENE => Scene::decode(frame.payload)
-                .and_then(|s| Plan::new(&s, &self.config))
-                .map(|_| ()),
+            kind::SCENE => {
+                let scene = Scene::decode(frame.payload)?;
+                self.spare_plan.build_into(&scene, &self.config, false)
+            }
             kind::TERRAIN => Terrain::decode(frame.payload, &self.scene).map(|_| ()),
             kind::TIME if frame.payload.is_empty() => Ok(()),
             kind::TIME => Err(Fault::BadLength),
@@ -395,14 +425,7 @@ impl Controller {
     }
 
     fn accept_scene(&mut self, payload: &[u8]) -> Result<(), Fault> {
-        let scene = Scene::decode(payload)?;
-        let plan = Plan::new(&scene, &self.config)?;
-        self.heights_m = scene.segments.map(|s| s.ground_h_m);
-        self.scene = scene;
-        self.plan = plan;
-        // A new focal plane: nothing of the old one's outputs applies.
-        self.has_output = [false; MAX_SEGMENTS];
-        Ok(())
+        self.set_scene(Scene::decode(payload)?)
     }
 
     /// Moves the clock to `now_us` (from the time source) and runs the update that is due,
@@ -443,9 +466,15 @@ impl Controller {
         // Not stale: t - t_nav lies in [-update period, stale_after], both < 2^53 us:
         // the difference is exact in i64 and small in f32.
         let dt_s = (t_us as i64).wrapping_sub(nav.time_us as i64) as f32 * 1e-6;
-        let state = nav.propagator.at(dt_s);
+        let state = nav.propagator.parts_at(dt_s);
         let attitude = attitude_at(&nav.attitude, dt_s);
-        let instant = match GENERAL_F32.instant(&state, &attitude, &EARTH, EARTH_RATE_RAD_S) {
+        let instant = match GENERAL_F32.instant_parts(
+            state.position_m,
+            state.velocity_mps,
+            state.r2_minus_a2_m2,
+            &attitude,
+            EARTH_RATE_RAD_S,
+        ) {
             Ok(i) => i,
             Err(e) => {
                 self.reject(Fault::from(e));

@@ -59,7 +59,30 @@ pub struct SegmentPlan {
     pub sampling_bound: f32,
 }
 
+/// The line of sight of no pixel, in unused plan entries.
+const BLANK_PIXEL: GeneralPixel<f32> = GeneralPixel {
+    u_m: [0.0; 3],
+    uu_m2: 0.0,
+    t1: 0.0,
+    t2: 0.0,
+};
+
 impl SegmentPlan {
+    /// An unused entry: no samples.
+    pub fn blank() -> SegmentPlan {
+        SegmentPlan {
+            index: 0,
+            tdi_stages: 1,
+            samples: [BLANK_PIXEL; MAX_SAMPLES],
+            n_samples: 0,
+            sample_px: [0; MAX_SAMPLES],
+            centre: BLANK_PIXEL,
+            sampling_budget: 0.0,
+            interpolation_mps: 0.0,
+            sampling_bound: 0.0,
+        }
+    }
+
     // `n_samples` <= MAX_SAMPLES in every plan `Plan::build` makes; the `min` proves it
     // to the optimiser (no panic path, docs/no-panic.md).
     pub fn samples(&self) -> &[GeneralPixel<f32>] {
@@ -197,18 +220,53 @@ impl Curvature {
 }
 
 impl Plan {
+    /// The plan of no scene: no segment, nothing to evaluate. A placeholder that
+    /// [`Plan::build_into`] overwrites (a controller keeps two plans and builds a new
+    /// scene's into the spare one, in place).
+    pub fn blank() -> Plan {
+        Plan {
+            segments: [SegmentPlan::blank(); MAX_SEGMENTS],
+            count: 0,
+            boresight: BLANK_PIXEL,
+            boresight_segment: 0,
+            pixel_m: 0.0,
+            line_clock_hz: 0.0,
+            stage_rule: StageRule::none(),
+            max_stages: 0,
+            envelope: AttitudeEnvelope {
+                max_roll_rad: 0.0,
+                max_pitch_rad: 0.0,
+                max_rate_rad_s: 0.0,
+            },
+            period_bounds_s: (0.0, 0.0),
+        }
+    }
+
     /// The plan of `scene`: active segments only, the fewest samples.
     pub fn new(scene: &Scene, config: &Config) -> Result<Plan, Fault> {
-        Plan::build(scene, config, false)
+        let mut plan = Plan::blank();
+        plan.build_into(scene, config, false)?;
+        Ok(plan)
     }
 
     /// The evaluate-everything plan, the baseline the planner is measured against:
     /// every segment of the table whether active or not, [`MAX_SAMPLES`] samples each.
     pub fn exhaustive(scene: &Scene, config: &Config) -> Result<Plan, Fault> {
-        Plan::build(scene, config, true)
+        let mut plan = Plan::blank();
+        plan.build_into(scene, config, true)?;
+        Ok(plan)
     }
 
-    fn build(scene: &Scene, config: &Config, exhaustive: bool) -> Result<Plan, Fault> {
+    /// Makes `self` the plan of `scene` (`exhaustive`: see [`Plan::exhaustive`]), in
+    /// place: a plan is 4.7 KB, and a flight stack of a few KB cannot hold one more. On
+    /// an error `self` is left part-built and must not be used (the controller builds
+    /// into its spare plan and swaps only on success).
+    pub fn build_into(
+        &mut self,
+        scene: &Scene,
+        config: &Config,
+        exhaustive: bool,
+    ) -> Result<(), Fault> {
         scene.validate(&EARTH, config.altitude_range_m.1)?;
         let stage_rule =
             StageRule::<f32>::new(f64::from(scene.mtf_floor)).map_err(|_| Fault::InvalidScene)?;
@@ -232,22 +290,15 @@ impl Plan {
         let boresight = GENERAL_F32
             .pixel(&boresight_camera, 0.0)
             .map_err(|_| Fault::InvalidScene)?;
-        let blank = SegmentPlan {
-            index: 0,
-            tdi_stages: 1,
-            samples: [boresight; MAX_SAMPLES],
-            n_samples: 0,
-            sample_px: [0; MAX_SAMPLES],
-            centre: boresight,
-            sampling_budget: 0.0,
-            interpolation_mps: 0.0,
-            sampling_bound: 0.0,
-        };
-        let mut segments = [blank; MAX_SEGMENTS];
+        // Whatever plan was here before leaves nothing behind (plans compare equal
+        // whichever buffer they were built in).
+        for s in self.segments.iter_mut() {
+            *s = SegmentPlan::blank();
+        }
         let mut count = 0usize;
         let table = scene.table().iter().enumerate();
         for (index, spec) in table.filter(|(_, s)| exhaustive || s.active) {
-            let slot = segments.get_mut(count).ok_or(Fault::InvalidScene)?;
+            let slot = self.segments.get_mut(count).ok_or(Fault::InvalidScene)?;
             let camera = scene.earth_camera(spec);
             let budget = SAMPLING_SHARE * f64::from(stage_rule.mismatch_budget())
                 / f64::from(spec.tdi_stages);
@@ -304,18 +355,16 @@ impl Plan {
             .enumerate()
             .min_by_key(|(_, s)| distance(s))
             .map_or(0, |(k, _)| k as u8);
-        Ok(Plan {
-            segments,
-            count: count as u8,
-            boresight,
-            boresight_segment,
-            pixel_m: scene.camera.pixel_m as f32,
-            line_clock_hz: scene.line_clock_hz as f32,
-            stage_rule,
-            max_stages: scene.max_stages,
-            envelope: scene.envelope,
-            period_bounds_s: period_bounds_s(scene, config),
-        })
+        self.count = count as u8;
+        self.boresight = boresight;
+        self.boresight_segment = boresight_segment;
+        self.pixel_m = scene.camera.pixel_m as f32;
+        self.line_clock_hz = scene.line_clock_hz as f32;
+        self.stage_rule = stage_rule;
+        self.max_stages = scene.max_stages;
+        self.envelope = scene.envelope;
+        self.period_bounds_s = period_bounds_s(scene, config);
+        Ok(())
     }
 
     pub fn active(&self) -> &[SegmentPlan] {

@@ -108,6 +108,16 @@ fn sinc_root(level: f64) -> f64 {
 }
 
 impl<T: Real> StageRule<T> {
+    /// The rule of no scene: every count but 0 fails it (a budget of 0), so no stage
+    /// count is promised. A placeholder until a real rule replaces it.
+    pub fn none() -> Self {
+        StageRule {
+            mtf_floor: T::ONE,
+            mismatch_budget: T::ZERO,
+            pair_kappa: T::ZERO,
+        }
+    }
+
     /// The rule for `mtf_floor` in (0, 1): solves sinc(x_f) = floor by bisection in f64
     /// (sinc falls strictly on [0, pi]), so the per-update work is one division.
     pub fn new(mtf_floor: f64) -> Result<Self, ModelError> {

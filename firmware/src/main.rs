@@ -9,11 +9,25 @@
 #![no_std]
 #![no_main]
 
+use controller::session::Session;
 use controller::{Config, Controller, Scene};
 use cortex_m_rt::entry;
 use firmware::board::{self, Parts};
 use firmware::line_clock::LineClocks;
 use firmware::{platform, stack, telemetry};
+use static_cell::StaticCell;
+
+/// The controller and its link state live here, not on `main`'s stack: the stack
+/// budget (12 KiB, docs/target.md) cannot hold them beside the update's frames.
+static SESSION: StaticCell<Session> = StaticCell::new();
+
+/// The session, blank (no scene yet). Its own function, never inlined: the blank value
+/// passes through this frame once, at boot, and the frame is gone before the telemetry
+/// loop runs (docs/target.md, "Stack").
+#[inline(never)]
+fn blank_session() -> &'static mut Session {
+    SESSION.init_with(|| Session::new(Controller::blank(Config::default())))
+}
 
 #[entry]
 fn main() -> ! {
@@ -39,9 +53,10 @@ fn main() -> ! {
         board::LINK
     );
     let mut clocks = LineClocks::new(line_clock);
-    let code = match Controller::new(Config::default(), Scene::paper_default()) {
-        Ok(controller) => {
-            let line_clock_hz = controller.plan().line_clock_hz;
+    let session = blank_session();
+    let code = match session.controller.set_scene(Scene::paper_default()) {
+        Ok(()) => {
+            let line_clock_hz = session.controller.plan().line_clock_hz;
             if timer_clock_hz as f32 != line_clock_hz {
                 defmt::info!(
                     "segment 0's timer counts at {=u32} Hz here, the scene's line clock is {=f32} Hz: the reload register is programmed, the rate is not the line clock's",
@@ -49,7 +64,7 @@ fn main() -> ! {
                     line_clock_hz
                 );
             }
-            let summary = telemetry::run(&mut link, &mut clocks, &mut clock, controller);
+            let summary = telemetry::run(&mut link, &mut clocks, &mut clock, session);
             if summary.tx_dropped == 0 && summary.rx_errors == 0 && clocks.errors == 0 {
                 0
             } else {
@@ -68,7 +83,7 @@ fn main() -> ! {
         }
     };
     defmt::info!(
-        "stack high-water mark: {=usize} bytes (controller state {=usize} bytes)",
+        "stack high-water mark: {=usize} bytes (the session, in static memory: {=usize} bytes)",
         stack::high_water_mark_bytes(),
         core::mem::size_of::<controller::session::Session>()
     );

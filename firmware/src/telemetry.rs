@@ -16,7 +16,7 @@
 //! between frames, [`Session::tick`], needs a clock whose rate is right: not QEMU's.)
 
 use controller::session::Session;
-use controller::{Controller, LinePeriodSink, Mode};
+use controller::{LinePeriodSink, Mode};
 use embedded_hal_nb::serial::{Error as _, ErrorKind};
 
 use crate::board::Monotonic;
@@ -38,14 +38,13 @@ pub struct Summary {
     pub longest_step_us: u64,
 }
 
-/// Runs the controller on `link` until an END frame; returns how it went.
+/// Runs the session's controller on `link` until an END frame; returns how it went.
 pub fn run<L: Link, S: LinePeriodSink, C: Monotonic>(
     link: &mut L,
     sink: &mut S,
     clock: &mut C,
-    controller: Controller,
+    session: &mut Session,
 ) -> Summary {
-    let mut session = Session::new(controller);
     let mut summary = Summary {
         tx_dropped: 0,
         rx_errors: 0,
@@ -81,7 +80,7 @@ pub fn run<L: Link, S: LinePeriodSink, C: Monotonic>(
         });
         let step_us = clock.now_us().saturating_sub(step_start_us);
         summary.longest_step_us = summary.longest_step_us.max(step_us);
-        report_changes(&session, &mut faults, &mut mode);
+        report_changes(session, &mut faults, &mut mode);
         if ended {
             if !flush_bounded(link) {
                 summary.tx_dropped = summary.tx_dropped.saturating_add(1);

@@ -119,15 +119,35 @@ impl<T: Real> General<T> {
         earth_rate_rad_s: f64,
     ) -> Result<GeneralInstant<T>, ModelError> {
         let (r64, v64) = (state.position_m, state.velocity_mps);
-        let r = r64.map(T::from_f64);
-        let v = v64.map(T::from_f64);
-        let (r2, h) = check_state(r, v)?;
         // |r|^2 - a^2 is the one difference of nearly equal terms (a factor up to 16 at
         // 200 km): formed in f64 from the f64 state (eight soft-f64 operations on the
         // target), then rounded. Everything else is a product or a sum of like signs.
         let a_m = ellipsoid.a_m;
         let r2_minus_a2 =
             T::from_f64((r64[0] * r64[0] + r64[1] * r64[1] + r64[2] * r64[2]) - a_m * a_m);
+        self.instant_parts(
+            r64.map(T::from_f64),
+            v64.map(T::from_f64),
+            r2_minus_a2,
+            attitude,
+            earth_rate_rad_s,
+        )
+    }
+
+    /// [`General::instant`] from the state already in `T`: the position and velocity
+    /// (m, m/s, ECI) and |r|^2 - a^2 (m^2, a the semi-major axis of the ellipsoid
+    /// [`General::ground`] will be given), which the caller forms without cancellation
+    /// (the controller: from the NAV frame's f64 value and the propagated increment,
+    /// `controller::nav::Propagator`).
+    pub fn instant_parts(
+        &self,
+        r: [T; 3],
+        v: [T; 3],
+        r2_minus_a2: T,
+        attitude: &Attitude<T>,
+        earth_rate_rad_s: f64,
+    ) -> Result<GeneralInstant<T>, ModelError> {
+        let (r2, h) = check_state(r, v)?;
         let w = T::from_f64(earth_rate_rad_s);
 
         let rn = r2.sqrt();

@@ -200,6 +200,19 @@ pub fn build(pass: &Pass) -> Result<Stream, String> {
         };
         injected.push((f.label(), expect));
     }
+    // The ground's scene upload at the start of the pass, 1 us after the first frame:
+    // the scene the firmware booted with, so that every check reads as before while the
+    // flight binary plans a scene in flight (its deepest stack, docs/target.md).
+    if let (Some(&t0), Some(&t1)) = (times.first(), times.get(1)) {
+        if t1 > t0 + 1 {
+            let mut p = vec![0u8; controller::frame::MAX_PAYLOAD];
+            let n = controller::Scene::paper_default()
+                .encode(&mut p)
+                .ok_or("the default scene does not fit a SCENE frame")?;
+            let bytes = frames.frame(kind::SCENE, t0 + 1, &p[..n]);
+            extra.push((1, Item { bytes, fault: None }));
+        }
+    }
     // Insert from the back so that earlier indices stay valid; equal indices keep
     // their order.
     extra.sort_by_key(|(i, _)| *i);
