@@ -24,9 +24,11 @@ static SESSION: StaticCell<Session> = StaticCell::new();
 /// The session, blank (no scene yet). Its own function, never inlined: the blank value
 /// passes through this frame once, at boot, and the frame is gone before the telemetry
 /// loop runs (docs/target.md, "Stack").
+/// None only if called twice (`main` calls it once): `try_init_with`, because
+/// `init_with` would panic there (docs/no-panic.md).
 #[inline(never)]
-fn blank_session() -> &'static mut Session {
-    SESSION.init_with(|| Session::new(Controller::blank(Config::default())))
+fn blank_session() -> Option<&'static mut Session> {
+    SESSION.try_init_with(|| Session::new(Controller::blank(Config::default())))
 }
 
 #[entry]
@@ -53,7 +55,10 @@ fn main() -> ! {
         board::LINK
     );
     let mut clocks = LineClocks::new(line_clock);
-    let session = blank_session();
+    let Some(session) = blank_session() else {
+        defmt::error!("the session was already taken");
+        platform::exit(1)
+    };
     let code = match session.controller.set_scene(Scene::paper_default()) {
         Ok(()) => {
             let line_clock_hz = session.controller.plan().line_clock_hz;
