@@ -92,7 +92,6 @@ impl Nav {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Propagator {
     pub state: StateVector,
-    velocity_mps: [f32; 3],
     half_accel_mps2: [f32; 3],
     sixth_jerk_mps3: [f32; 3],
     position_hi_m: [f32; 3],
@@ -130,7 +129,6 @@ impl Propagator {
             velocity_hi_mps: v.map(hi),
             velocity_lo_mps: v.map(lo),
             r2_minus_a2_m2: (r2 - a_m * a_m) as f32,
-            velocity_mps: v.map(|x| x as f32),
             half_accel_mps2: r.map(|x| (-0.5 * mu_r3 * x) as f32),
             sixth_jerk_mps3: core::array::from_fn(|k| {
                 (-mu_r3 * (v[k] - 3.0 * rv_r2 * r[k]) / 6.0) as f32
@@ -138,38 +136,36 @@ impl Propagator {
         }
     }
 
-    /// The state `dt_s` after the NAV instant (dt may be negative: an update instant
-    /// up to one update period before the frame's tag).
-    pub fn at(&self, dt_s: f32) -> StateVector {
+    /// The series' increments of position and velocity `dt_s` after the NAV instant,
+    /// in f32 (the one series both routes below add to their state).
+    fn increments(&self, dt_s: f32) -> ([f32; 3], [f32; 3]) {
         let (v, a2, j6) = (
-            self.velocity_mps,
+            self.velocity_hi_mps,
             self.half_accel_mps2,
             self.sixth_jerk_mps3,
         );
-        let r0 = self.state.position_m;
-        let v0 = self.state.velocity_mps;
+        (
+            core::array::from_fn(|k| dt_s * (v[k] + dt_s * (a2[k] + dt_s * j6[k]))),
+            core::array::from_fn(|k| dt_s * (2.0 * a2[k] + dt_s * (3.0 * j6[k]))),
+        )
+    }
+
+    /// The state `dt_s` after the NAV instant (dt may be negative: an update instant
+    /// up to one update period before the frame's tag), in f64: the route
+    /// [`Propagator::parts_at`] is checked against.
+    pub fn at(&self, dt_s: f32) -> StateVector {
+        let (dr, dv) = self.increments(dt_s);
+        let (r0, v0) = (self.state.position_m, self.state.velocity_mps);
         StateVector {
-            position_m: core::array::from_fn(|k| {
-                r0[k] + f64::from(dt_s * (v[k] + dt_s * (a2[k] + dt_s * j6[k])))
-            }),
-            velocity_mps: core::array::from_fn(|k| {
-                v0[k] + f64::from(dt_s * (2.0 * a2[k] + dt_s * (3.0 * j6[k])))
-            }),
+            position_m: core::array::from_fn(|k| r0[k] + f64::from(dr[k])),
+            velocity_mps: core::array::from_fn(|k| v0[k] + f64::from(dv[k])),
         }
     }
-}
 
-impl Propagator {
-    /// The state `dt_s` after the NAV instant as [`StateParts`] (the same series as
-    /// [`Propagator::at`], all in f32).
+    /// The state `dt_s` after the NAV instant as [`StateParts`], all in f32: what the
+    /// controller's update uses.
     pub fn parts_at(&self, dt_s: f32) -> StateParts {
-        let (v, a2, j6) = (
-            self.velocity_mps,
-            self.half_accel_mps2,
-            self.sixth_jerk_mps3,
-        );
-        let dr: [f32; 3] = core::array::from_fn(|k| dt_s * (v[k] + dt_s * (a2[k] + dt_s * j6[k])));
-        let dv: [f32; 3] = core::array::from_fn(|k| dt_s * (2.0 * a2[k] + dt_s * (3.0 * j6[k])));
+        let (dr, dv) = self.increments(dt_s);
         let r0 = self.position_hi_m;
         // |r0 + dr|^2 - a^2 = (|r0|^2 - a^2) + dr.(2 r0 + dr): no cancellation left (r0's
         // remainder changes the product by 2 |lo| |dr| < 1e4 m^2, 1e-9 of the sum).

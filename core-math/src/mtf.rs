@@ -92,6 +92,18 @@ pub struct StageRule<T> {
     pair_kappa: T,
 }
 
+/// |e| and |t| of the combined stage limit's inputs, each refused when not finite
+/// (the drift first).
+fn magnitudes<T: Real>(rel_mismatch: T, tan_drift: T) -> Result<(T, T), ModelError> {
+    if !tan_drift.is_finite() {
+        return Err(ModelError::NonFinite(Param::Drift));
+    }
+    if !rel_mismatch.is_finite() {
+        return Err(ModelError::NonFinite(Param::RelativeMismatch));
+    }
+    Ok((rel_mismatch.abs(), tan_drift.abs()))
+}
+
 /// The root of sinc(x) = `level` on [0, pi] (sinc falls strictly there), by bisection
 /// in f64.
 fn sinc_root(level: f64) -> f64 {
@@ -201,15 +213,8 @@ impl<T: Real> StageRule<T> {
         tan_drift: T,
         stage_limit: u32,
     ) -> Result<u32, ModelError> {
-        if !tan_drift.is_finite() {
-            return Err(ModelError::NonFinite(Param::Drift));
-        }
-        if !rel_mismatch.is_finite() {
-            return Err(ModelError::NonFinite(Param::RelativeMismatch));
-        }
+        let (e, t) = magnitudes(rel_mismatch, tan_drift)?;
         let limit = stage_limit.min(MAX_STAGE_LIMIT);
-        let e = rel_mismatch.abs();
-        let t = tan_drift.abs();
         let (larger, smaller) = if e > t { (e, t) } else { (t, e) };
         if larger == T::ZERO {
             return Ok(limit);
@@ -268,11 +273,7 @@ impl<T: Real> StageRule<T> {
         tan_drift: T,
         stage_limit: u32,
     ) -> Result<u32, ModelError> {
-        if !tan_drift.is_finite() {
-            return Err(ModelError::NonFinite(Param::Drift));
-        }
-        let e = rel_mismatch.abs();
-        let t = tan_drift.abs();
+        let (e, t) = magnitudes(rel_mismatch, tan_drift)?;
         let larger = if e > t { e } else { t };
         let mut hi = self.max_stages(larger, stage_limit)?;
         let mut lo = self
