@@ -18,6 +18,7 @@ mod bench;
 mod board;
 mod flash;
 mod pass;
+mod profile;
 mod qemu;
 mod tools;
 

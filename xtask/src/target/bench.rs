@@ -12,6 +12,7 @@ use std::process::Command;
 use object::{Object, ObjectSymbol};
 
 use super::board::{Board, BoardArg};
+use super::profile;
 use super::{build_board_bin, ensure_target_tools, qemu, tools, workspace_root};
 
 const PLUGIN_SOURCE: &str = "tools/qemu-stopwatch/stopwatch.c";
@@ -24,6 +25,10 @@ pub struct BenchCounts {
     /// Raw count of the empty region, subtracted by [`BenchCounts::net`].
     pub overhead: u64,
     pub regions: Vec<(String, u64)>,
+    /// The bench ELF that was run.
+    pub elf: PathBuf,
+    /// With a profiled region: each executed address there and its count.
+    pub pc_counts: Vec<(u64, u64)>,
 }
 
 impl BenchCounts {
@@ -36,13 +41,22 @@ impl BenchCounts {
     }
 }
 
-/// `cargo xtask bench`'s options: the board.
-pub type BenchArgs = BoardArg;
+/// `cargo xtask bench`'s options.
+#[derive(clap::Args)]
+pub struct BenchArgs {
+    #[command(flatten)]
+    board: BoardArg,
+    /// Also profile the one region whose label contains this text: its instructions
+    /// attributed to functions, inlined ones included (docs/bench.md, "Profile")
+    #[arg(long, value_name = "LABEL")]
+    profile: Option<String>,
+}
 
-/// `cargo xtask bench`: measure on the board's QEMU machine, then print every region.
+/// `cargo xtask bench`: measure on the board's QEMU machine, then print every region
+/// (and, with `--profile`, where one region's instructions go).
 pub fn bench(args: &BenchArgs) -> Result<(), String> {
-    let board = args.board;
-    let counts = measure_on(board, false)?;
+    let board = args.board.board;
+    let counts = measure_on(board, false, None)?;
     let overhead = counts.overhead;
     println!();
     println!("guest instructions per region (Cortex-M4 under QEMU {}, board {} ({}), release: opt-level 3, fat LTO, codegen-units 1)", counts.qemu_version, board.name(), board.qemu_machine());
@@ -52,6 +66,25 @@ pub fn bench(args: &BenchArgs) -> Result<(), String> {
     for (label, raw) in &counts.regions {
         println!("{:>8} {:>8}  {label}", raw.saturating_sub(overhead), raw);
     }
+    if let Some(text) = &args.profile {
+        let matching: Vec<usize> = (0..counts.regions.len())
+            .filter(|&i| counts.regions[i].0.contains(text.as_str()))
+            .collect();
+        let [region] = matching[..] else {
+            return Err(format!(
+                "--profile `{text}` matches {} regions; give text that one label alone contains",
+                matching.len()
+            ));
+        };
+        let profiled = measure_on(board, true, Some(region))?;
+        if profiled.regions.get(region) != counts.regions.get(region) {
+            return Err("the profiled run counted the region differently".into());
+        }
+        let (label, raw) = &counts.regions[region];
+        println!();
+        println!("profile of `{label}` ({raw} raw instructions, markers included)");
+        profile::print(&profiled.elf, &profiled.pc_counts, *raw)?;
+    }
     Ok(())
 }
 
@@ -59,11 +92,16 @@ pub fn bench(args: &BenchArgs) -> Result<(), String> {
 /// the parsed counts. The decoded defmt log is echoed as the firmware runs, to stdout or,
 /// with `log_to_stderr`, to stderr.
 pub fn measure(log_to_stderr: bool) -> Result<BenchCounts, String> {
-    measure_on(Board::DEFAULT, log_to_stderr)
+    measure_on(Board::DEFAULT, log_to_stderr, None)
 }
 
-/// [`measure`] on `board`.
-fn measure_on(board: Board, log_to_stderr: bool) -> Result<BenchCounts, String> {
+/// [`measure`] on `board`; with `profile`, the per-address counts of that region (its
+/// index in the run, 0 being the empty region) too.
+fn measure_on(
+    board: Board,
+    log_to_stderr: bool,
+    profile: Option<usize>,
+) -> Result<BenchCounts, String> {
     ensure_target_tools()?;
     if !tools::have("gcc") {
         tools::apt_install(&["gcc", "libc6-dev"], "gcc (to build the QEMU plugin)")?;
@@ -73,17 +111,20 @@ fn measure_on(board: Board, log_to_stderr: bool) -> Result<BenchCounts, String> 
     let plugin = build_plugin(&dir)?;
     let (start, stop) = marker_addresses(&elf)?;
     let counts_path = dir.join("bench-counts.txt");
+    let pcs_path = dir.join("bench-pcs.txt");
     let _ = std::fs::remove_file(&counts_path);
+    let _ = std::fs::remove_file(&pcs_path);
+    let mut plugin_args = format!(
+        "{},start={start:#x},stop={stop:#x},out={}",
+        plugin.display(),
+        counts_path.display()
+    );
+    if let Some(region) = profile {
+        plugin_args += &format!(",profile={region},pcs={}", pcs_path.display());
+    }
 
     let options = qemu::Options {
-        extra_args: vec![
-            "-plugin".into(),
-            format!(
-                "{},start={start:#x},stop={stop:#x},out={}",
-                plugin.display(),
-                counts_path.display()
-            ),
-        ],
+        extra_args: vec!["-plugin".into(), plugin_args],
         capture: true,
         serial: None,
         log_to_stderr,
@@ -118,10 +159,16 @@ fn measure_on(board: Board, log_to_stderr: bool) -> Result<BenchCounts, String> 
             counts.len()
         ));
     }
+    let pc_counts = match profile {
+        Some(_) => profile::read_counts(&pcs_path)?,
+        None => Vec::new(),
+    };
     Ok(BenchCounts {
         qemu_version: qemu_version(),
         overhead: counts.first().copied().unwrap_or(0),
         regions: labels.iter().map(|l| l.to_string()).zip(counts).collect(),
+        elf,
+        pc_counts,
     })
 }
 
