@@ -378,7 +378,7 @@ fn write_controller_cases(out: &mut String) {
                 segments,
                 "SegmentGold {{ index: {}, samples: {}, ticks_exact: {}, drift_rad: {} }}, ",
                 s.index,
-                seg.sample_px().len(),
+                seg.samples.len(),
                 f64_src(s.ticks_exact),
                 f64_src(s.drift_rad),
             );

@@ -12,13 +12,14 @@
 //! refused computation leaves that segment's last good period in force, and nothing
 //! outside the physically possible period range is ever written.
 
-use core_math::earth::{Attitude, GeneralUpdate};
+use core_math::earth::{Attitude, GeneralRowMotion, GeneralUpdate};
+use core_math::ImageMotion;
 use core_math::{line_period_ticks, sinc, Backend, Ellipsoid, GENERAL_F32};
 
 use crate::fault::{Counters, Fault};
 use crate::frame::{kind, Frame};
 use crate::nav::{attitude_at, Nav, Propagator};
-use crate::plan::{Plan, SegmentPlan, MAX_SPEED2_RATIO, MIN_SPEED2_RATIO};
+use crate::plan::{Plan, Sample, SegmentPlan, MAX_SPEED2_RATIO, MIN_SPEED2_RATIO};
 use crate::scene::{AttitudeEnvelope, Scene, Terrain, MAX_SEGMENTS};
 
 /// The Earth of the model: WGS 84, a = 6 378 137 m, f = 1/298.257223563.
@@ -497,9 +498,9 @@ impl Controller {
                     .then(|| (sin, cos, drift_angle_rad(m.v2_mps / m.v1_mps)))
             });
         self.yaw_request_rad = steer.map(|(_, _, rad)| rad);
-        // Indices by `get` (`count` <= MAX_SEGMENTS and `index` < MAX_SEGMENTS by
-        // construction of the plan): no panic path (docs/no-panic.md).
-        for k in 0..usize::from(self.plan.count) {
+        // Output slots by `get` (`index` < MAX_SEGMENTS by construction of the plan): no
+        // panic path (docs/no-panic.md).
+        for k in 0..self.plan.segments.len() {
             let Some(seg) = self.plan.segments.get(k) else {
                 break;
             };
@@ -558,30 +559,29 @@ impl Controller {
         // one must move the same way along P1 (one transfer direction per segment). In
         // forward flight the image moves towards -P1 (the ground runs backwards under
         // the camera); towards +P1 is the reversed transfer.
-        let centre = GENERAL_F32.motion(update, &seg.centre)?;
+        // The samples and the centre lie on the segment's row: its constants once, then
+        // about twenty operations a pixel.
+        let row = GENERAL_F32.row_motion(update, &seg.row);
+        let centre = row.motion_at(seg.centre_p2_m)?;
         let reversed = centre.v1_mps > 0.0;
         let tan_centre = centre.v2_mps / centre.v1_mps;
-        let (mut v_min, mut v_max, mut tan_max) = (f32::INFINITY, 0.0f32, tan_centre.abs());
-        for p in seg.samples() {
-            let m = GENERAL_F32.motion(update, p)?;
-            if (m.v1_mps > 0.0) != reversed {
-                return Err(Fault::PeriodOutOfRange);
-            }
-            // Comparisons, not f32::min/max: those are software calls on this core
-            // (fminf/fmaxf, NaN handling), a tenth of the update. A NaN would be skipped
-            // by both alike; `motion` refuses a NaN v1 in any case.
-            let v = m.v1_mps.abs();
-            if v < v_min {
-                v_min = v;
-            }
-            if v > v_max {
-                v_max = v;
-            }
-            let tan = (m.v2_mps / m.v1_mps).abs();
-            if tan > tan_max {
-                tan_max = tan;
-            }
+        // v1's extremes are tracked signed, and its sign checked once after the loop;
+        // the largest |v2/v1| as the pair (|v2|, |v1|) that gives it, compared by
+        // cross-multiplying (|v1| > 0): one division at the end, not one a pixel. The loop
+        // keeps no error exit of its own, so none of the exit's work is hoisted into it.
+        let Extremes {
+            lo,
+            hi,
+            drift_v2,
+            drift_v1,
+        } = extremes(&row, &seg.samples, centre)?;
+        // Every sample must move the same way as the centre (one transfer direction per
+        // segment).
+        let (v_min, v_max) = if reversed { (lo, hi) } else { (-hi, -lo) };
+        if !(v_min > 0.0) {
+            return Err(Fault::PeriodOutOfRange);
         }
+        let tan_max = drift_v2 / drift_v1;
         // The period minimising the worst relative mismatch over [v_min, v_max]: the
         // line speed equal to the harmonic mean of the extremes, i.e. the mean of the
         // extremes' periods.
@@ -619,7 +619,7 @@ impl Controller {
         let drift_rad = drift_angle_rad(tan_centre);
         let residual_drift_rad = match steer {
             Some((sin, cos, _)) => {
-                let m = GENERAL_F32.motion(&update.yawed(sin, cos), &seg.centre)?;
+                let m = GENERAL_F32.motion_yawed(update, &seg.centre, sin, cos)?;
                 drift_angle_rad(m.v2_mps / m.v1_mps)
             }
             None => drift_rad,
@@ -637,6 +637,52 @@ impl Controller {
             held: false,
         })
     }
+}
+
+/// What a segment's samples show: v1's signed extremes, and the (|v2|, |v1|) of the
+/// largest |v2/v1| over the samples and the centre.
+struct Extremes {
+    lo: f32,
+    hi: f32,
+    drift_v2: f32,
+    drift_v1: f32,
+}
+
+/// The samples' [`Extremes`], the centre's drift included.
+///
+/// Its own function, never inlined: the loop's square root is a call
+/// (`core_math::sqrt`), which clobbers s0-s15; inlined into `segment`, whose values
+/// then live across it, every sample reloaded a dozen of them (68 instructions a sample,
+/// `cargo xtask bench --profile`). Here the row's constants and the running extremes fit
+/// the callee-saved s16-s31.
+#[inline(never)]
+fn extremes(
+    row: &GeneralRowMotion<f32>,
+    samples: &[Sample],
+    centre: ImageMotion<f32>,
+) -> Result<Extremes, Fault> {
+    // Comparisons, not f32::min/max: those are software calls on this core
+    // (fminf/fmaxf, NaN handling). `motion_at` refuses a NaN v1.
+    let mut e = Extremes {
+        lo: f32::INFINITY,
+        hi: f32::NEG_INFINITY,
+        drift_v2: centre.v2_mps.abs(),
+        drift_v1: centre.v1_mps.abs(),
+    };
+    for sample in samples {
+        let m = row.motion_at(sample.p2_m)?;
+        if m.v1_mps < e.lo {
+            e.lo = m.v1_mps;
+        }
+        if m.v1_mps > e.hi {
+            e.hi = m.v1_mps;
+        }
+        let (v1, v2) = (m.v1_mps.abs(), m.v2_mps.abs());
+        if v2 * e.drift_v1 > e.drift_v2 * v1 {
+            (e.drift_v2, e.drift_v1) = (v2, v1);
+        }
+    }
+    Ok(e)
 }
 
 /// Whether `a` and its propagation at its rates `back_s` before and `ahead_s` after its

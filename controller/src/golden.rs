@@ -87,7 +87,7 @@ pub fn update(
         let camera = scene.earth_camera(spec);
         let g = geometry(height(seg.index));
         let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
-        for &n in seg.sample_px() {
+        for n in seg.samples.iter().map(|s| s.px) {
             let m = EarthReference.evaluate(&camera, &g, f64::from(n))?;
             lo = lo.min(libm::fabs(m.v1_mps));
             hi = hi.max(libm::fabs(m.v1_mps));

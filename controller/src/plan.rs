@@ -16,8 +16,9 @@
 //! attitude rate slows the image. The controller's tests check it against dense
 //! evaluations of the f64 reference (1 000 pixels a segment) over the envelope.
 
-use core_math::earth::{circular_state, Attitude, GeneralPixel, GeneralUpdate};
+use core_math::earth::{circular_state, Attitude, GeneralPixel, GeneralRow, GeneralUpdate};
 use core_math::{Backend, StageRule, GENERAL_F32};
+use heapless::Vec;
 
 use crate::control::{Config, EARTH, EARTH_RATE_RAD_S};
 use crate::fault::Fault;
@@ -37,17 +38,29 @@ const PROBES: usize = 9;
 /// the largest drift a yaw steering law asks for (4.6 deg, docs/derivation.md).
 const PROBE_YAWS_RAD: [f64; 3] = [-0.1, 0.0, 0.1];
 
-/// One active segment, ready to evaluate.
+/// One sample pixel of a segment.
 #[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sample {
+    /// Pixel offset n.
+    pub px: i32,
+    /// Its p2 = n x pixel pitch (m) on the segment's row.
+    pub p2_m: f32,
+}
+
+/// One active segment, ready to evaluate.
+#[derive(Clone, Debug, PartialEq)]
 pub struct SegmentPlan {
     /// Index in the scene's segment table.
     pub index: u8,
     pub tdi_stages: u16,
-    pub samples: [GeneralPixel<f32>; MAX_SAMPLES],
-    pub n_samples: u8,
-    /// Pixel offsets of the samples.
-    pub sample_px: [i32; MAX_SAMPLES],
-    /// The segment's centre pixel (its drift is reported there).
+    /// The segment's row of the focal plane (its p1): every sample and the centre lie
+    /// on it, so that an update evaluates them by the row form
+    /// (`core_math::General::row_motion`).
+    pub row: GeneralRow<f32>,
+    pub samples: Vec<Sample, MAX_SAMPLES>,
+    /// The segment's centre pixel (its drift is reported there): its p2 on the row, and
+    /// its pixel constants for the steered residual (`General::motion_yawed`).
+    pub centre_p2_m: f32,
     pub centre: GeneralPixel<f32>,
     /// Relative error allowed on the segment's velocity extremes.
     pub sampling_budget: f32,
@@ -67,37 +80,10 @@ const BLANK_PIXEL: GeneralPixel<f32> = GeneralPixel {
     t2: 0.0,
 };
 
-impl SegmentPlan {
-    /// An unused entry: no samples.
-    pub fn blank() -> SegmentPlan {
-        SegmentPlan {
-            index: 0,
-            tdi_stages: 1,
-            samples: [BLANK_PIXEL; MAX_SAMPLES],
-            n_samples: 0,
-            sample_px: [0; MAX_SAMPLES],
-            centre: BLANK_PIXEL,
-            sampling_budget: 0.0,
-            interpolation_mps: 0.0,
-            sampling_bound: 0.0,
-        }
-    }
-
-    // `n_samples` <= MAX_SAMPLES in every plan `Plan::build` makes; the `min` proves it
-    // to the optimiser (no panic path, docs/no-panic.md).
-    pub fn samples(&self) -> &[GeneralPixel<f32>] {
-        &self.samples[..usize::from(self.n_samples).min(MAX_SAMPLES)]
-    }
-    pub fn sample_px(&self) -> &[i32] {
-        &self.sample_px[..usize::from(self.n_samples).min(MAX_SAMPLES)]
-    }
-}
-
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Plan {
-    pub segments: [SegmentPlan; MAX_SEGMENTS],
-    /// Number of active segments (entries in `segments`).
-    pub count: u8,
+    /// The active segments, in table order.
+    pub segments: Vec<SegmentPlan, MAX_SEGMENTS>,
     /// The array centre: the boresight pixel (p1 = p2 = 0), where a yaw turn turns the
     /// image motion and nothing else (the yaw steering request zeroes its drift).
     pub boresight: GeneralPixel<f32>,
@@ -225,8 +211,7 @@ impl Plan {
     /// scene's into the spare one, in place).
     pub fn blank() -> Plan {
         Plan {
-            segments: [SegmentPlan::blank(); MAX_SEGMENTS],
-            count: 0,
+            segments: Vec::new(),
             boresight: BLANK_PIXEL,
             boresight_segment: 0,
             pixel_m: 0.0,
@@ -290,15 +275,9 @@ impl Plan {
         let boresight = GENERAL_F32
             .pixel(&boresight_camera, 0.0)
             .map_err(|_| Fault::InvalidScene)?;
-        // Whatever plan was here before leaves nothing behind (plans compare equal
-        // whichever buffer they were built in).
-        for s in self.segments.iter_mut() {
-            *s = SegmentPlan::blank();
-        }
-        let mut count = 0usize;
+        self.segments.clear();
         let table = scene.table().iter().enumerate();
         for (index, spec) in table.filter(|(_, s)| exhaustive || s.active) {
-            let slot = self.segments.get_mut(count).ok_or(Fault::InvalidScene)?;
             let camera = scene.earth_camera(spec);
             let budget = SAMPLING_SHARE * f64::from(stage_rule.mismatch_budget())
                 / f64::from(spec.tdi_stages);
@@ -320,24 +299,36 @@ impl Plan {
                 k += 1;
             }
             let spacing = width / (k - 1) as f64;
-            slot.index = index as u8;
-            slot.tdi_stages = spec.tdi_stages;
-            slot.n_samples = k as u8;
-            slot.sampling_budget = budget as f32;
-            slot.interpolation_mps = error(k) as f32;
-            slot.sampling_bound = (error(k) / v_min) as f32;
-            slot.centre = GENERAL_F32
-                .pixel(&camera, spec.centre_px())
-                .map_err(|_| Fault::InvalidScene)?;
+            let mut samples = Vec::new();
             for j in 0..k {
                 // Rounded to whole pixels; the ends are exact.
                 let n = libm::round(f64::from(spec.first_px) + spacing * j as f64) as i32;
-                slot.sample_px[j] = n;
-                slot.samples[j] = GENERAL_F32
+                // Checked like any pixel: the row form then needs no check of its own.
+                GENERAL_F32
                     .pixel(&camera, f64::from(n))
                     .map_err(|_| Fault::InvalidScene)?;
+                let p2_m = (f64::from(n) * camera.pixel_m) as f32;
+                samples
+                    .push(Sample { px: n, p2_m })
+                    .map_err(|_| Fault::InvalidScene)?;
             }
-            count += 1;
+            let centre = GENERAL_F32
+                .pixel(&camera, spec.centre_px())
+                .map_err(|_| Fault::InvalidScene)?;
+            let segment = SegmentPlan {
+                index: index as u8,
+                tdi_stages: spec.tdi_stages,
+                row: GENERAL_F32.row(&camera).map_err(|_| Fault::InvalidScene)?,
+                samples,
+                centre_p2_m: centre.u_m[1],
+                centre,
+                sampling_budget: budget as f32,
+                interpolation_mps: error(k) as f32,
+                sampling_bound: (error(k) / v_min) as f32,
+            };
+            self.segments
+                .push(segment)
+                .map_err(|_| Fault::InvalidScene)?;
         }
         // The segment the boresight falls in, else the one nearest to it.
         let distance = |s: &SegmentSpec| {
@@ -355,7 +346,6 @@ impl Plan {
             .enumerate()
             .min_by_key(|(_, s)| distance(s))
             .map_or(0, |(k, _)| k as u8);
-        self.count = count as u8;
         self.boresight = boresight;
         self.boresight_segment = boresight_segment;
         self.pixel_m = scene.camera.pixel_m as f32;
@@ -368,7 +358,7 @@ impl Plan {
     }
 
     pub fn active(&self) -> &[SegmentPlan] {
-        &self.segments[..usize::from(self.count).min(MAX_SEGMENTS)]
+        &self.segments
     }
 }
 

@@ -462,7 +462,11 @@ fn scene_upload_replaces_the_plan() {
     let len = encode(kind::SCENE, 2, 1_010_000, &payload[..n], &mut buf).unwrap();
     feed(&mut c, &buf[..len]);
     assert_eq!(c.counters.total(), 0);
-    assert_eq!(c.plan().count, 3, "inactive segments are not planned");
+    assert_eq!(
+        c.plan().active().len(),
+        3,
+        "inactive segments are not planned"
+    );
     regs.writes.clear();
     c.advance(1_050_000, &mut regs);
     let idx: Vec<u8> = regs.writes.iter().map(|w| w.0).collect();
@@ -473,7 +477,7 @@ fn scene_upload_replaces_the_plan() {
     let len = encode(kind::SCENE, 3, 1_020_000, &payload[..n], &mut buf).unwrap();
     feed(&mut c, &buf[..len]);
     assert_eq!(c.counters.get(Fault::InvalidScene), 1);
-    assert_eq!(c.plan().count, 3);
+    assert_eq!(c.plan().active().len(), 3);
 }
 
 proptest! {

@@ -28,13 +28,13 @@ const F32_SLACK: f64 = 2e-6;
 fn the_default_scene_plan() {
     let scene = Scene::paper_default();
     let plan = Plan::new(&scene, &Config::default()).unwrap();
-    assert_eq!(plan.count, 10);
+    assert_eq!(plan.active().len(), 10);
     for s in plan.active() {
         eprintln!(
             "segment {}: {} samples, interpolation {:.2e} m/s, bound {:.2e} at the slowest image, budget {:.2e}",
-            s.index, s.n_samples, s.interpolation_mps, s.sampling_bound, s.sampling_budget
+            s.index, s.samples.len(), s.interpolation_mps, s.sampling_bound, s.sampling_budget
         );
-        assert!(s.n_samples >= 2);
+        assert!(s.samples.len() >= 2);
         assert!(
             s.sampling_bound <= s.sampling_budget,
             "segment {}: {} > {}",
@@ -43,8 +43,8 @@ fn the_default_scene_plan() {
             s.sampling_budget
         );
         let spec = scene.segments[usize::from(s.index)];
-        assert_eq!(s.sample_px()[0], spec.first_px);
-        assert_eq!(*s.sample_px().last().unwrap(), spec.last_px);
+        assert_eq!(s.samples[0].px, spec.first_px);
+        assert_eq!(s.samples.last().unwrap().px, spec.last_px);
     }
 }
 
@@ -163,7 +163,7 @@ fn the_reported_worst_mismatch_bounds_the_truth_over_every_pixel() {
             .plan()
             .active()
             .iter()
-            .map(|s| usize::from(s.n_samples))
+            .map(|s| s.samples.len())
             .sum::<usize>();
     }
     assert!(w.compared >= 500, "only {} segments compared", w.compared);

@@ -57,7 +57,7 @@ fn default_update_period_meets_a_tenth_of_the_mtf_budget() {
                     };
                     for seg in plan.active() {
                         let camera = scene.earth_camera(&scene.segments[usize::from(seg.index)]);
-                        for &n in seg.sample_px() {
+                        for n in seg.samples.iter().map(|s| s.px) {
                             let v = |t: f64| {
                                 EarthReference
                                     .evaluate(&camera, &at(t), f64::from(n))

@@ -452,9 +452,10 @@ fn a_general_case_against_fifty_digits() {
     );
 }
 
-/// Turning the camera about its boresight by `delta` (`GeneralUpdate::yawed`, the yaw
-/// steering request's route) is the update at yaw + delta: checked against the
-/// reference evaluated at the turned attitude, over the envelope.
+/// Turning the camera about its boresight by `delta` (`GeneralUpdate::yawed`, and
+/// `General::motion_yawed`, the yaw steering request's residual drift) is the update at
+/// yaw + delta: both routes checked against the reference evaluated at the turned
+/// attitude, over the envelope.
 #[test]
 fn a_yawed_update_is_the_update_at_the_turned_yaw() {
     let mut rng = SplitMix64(0x7A3D_2026_1124_0001);
@@ -486,15 +487,36 @@ fn a_yawed_update_is_the_update_at_the_turned_yaw() {
             v1_mps: m32.v1_mps as f64,
             v2_mps: m32.v2_mps as f64,
         };
+        // The controller's route: the unturned update, the pixel turned back
+        // (`General::motion_yawed`); the same quantity, rounded differently.
+        let y64 = GENERAL_F64
+            .motion_yawed(&GENERAL_F64.update(&c.geometry).unwrap(), &p64, s, co)
+            .unwrap();
+        worst64 = worst64.max(rel(&y64, &r));
+        let y32 = GENERAL_F32
+            .motion_yawed(
+                &GENERAL_F32.update(&g32).unwrap(),
+                &p32,
+                s as f32,
+                co as f32,
+            )
+            .unwrap();
+        let y32 = ImageMotion {
+            v1_mps: y32.v1_mps as f64,
+            v2_mps: y32.v2_mps as f64,
+        };
         let kappa = earth_kappa(&c.camera, &turned, c.n_px).unwrap_or(f64::INFINITY);
-        let e32 = rel(&m32, &r);
-        // The f32 route's bound of the turned problem (as in the f32 test), with one
-        // more rounding of each turned component.
-        assert!(
-            e32 <= EARTH_F32_KAPPA_C * (kappa + 4.0) * U32 || e32 <= EARTH_F32_NEAR_LIMB_TOLERANCE,
-            "f32 {e32:e} (kappa {kappa:.1}) at {c:?}, delta {delta}"
-        );
-        worst32 = worst32.max(e32);
+        for (route, m) in [("yawed", &m32), ("motion_yawed", &y32)] {
+            let e32 = rel(m, &r);
+            // The f32 route's bound of the turned problem (as in the f32 test), with one
+            // more rounding of each turned component.
+            assert!(
+                e32 <= EARTH_F32_KAPPA_C * (kappa + 4.0) * U32
+                    || e32 <= EARTH_F32_NEAR_LIMB_TOLERANCE,
+                "f32 {route} {e32:e} (kappa {kappa:.1}) at {c:?}, delta {delta}"
+            );
+            worst32 = worst32.max(e32);
+        }
         compared += 1;
     }
     assert!(compared > 3_000, "only {compared} cases compared");
@@ -503,4 +525,83 @@ fn a_yawed_update_is_the_update_at_the_turned_yaw() {
         "f64 yawed vs reference: {worst64:e}"
     );
     println!("yawed update: {compared} cases, f64 {worst64:.2e}, f32 {worst32:.2e}");
+}
+
+/// The row form (`General::row_motion`, the controller's per-sample route): on the
+/// pixel's row it is `motion` expanded in p2. Over the envelope, f64 within 1e-12 of the
+/// reference; f32 within the same condition-number bound as `motion`'s f32 route; hit,
+/// miss and refusal as `motion` (beyond 1e-4 deg of the limb).
+#[test]
+fn the_row_form_is_the_motion_on_the_row() {
+    let mut rng = SplitMix64(0x0EA7_2026_1124_0A0E);
+    let (mut compared, mut worst64, mut ratio32, mut far32) = (0, 0f64, 0f64, 0f64);
+    for _ in 0..20_000 {
+        let Some(c) = rng.earth_case() else { continue };
+        let m = margin_deg(&c);
+        let p2_m = c.n_px * c.camera.pixel_m;
+        let u64_ = GENERAL_F64.update(&c.geometry);
+        let g32 = c.geometry.to::<f32>();
+        let u32_ = GENERAL_F32.update(&g32);
+        let (Ok(u64_), Ok(u32_)) = (u64_, u32_) else {
+            continue;
+        };
+        let row64 = GENERAL_F64
+            .row_motion(&u64_, &GENERAL_F64.row(&c.camera).unwrap())
+            .motion_at(p2_m);
+        let row32 = GENERAL_F32
+            .row_motion(&u32_, &GENERAL_F32.row(&c.camera).unwrap())
+            .motion_at(p2_m as f32);
+        let direct64 = GENERAL_F64.motion(&u64_, &GENERAL_F64.pixel(&c.camera, c.n_px).unwrap());
+        let direct32 = GENERAL_F32.motion(&u32_, &GENERAL_F32.pixel(&c.camera, c.n_px).unwrap());
+        if m.abs() < EITHER_DEG {
+            continue;
+        }
+        assert_eq!(
+            row64.is_ok(),
+            direct64.is_ok(),
+            "f64 {row64:?} / {direct64:?} at {c:?}"
+        );
+        assert_eq!(
+            row32.map(|_| ()),
+            direct32.map(|_| ()),
+            "f32 at {m} deg: {c:?}"
+        );
+        let (Ok(row64), Ok(row32)) = (row64, row32) else {
+            continue;
+        };
+        if m < 0.01 {
+            continue;
+        }
+        let r = EarthReference
+            .evaluate(&c.camera, &c.geometry, c.n_px)
+            .unwrap();
+        worst64 = worst64.max(rel(&row64, &r));
+        let e32 = rel(
+            &ImageMotion {
+                v1_mps: row32.v1_mps as f64,
+                v2_mps: row32.v2_mps as f64,
+            },
+            &r,
+        );
+        let kappa = earth_kappa(&c.camera, &c.geometry, c.n_px).unwrap();
+        assert!(
+            e32 <= EARTH_F32_KAPPA_C * kappa * U32,
+            "f32 row {e32:e}, kappa {kappa}: {c:?}"
+        );
+        if kappa <= EARTH_F32_KAPPA_LIMIT && m >= 1.0 {
+            assert!(e32 <= EARTH_F32_REL_TOLERANCE, "f32 row {e32:e}: {c:?}");
+            far32 = far32.max(e32);
+        }
+        ratio32 = ratio32.max(e32 / (kappa * U32));
+        compared += 1;
+    }
+    assert!(compared > 10_000, "only {compared} cases compared");
+    assert!(
+        worst64 <= EARTH_F64_REL_TOLERANCE,
+        "f64 row vs reference: {worst64:e}"
+    );
+    println!(
+        "row form: {compared} cases, f64 {worst64:.2e}, f32 {far32:.2e} (kappa <= \
+         {EARTH_F32_KAPPA_LIMIT}, >= 1 deg from the limb), f32 err/(kappa u) {ratio32:.2}"
+    );
 }

@@ -98,7 +98,7 @@ fn check(k: usize, c: &Controller, g: &UpdateGolden, w: &mut Worst) {
         let ticks_err = libm::fabs(f64::from(o.ticks) - gold.ticks_exact);
         let drift_err = libm::fabs(f64::from(o.drift_rad) - gold.drift_rad);
         let ok = o.index == gold.index
-            && seg.sample_px().len() == gold.samples
+            && seg.samples.len() == gold.samples
             && !o.held
             && ticks_err <= TICKS_REL_TOL * gold.ticks_exact + 0.5
             && drift_err <= ANGLE_TOL_RAD;
@@ -112,7 +112,7 @@ fn check(k: usize, c: &Controller, g: &UpdateGolden, w: &mut Worst) {
                 gold.ticks_exact,
                 o.drift_rad,
                 gold.drift_rad,
-                seg.sample_px().len(),
+                seg.samples.len(),
                 gold.samples,
                 o.held
             );

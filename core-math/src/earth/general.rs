@@ -287,32 +287,173 @@ impl<T: Real> Backend<Earth> for General<T> {
         up: &GeneralUpdate<T>,
         px: &GeneralPixel<T>,
     ) -> Result<ImageMotion<T>, ModelError> {
-        let u = px.u_m;
-        let nu = dot3(up.n_b, u);
-        let beta = dot3(up.rho_b_m, u);
-        // Both roots share the sign of -beta (C > 0: the satellite is outside).
+        let g = g_at(up, px.u_m, px.uu_m2)?;
+        project(g, px)
+    }
+}
+
+/// g = c'/s at the pixel u (|u|^2 = `uu`): the near root, then -W x u - V / s.
+#[inline(always)]
+fn g_at<T: Real>(up: &GeneralUpdate<T>, u: [T; 3], uu: T) -> Result<[T; 3], ModelError> {
+    let nu = dot3(up.n_b, u);
+    let beta = dot3(up.rho_b_m, u);
+    // Both roots share the sign of -beta (C > 0: the satellite is outside).
+    if !(beta < T::ZERO) {
+        return Err(ModelError::LineOfSightMissesEarth);
+    }
+    let alpha = uu + up.stretch2_minus_1 * nu * nu;
+    let disc = beta * beta - alpha * up.c_m2;
+    if !(disc >= T::ZERO) {
+        return Err(ModelError::LineOfSightMissesEarth);
+    }
+    let inv_s = (disc.sqrt() - beta) * up.inv_c_per_m2;
+    let (w, v) = (up.w_b_rad_s, up.v_b_mps);
+    Ok([
+        -(w[1] * u[2] - w[2] * u[1]) - v[0] * inv_s,
+        -(w[2] * u[0] - w[0] * u[2]) - v[1] * inv_s,
+        -(w[0] * u[1] - w[1] * u[0]) - v[2] * inv_s,
+    ])
+}
+
+/// (v1, v2) = (g1 + (p1/f) g3, g2 + (p2/f) g3), refused when v1 is too slow to clock.
+#[inline(always)]
+fn project<T: Real>(g: [T; 3], px: &GeneralPixel<T>) -> Result<ImageMotion<T>, ModelError> {
+    let v1 = g[0] + px.t1 * g[2];
+    if !(v1.abs() >= T::from_f64(MIN_V1_MPS)) {
+        return Err(ModelError::NoAlongTrackMotion);
+    }
+    Ok(ImageMotion {
+        v1_mps: v1,
+        v2_mps: g[1] + px.t2 * g[2],
+    })
+}
+
+impl<T: Real> General<T> {
+    /// [`Backend::motion`] on `up.yawed(sin_delta, cos_delta)`, without forming the
+    /// turned update. The turn R = Rz(delta)^T acts on every B-frame vector of the
+    /// update, so n'.u = n.(R^T u), rho'.u = rho.(R^T u), (R w) x u = R (w x R^T u) and
+    /// g'(u) = R g(R^T u): the unturned update's g at the pixel turned back, turned. The
+    /// projection onto the focal plane keeps the pixel's own (p1, p2).
+    pub fn motion_yawed(
+        &self,
+        up: &GeneralUpdate<T>,
+        px: &GeneralPixel<T>,
+        sin_delta: T,
+        cos_delta: T,
+    ) -> Result<ImageMotion<T>, ModelError> {
+        let (s, c, u) = (sin_delta, cos_delta, px.u_m);
+        let back = [c * u[0] - s * u[1], s * u[0] + c * u[1], u[2]];
+        let g = g_at(up, back, px.uu_m2)?;
+        project([c * g[0] + s * g[1], c * g[1] - s * g[0], g[2]], px)
+    }
+
+    /// The constants of one row of the focal plane at one update: (v1, v2) at any p2 of
+    /// the row for about twenty operations ([`GeneralRowMotion::motion_at`]).
+    ///
+    /// With u = (p1, p2, -f) and s = 1/s the near root's inverse:
+    ///
+    /// ```text
+    /// n.u   = (n1 p1 - n3 f) + n2 p2,        rho.u = (rho1 p1 - rho3 f) + rho2 p2
+    /// alpha = (p1^2 + f^2) + p2^2 + (kappa^2 - 1) (n.u)^2
+    /// v1    = (f + t1 p1) w2 + (w3 - t1 w1) p2 - (V1 + t1 V3) s
+    /// v2    = -(w3 p1 + f w1) + t1 w2 p2 - (w1 / f) p2^2 - (V2 + (V3 / f) p2) s
+    /// ```
+    ///
+    /// (t1 = p1/f; indices 1..3 are the B axes), the expansion of [`Backend::motion`]'s
+    /// g and projection in p2, checked against it (`core-math/tests/earth.rs`).
+    pub fn row_motion(&self, up: &GeneralUpdate<T>, row: &GeneralRow<T>) -> GeneralRowMotion<T> {
+        let (p1, f, t1) = (row.p1_m, row.focal_m, row.t1);
+        let (n, rho, w, v) = (up.n_b, up.rho_b_m, up.w_b_rad_s, up.v_b_mps);
+        GeneralRowMotion {
+            nu: [n[0] * p1 - n[2] * f, n[1]],
+            beta: [rho[0] * p1 - rho[2] * f, rho[1]],
+            uu0_m2: row.uu0_m2,
+            stretch2_minus_1: up.stretch2_minus_1,
+            c_m2: up.c_m2,
+            inv_c_per_m2: up.inv_c_per_m2,
+            v1: [(f + t1 * p1) * w[1], w[2] - t1 * w[0], v[0] + t1 * v[2]],
+            v2: [
+                -(w[2] * p1 + f * w[0]),
+                t1 * w[1],
+                -(w[0] * row.inv_focal_per_m),
+                v[1],
+                v[2] * row.inv_focal_per_m,
+            ],
+        }
+    }
+
+    /// The row of the focal plane at the camera's p1 (boot-time work in f64, rounded
+    /// once), for [`General::row_motion`]. A pixel n of the camera lies on it at
+    /// p2 = n x pixel pitch.
+    pub fn row(&self, camera: &EarthCamera) -> Result<GeneralRow<T>, ModelError> {
+        camera.focal_plane_m(0.0)?;
+        let (p1, f) = (camera.p1_m, camera.focal_m);
+        Ok(GeneralRow {
+            p1_m: T::from_f64(p1),
+            focal_m: T::from_f64(f),
+            t1: T::from_f64(p1 / f),
+            inv_focal_per_m: T::from_f64(1.0 / f),
+            uu0_m2: T::from_f64(p1 * p1 + f * f),
+        })
+    }
+}
+
+/// One row of the focal plane: the pixels u = (p1, p2, -f) at one p1.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GeneralRow<T> {
+    pub p1_m: T,
+    pub focal_m: T,
+    /// p1/f and 1/f.
+    pub t1: T,
+    pub inv_focal_per_m: T,
+    /// p1^2 + f^2 (m^2).
+    pub uu0_m2: T,
+}
+
+/// A row's constants at one update ([`General::row_motion`]): each quantity of the
+/// per-pixel work as a polynomial in p2.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GeneralRowMotion<T> {
+    /// n.u = nu[0] + nu[1] p2 (m).
+    pub nu: [T; 2],
+    /// beta = rho.u = beta[0] + beta[1] p2 (m^2).
+    pub beta: [T; 2],
+    /// p1^2 + f^2 (m^2).
+    pub uu0_m2: T,
+    pub stretch2_minus_1: T,
+    pub c_m2: T,
+    pub inv_c_per_m2: T,
+    /// v1 = v1[0] + v1[1] p2 - v1[2] / s (m/s).
+    pub v1: [T; 3],
+    /// v2 = v2[0] + v2[1] p2 + v2[2] p2^2 - (v2[3] + v2[4] p2) / s (m/s).
+    pub v2: [T; 5],
+}
+
+impl<T: Real> GeneralRowMotion<T> {
+    /// (v1, v2) at the row's pixel p2 (m): [`Backend::motion`] at u = (p1, p2, -f), with
+    /// its checks and errors, rounded differently.
+    #[inline(always)]
+    pub fn motion_at(&self, p2_m: T) -> Result<ImageMotion<T>, ModelError> {
+        let p2 = p2_m;
+        let nu = self.nu[0] + self.nu[1] * p2;
+        let beta = self.beta[0] + self.beta[1] * p2;
         if !(beta < T::ZERO) {
             return Err(ModelError::LineOfSightMissesEarth);
         }
-        let alpha = px.uu_m2 + up.stretch2_minus_1 * nu * nu;
-        let disc = beta * beta - alpha * up.c_m2;
+        let alpha = self.uu0_m2 + p2 * p2 + self.stretch2_minus_1 * nu * nu;
+        let disc = beta * beta - alpha * self.c_m2;
         if !(disc >= T::ZERO) {
             return Err(ModelError::LineOfSightMissesEarth);
         }
-        let inv_s = (disc.sqrt() - beta) * up.inv_c_per_m2;
-        let (w, v) = (up.w_b_rad_s, up.v_b_mps);
-        let g = [
-            -(w[1] * u[2] - w[2] * u[1]) - v[0] * inv_s,
-            -(w[2] * u[0] - w[0] * u[2]) - v[1] * inv_s,
-            -(w[0] * u[1] - w[1] * u[0]) - v[2] * inv_s,
-        ];
-        let v1 = g[0] + px.t1 * g[2];
+        let inv_s = (disc.sqrt() - beta) * self.inv_c_per_m2;
+        let v1 = self.v1[0] + self.v1[1] * p2 - self.v1[2] * inv_s;
         if !(v1.abs() >= T::from_f64(MIN_V1_MPS)) {
             return Err(ModelError::NoAlongTrackMotion);
         }
+        let c = &self.v2;
         Ok(ImageMotion {
             v1_mps: v1,
-            v2_mps: g[1] + px.t2 * g[2],
+            v2_mps: c[0] + p2 * (c[1] + c[2] * p2) - (c[3] + c[4] * p2) * inv_s,
         })
     }
 }

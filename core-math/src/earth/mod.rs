@@ -30,7 +30,9 @@ pub mod kepler;
 #[cfg(feature = "reference")]
 pub mod reference;
 
-pub use general::{General, GeneralInstant, GeneralPixel, GeneralUpdate};
+pub use general::{
+    General, GeneralInstant, GeneralPixel, GeneralRow, GeneralRowMotion, GeneralUpdate,
+};
 #[cfg(feature = "reference")]
 pub use reference::EarthReference;
 

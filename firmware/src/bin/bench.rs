@@ -105,7 +105,7 @@ where
     let mut out = [backend.pixel(camera, 0.0)?; MAX_POINTS];
     let mut count = 0;
     for seg in plan.active() {
-        for &n_px in seg.sample_px() {
+        for n_px in seg.samples.iter().map(|s| s.px) {
             let slot = out.get_mut(count).ok_or(FirmwareError::Layout)?;
             *slot = backend.pixel(camera, f64::from(n_px))?;
             count += 1;

@@ -26,10 +26,10 @@ fn run() -> Result<(), FirmwareError> {
         return Err(FirmwareError::Telemetry);
     }
     defmt::info!(
-        "default scene, roll {=f32} deg, pitch {=f32} deg: {=u8} segments, line clock {=f32} MHz, yaw request {=f32} mrad",
+        "default scene, roll {=f32} deg, pitch {=f32} deg: {=usize} segments, line clock {=f32} MHz, yaw request {=f32} mrad",
         ROLL_DEG,
         PITCH_DEG,
-        c.plan().count,
+        c.plan().active().len(),
         c.plan().line_clock_hz * 1e-6,
         c.yaw_request_rad().unwrap_or(f32::NAN) * 1e3
     );

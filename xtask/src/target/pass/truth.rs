@@ -102,9 +102,9 @@ pub fn check(
     let mut paper_pixels = std::collections::BTreeMap::new();
     for seg in plan.active() {
         let pixels = seg
-            .sample_px()
+            .samples
             .iter()
-            .map(|&n| Reference.pixel(&scene.camera, f64::from(n)))
+            .map(|s| Reference.pixel(&scene.camera, f64::from(s.px)))
             .collect::<Result<Vec<_>, _>>()
             .map_err(|e| e.name().to_string())?;
         paper_pixels.insert(seg.index, pixels);
