@@ -14,7 +14,7 @@
 
 use core_math::earth::{Attitude, GeneralRowMotion, GeneralUpdate};
 use core_math::ImageMotion;
-use core_math::{line_period_ticks, sinc, Backend, Ellipsoid, GENERAL_F32};
+use core_math::{nearest_ticks, sinc, Backend, Ellipsoid, Real, GENERAL_F32};
 
 use crate::fault::{Counters, Fault};
 use crate::frame::{kind, Frame};
@@ -135,6 +135,8 @@ pub struct Controller {
     resync_candidate_us: Option<u64>,
     now_us: u64,
     next_update_us: u64,
+    /// The update period `next_update_us` was scheduled with (0: none yet).
+    scheduled_period_us: u64,
     last_update_us: Option<u64>,
     pub counters: Counters,
     pub last_fault: Option<Fault>,
@@ -186,6 +188,7 @@ impl Controller {
             resync_candidate_us: None,
             now_us: 0,
             next_update_us: 0,
+            scheduled_period_us: 0,
             last_update_us: None,
             counters: Counters::default(),
             last_fault: None,
@@ -441,7 +444,16 @@ impl Controller {
         // Only the latest due instant is computed: after a gap, catching up on missed
         // updates would only delay the current one.
         let period = self.config.update_period_us.max(1);
-        let t = self.now_us - self.now_us % period;
+        // The instant due is the one scheduled, unless the clock has passed the next one
+        // too or the period was changed: a 64-bit division (a software call here) only
+        // then.
+        let t = if period == self.scheduled_period_us && self.now_us - self.next_update_us < period
+        {
+            self.next_update_us
+        } else {
+            self.now_us - self.now_us % period
+        };
+        self.scheduled_period_us = period;
         // t <= MAX_TIME_TAG_US; saturating all the same, for any configured period.
         self.next_update_us = t.saturating_add(period);
         self.last_update_us = Some(t);
@@ -465,8 +477,13 @@ impl Controller {
             return;
         }
         // Not stale: t - t_nav lies in [-update period, stale_after], both < 2^53 us:
-        // the difference is exact in i64 and small in f32.
-        let dt_s = (t_us as i64).wrapping_sub(nav.time_us as i64) as f32 * 1e-6;
+        // the difference is exact in i64 and small in f32. Converted from i32 when it
+        // fits (one instruction; from i64 it is a software call), to the same f32.
+        let dt_us = (t_us as i64).wrapping_sub(nav.time_us as i64);
+        let dt_s = match i32::try_from(dt_us) {
+            Ok(dt) => dt as f32,
+            Err(_) => dt_us as f32,
+        } * 1e-6;
         let state = nav.propagator.parts_at(dt_s);
         let attitude = attitude_at(&nav.attitude, dt_s);
         let instant = match GENERAL_F32.instant_parts(
@@ -474,7 +491,7 @@ impl Controller {
             state.velocity_mps,
             state.r2_minus_a2_m2,
             &attitude,
-            EARTH_RATE_RAD_S,
+            EARTH_RATE_RAD_S as f32,
         ) {
             Ok(i) => i,
             Err(e) => {
@@ -491,7 +508,7 @@ impl Controller {
             .and_then(|u| GENERAL_F32.motion(&u, &self.plan.boresight))
             .ok()
             .and_then(|m| {
-                let speed = libm::sqrtf(m.v1_mps * m.v1_mps + m.v2_mps * m.v2_mps);
+                let speed = Real::sqrt(m.v1_mps * m.v1_mps + m.v2_mps * m.v2_mps);
                 let sign = if m.v1_mps < 0.0 { -1.0 } else { 1.0 };
                 let (sin, cos) = (sign * m.v2_mps / speed, sign * m.v1_mps / speed);
                 (sin.is_finite() && cos.is_finite())
@@ -500,13 +517,23 @@ impl Controller {
         self.yaw_request_rad = steer.map(|(_, _, rad)| rad);
         // Output slots by `get` (`index` < MAX_SEGMENTS by construction of the plan): no
         // panic path (docs/no-panic.md).
+        // Segments over the same ground height share its update: made once per height
+        // in a row (a flat scene makes one, terrain one per segment).
+        let mut ground: Option<(f32, GeneralUpdate<f32>)> = None;
         for k in 0..self.plan.segments.len() {
             let Some(seg) = self.plan.segments.get(k) else {
                 break;
             };
             let index = seg.index;
-            let result = GENERAL_F32
-                .ground(&instant, &EARTH, self.height(index))
+            let height_m = self.height(index);
+            let update = match ground {
+                Some((h, u)) if h == height_m => Ok(u),
+                _ => GENERAL_F32.ground(&instant, &EARTH, height_m),
+            };
+            if let Ok(u) = update {
+                ground = Some((height_m, u));
+            }
+            let result = update
                 .map_err(Fault::from)
                 .and_then(|update| self.segment(&update, seg, steer));
             let slot = usize::from(index);
@@ -591,10 +618,13 @@ impl Controller {
         if !(period_s >= lo && period_s <= hi) {
             return Err(Fault::PeriodOutOfRange);
         }
-        let ticks = line_period_ticks(period_s, self.plan.line_clock_hz).map_err(Fault::from)?;
+        // The clock was checked when the scene arrived and the period just above:
+        // only the rounding to whole ticks is left (`line_period_ticks` less its input
+        // checks, a tenth of a segment's work).
+        let ticks = nearest_ticks(period_s * self.plan.line_clock_hz).map_err(Fault::from)?;
         // The mismatch of the period actually programmed, rounding to ticks included,
         // against the range v1 may take between the samples.
-        let v_line = a * self.plan.line_clock_hz / ticks.ticks as f32;
+        let v_line = a * self.plan.line_clock_hz / ticks as f32;
         let (v_lo, v_hi) = (v_min - seg.interpolation_mps, v_max + seg.interpolation_mps);
         let stages = u32::from(seg.tdi_stages);
         let (worst_mismatch, mtf, max_stages) = if v_lo > 0.0 {
@@ -626,7 +656,7 @@ impl Controller {
         };
         Ok(SegmentOutput {
             index: seg.index,
-            ticks: ticks.ticks,
+            ticks,
             worst_mismatch,
             mtf,
             max_stages,
@@ -703,6 +733,7 @@ fn inside_envelope(a: &Attitude<f32>, env: &AttitudeEnvelope, back_s: f32, ahead
 /// The drift angle atan(t) (rad) of a drift tangent t = v2/v1: `core_math::trig::atan_f32`
 /// (2.2 ulp, a tenth of libm's `atanf` cost here), which the drift smear of keystoned
 /// outer segments (|t| up to 0.3 at 20 deg of pitch) needs beyond any short series.
+#[inline(always)]
 pub fn drift_angle_rad(t: f32) -> f32 {
     core_math::trig::atan_f32(t)
 }

@@ -59,7 +59,7 @@ pub use earth::{Earth, EarthCamera, EarthGeometry, Ellipsoid, General};
 pub use error::{ModelError, Param};
 #[cfg(feature = "fixed-point")]
 pub use fixed_point::{Fixed, FixedReal, FIXED};
-pub use line_period::{line_period_s, line_period_ticks, Ticks};
+pub use line_period::{line_period_s, line_period_ticks, nearest_ticks, Ticks};
 #[cfg(feature = "micromath")]
 pub use micromath_f32::MicroF32;
 pub use model::{

@@ -47,11 +47,27 @@ pub fn line_period_ticks<T: Real>(period_s: T, clock_hz: T) -> Result<Ticks<T>, 
         return Err(ModelError::LinePeriodOutOfRange);
     }
     let exact = period_s * clock_hz;
+    let ticks = nearest_ticks(exact)?;
+    Ok(Ticks {
+        ticks,
+        rounding_error_s: (T::from_u32(ticks) - exact) / clock_hz,
+    })
+}
+
+/// A count of `exact_ticks` (period x clock) rounded half up to a whole number of ticks:
+/// the rounding of [`line_period_ticks`], for a caller whose period and clock are
+/// checked already (the controller: its clock when the scene arrives, each period
+/// against the physical bounds). Refused unless 1 <= ticks <= `u32::MAX`; any input,
+/// NaN and infinities included, gives a count in that range or the error.
+#[inline]
+pub fn nearest_ticks<T: Real>(exact_ticks: T) -> Result<u32, ModelError> {
+    let exact = exact_ticks;
     // Half up, from the exact fraction: `floor(exact + 0.5)` would round the sum first
     // (0.5 - 1 ulp + 0.5 gives 1.0; in f32 an odd integer above 2^23 plus 0.5 ties to
     // the even one above).
-    // exact > 0: truncation is the floor (saturating at u32::MAX, which the range check
-    // below then refuses), without the software `floorf` of this core.
+    // Truncation is the floor for exact >= 0 (saturating at u32::MAX, which the range
+    // check below then refuses; NaN and negatives give 0, refused too), without the
+    // software `floorf` of this core.
     let whole = T::from_u32(exact.to_u32());
     let nearest = if exact - whole >= T::from_f64(0.5) {
         whole + T::ONE
@@ -63,9 +79,5 @@ pub fn line_period_ticks<T: Real>(period_s: T, clock_hz: T) -> Result<Ticks<T>, 
     if !(nearest >= T::ONE && nearest < T::from_f64(4_294_967_296.0)) {
         return Err(ModelError::LinePeriodOutOfRange);
     }
-    let ticks = nearest.to_u32();
-    Ok(Ticks {
-        ticks,
-        rounding_error_s: (T::from_u32(ticks) - exact) / clock_hz,
-    })
+    Ok(nearest.to_u32())
 }

@@ -52,6 +52,7 @@ impl Scalar for MicroF32 {
 impl Real for MicroF32 {
     const ZERO: Self = MicroF32(0.0);
     const ONE: Self = MicroF32(1.0);
+    const EPSILON: Self = MicroF32(f32::EPSILON);
     #[inline(always)]
     fn from_f64(x: f64) -> Self {
         MicroF32(<f32 as Real>::from_f64(x))

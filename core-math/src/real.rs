@@ -26,6 +26,9 @@ pub trait Real:
 {
     const ZERO: Self;
     const ONE: Self;
+    /// The distance from 1 to the next value (2^-52, 2^-23): what a truncated series
+    /// must reach.
+    const EPSILON: Self;
     /// Round an f64 to this type (round to nearest even).
     fn from_f64(x: f64) -> Self;
     /// Correctly rounded square root.
@@ -65,6 +68,7 @@ impl Scalar for f32 {
 impl Real for f64 {
     const ZERO: Self = 0.0;
     const ONE: Self = 1.0;
+    const EPSILON: Self = f64::EPSILON;
     #[inline(always)]
     fn from_f64(x: f64) -> Self {
         x
@@ -116,6 +120,7 @@ impl Real for f64 {
 impl Real for f32 {
     const ZERO: Self = 0.0;
     const ONE: Self = 1.0;
+    const EPSILON: Self = f32::EPSILON;
     #[inline(always)]
     fn from_f64(x: f64) -> Self {
         x as f32

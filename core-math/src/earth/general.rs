@@ -130,7 +130,7 @@ impl<T: Real> General<T> {
             v64.map(T::from_f64),
             r2_minus_a2,
             attitude,
-            earth_rate_rad_s,
+            T::from_f64(earth_rate_rad_s),
         )
     }
 
@@ -145,10 +145,10 @@ impl<T: Real> General<T> {
         v: [T; 3],
         r2_minus_a2: T,
         attitude: &Attitude<T>,
-        earth_rate_rad_s: f64,
+        earth_rate_rad_s: T,
     ) -> Result<GeneralInstant<T>, ModelError> {
         let (r2, h) = check_state(r, v)?;
-        let w = T::from_f64(earth_rate_rad_s);
+        let w = earth_rate_rad_s;
 
         let rn = r2.sqrt();
         // |h| > 0: check_state refused any state with |h|^2 <= 1e-12 |r|^2 |v|^2.
