@@ -6,14 +6,14 @@
 //! |x| < 12 800 rad), then the minimax polynomials of Cephes' `sinf`/`cosf` on
 //! [-pi/4, pi/4]. Measured error against f64 over |x| <= 100 rad: at most 1.54 ulp
 //! (`core-math/tests/trig.rs`). Larger arguments, which the model never produces, fall
-//! back to libm.
+//! back to libm's f64 `sincos`, rounded.
 
 /// pi/2 = P1 + P2 + P3, P1 and P2 with trailing zero bits (Cephes' DP1..DP3, doubled).
 const P1: f32 = 1.570_312_5;
 const P2: f32 = 4.837_513e-4;
 const P3: f32 = 7.549_79e-8;
 const TWO_OVER_PI: f32 = core::f32::consts::FRAC_2_PI;
-/// Beyond this |x| the reduction is not exact: use libm.
+/// Beyond this |x| the reduction is not exact: libm in f64 ([`sin_cos_huge`]).
 const FAST_LIMIT: f32 = 12_800.0;
 
 /// sin r and cos r for |r| <= pi/4 (Cephes coefficients).
@@ -49,11 +49,15 @@ pub fn sin_cos_f32(x: f32) -> (f32, f32) {
     }
 }
 
-/// libm's (sin x, cos x), for the arguments the reduction cannot take.
+/// (sin x, cos x) for the arguments the reduction cannot take (|x| >= 12 800 rad, and
+/// NaN, infinities): libm's f64 `sincos` of the exact argument, rounded to f32. Not
+/// `sincosf`: its own reduction would add 3.2 KB of flash, and the f64 one is linked
+/// anyway (the planner's boot-time work). Within 0.5 ulp + 1 f64 ulp.
 #[cold]
 #[inline(never)]
 fn sin_cos_huge(x: f32) -> (f32, f32) {
-    libm::sincosf(x)
+    let (s, c) = libm::sincos(f64::from(x));
+    (s as f32, c as f32)
 }
 
 /// tan(3 pi / 8) = 1 + sqrt 2 and tan(pi / 8) = sqrt 2 - 1: the ends of the three

@@ -51,8 +51,19 @@ fn within_one_ulp_over_the_angles_the_model_uses() {
 #[test]
 fn large_and_special_arguments() {
     assert_eq!(sin_cos_f32(0.0), (0.0, 1.0));
-    let (s, c) = sin_cos_f32(1e5);
-    assert_eq!((s, c), libm::sincosf(1e5), "beyond the fast range: libm");
+    // Beyond the fast range: libm's f64 sincos of the exact argument, rounded; that is
+    // sincosf's correctly rounded value here (and at every argument within 1 ulp).
+    for x in [1e5f32, -3.0e7, 1.7e38, 12_800.0] {
+        let (s, c) = sin_cos_f32(x);
+        let (s64, c64) = libm::sincos(f64::from(x));
+        assert_eq!((s, c), (s64 as f32, c64 as f32), "{x}");
+        let (sf, cf) = libm::sincosf(x);
+        assert!(
+            (s - sf).abs() <= f32::EPSILON && (c - cf).abs() <= f32::EPSILON,
+            "{x}"
+        );
+    }
+    assert_eq!(sin_cos_f32(1e5), libm::sincosf(1e5));
     let (s, c) = sin_cos_f32(f32::NAN);
     assert!(s.is_nan() && c.is_nan());
 }
