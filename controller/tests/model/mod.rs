@@ -14,7 +14,9 @@ use controller::frame::{
 };
 use controller::nav::{Attitude, Nav};
 use controller::report::{Periods, Status};
-use controller::scene::{SCENE_HEADER_LEN, SEGMENT_LEN};
+use controller::scene::{
+    Terrain, MAX_GROUND_H_M, MAX_SEGMENTS, MIN_GROUND_H_M, SCENE_HEADER_LEN, SEGMENT_LEN,
+};
 use controller::session::Session;
 use controller::{Config, Controller, Fault, LinePeriodSink, Mode, Scene, SegmentOutput};
 use core_math::{StateVector, GM_M3_S2};
@@ -64,6 +66,9 @@ pub enum Action {
     BadVersion { version: u8, seed: u64 },
     /// A header announcing more than the largest payload.
     Oversized { len: u16, seed: u64 },
+    /// A TERRAIN frame, in the window: heights for the scene in force, valid or with
+    /// one defect (a NaN, a height out of range, the wrong count).
+    Terrain { dt_us: u64, what: u8, x: u64 },
 }
 
 /// Kinds the camera takes (and END, which ends a run): anything else is unknown.
@@ -144,7 +149,11 @@ impl Action {
                 len: (a % 1000) as u16,
                 seed: b,
             },
-            _ => Action::Time { dt_us: dt(a) },
+            _ => Action::Terrain {
+                dt_us: dt(a),
+                what: b as u8,
+                x: c,
+            },
         }
     }
 }
@@ -521,11 +530,12 @@ impl Harness {
         sent
     }
 
-    fn snapshot(&self) -> (Option<u64>, Scene, Vec<SegmentOutput>, u32) {
+    fn snapshot(&self) -> (Option<u64>, Scene, Vec<f32>, Vec<SegmentOutput>, u32) {
         let c = &self.session.controller;
         (
             c.nav().map(|n| n.time_us),
             *c.scene(),
+            c.heights_m().to_vec(),
             c.outputs().copied().collect(),
             c.updates,
         )
@@ -725,6 +735,52 @@ impl Harness {
                 self.one_frame(kind::NAV, now + dt_us, &nav_payload(sv, att), Err(f), None);
             }
             Action::Time { dt_us } => self.one_frame(kind::TIME, now + dt_us, &[], Ok(()), None),
+            Action::Terrain { dt_us, what, x } => {
+                let count = self.session.controller.scene().count;
+                let mut t = Terrain {
+                    heights_m: [0.0; MAX_SEGMENTS],
+                    count,
+                };
+                let span = MAX_GROUND_H_M - MIN_GROUND_H_M;
+                for (j, h) in t.heights_m.iter_mut().enumerate() {
+                    *h = MIN_GROUND_H_M + span * ((x >> (5 * j)) % 32) as f32 / 31.0;
+                }
+                let j = usize::from(what >> 3) % usize::from(count.max(1));
+                let verdict = match what % 6 {
+                    0..=2 => Ok(()),
+                    3 => {
+                        t.heights_m[j] = f32::NAN;
+                        Err(Fault::NonFinite)
+                    }
+                    4 => {
+                        t.heights_m[j] = if x % 2 == 0 {
+                            MAX_GROUND_H_M + 1.0
+                        } else {
+                            MIN_GROUND_H_M - 1.0
+                        };
+                        Err(Fault::OutOfRange)
+                    }
+                    _ => {
+                        t.count = if usize::from(count) < MAX_SEGMENTS {
+                            count + 1
+                        } else {
+                            count - 1
+                        };
+                        Err(Fault::InvalidScene)
+                    }
+                };
+                let mut p = [0u8; 128];
+                let n = t.encode(&mut p).expect("a TERRAIN payload fits");
+                let accepted = self.session.controller.frames_accepted;
+                self.one_frame(kind::TERRAIN, now + dt_us, &p[..n], verdict, None);
+                if self.session.controller.frames_accepted > accepted {
+                    assert_eq!(
+                        self.session.controller.heights_m(),
+                        &t.heights_m[..usize::from(count)],
+                        "TERRAIN not taken"
+                    );
+                }
+            }
             Action::Tick { dt_us } => {
                 let mut out = Vec::new();
                 let mut sink = Recorder::default();
