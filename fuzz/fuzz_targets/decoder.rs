@@ -73,9 +73,12 @@ struct SceneOp {
     line_clock_hz: Option<f64>,
     mtf_floor: Option<f32>,
     max_roll_rad: Option<f32>,
+    max_pitch_rad: Option<f32>,
+    max_rate_rad_s: Option<f32>,
     max_stages: Option<u16>,
     count: Option<u8>,
-    segments: Vec<(u8, i32, i32, u16, bool)>,
+    /// (index, first px, last px, stages, active, ground height m, p1 m)
+    segments: Vec<(u8, i32, i32, u16, bool, f32, f32)>,
 }
 
 #[derive(Debug)]
@@ -107,7 +110,7 @@ fn frame(kind: u8, seq: u16, time_us: u64, payload: &[u8]) -> Vec<u8> {
     }
 }
 
-fn nav_payload(state: StateVector, attitude: Attitude) -> Vec<u8> {
+fn nav_payload(state: StateVector, attitude: Attitude<f32>) -> Vec<u8> {
     let mut p = [0u8; 128];
     let n = Nav { state, attitude }.encode(&mut p).unwrap();
     p[..n].to_vec()
@@ -225,17 +228,25 @@ fn build(ops: &[Op]) -> Vec<u8> {
                     sc.mtf_floor = x;
                 }
                 if let Some(x) = s.max_roll_rad {
-                    sc.max_roll_rad = x;
+                    sc.envelope.max_roll_rad = x;
+                }
+                if let Some(x) = s.max_pitch_rad {
+                    sc.envelope.max_pitch_rad = x;
+                }
+                if let Some(x) = s.max_rate_rad_s {
+                    sc.envelope.max_rate_rad_s = x;
                 }
                 if let Some(x) = s.max_stages {
                     sc.max_stages = x;
                 }
-                for &(idx, first_px, last_px, tdi_stages, active) in &s.segments {
+                for &(idx, first_px, last_px, tdi_stages, active, ground_h_m, p1_m) in &s.segments {
                     sc.segments[usize::from(idx) % MAX_SEGMENTS] = SegmentSpec {
                         first_px,
                         last_px,
                         tdi_stages,
                         active,
+                        ground_h_m,
+                        p1_m,
                     };
                 }
                 if let Some(c) = s.count {
@@ -392,10 +403,15 @@ fuzz_target!(|input: Input| {
                     }
                 }
                 Event::Frame(f) => {
+                    // As the session does: only an accepted frame moves the clock, so
+                    // only it can make an update due.
+                    let before = c.frames_accepted;
                     c.on_frame(&f);
-                    sink.arm(&c);
-                    let now = c.now_us();
-                    c.advance(now, &mut sink);
+                    if c.frames_accepted != before {
+                        sink.arm(&c);
+                        let now = c.now_us();
+                        c.advance(now, &mut sink);
+                    }
                 }
             }
         });

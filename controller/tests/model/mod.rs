@@ -743,7 +743,7 @@ impl Harness {
                 };
                 let span = MAX_GROUND_H_M - MIN_GROUND_H_M;
                 for (j, h) in t.heights_m.iter_mut().enumerate() {
-                    *h = MIN_GROUND_H_M + span * ((x >> (5 * j)) % 32) as f32 / 31.0;
+                    *h = MIN_GROUND_H_M + span * (x.rotate_right(5 * j as u32) % 32) as f32 / 31.0;
                 }
                 let j = usize::from(what >> 3) % usize::from(count.max(1));
                 let verdict = match what % 6 {
