@@ -104,7 +104,7 @@ impl SplitMix64 {
         };
         if self.next_u64() & 3 == 0 {
             let mut margin = libm::pow(10.0, self.uniform(-3.0, libm::log10(3.0))).to_radians();
-            if self.next_u64() % 20 == 0 {
+            if self.next_u64().is_multiple_of(20) {
                 margin = -margin;
             }
             let side = if self.next_u64() & 1 == 0 { 1.0 } else { -1.0 };

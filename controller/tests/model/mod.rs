@@ -81,7 +81,7 @@ impl Action {
         let frac = |x: u64| (x % 1_000_001) as f64 / 1e6;
         // Mostly one update period or two, sometimes up to the whole window.
         let dt = |x: u64| {
-            if x % 8 == 0 {
+            if x.is_multiple_of(8) {
                 1 + (x >> 3) % 5_000_000
             } else {
                 1 + (x >> 3) % 60_000
@@ -116,7 +116,7 @@ impl Action {
             },
             20 => Action::TimeMax { below_max: a % 3 },
             21 => Action::Resync {
-                forward: a % 2 == 0,
+                forward: a.is_multiple_of(2),
                 offset_us: 1 + (a >> 1) % 1_000_000_000,
                 gap_us: 1 + b % 5_000_000,
             },

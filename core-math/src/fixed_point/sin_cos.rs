@@ -23,7 +23,7 @@ const fn factorial(n: u32) -> i128 {
 const fn coef(n: u32, k: u32) -> i64 {
     let f = factorial(n);
     let c = ((1i128 << 62) + f / 2) / f;
-    if k % 2 == 0 {
+    if k.is_multiple_of(2) {
         c as i64
     } else {
         -(c as i64)
