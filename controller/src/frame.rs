@@ -1,9 +1,12 @@
 //! Telemetry framing: sync word, version, kind, length, sequence number, time tag,
 //! payload, CRC. Layout and rationale: `docs/telemetry.md`.
 //!
-//! The decoder is a byte-stream state machine over a fixed buffer: it never blocks,
-//! never allocates, and after any bad frame it rescans the bytes it already holds for the
-//! next sync word, so a corrupted or truncated frame costs that frame only.
+//! The decoder is a byte-stream state machine over a fixed-capacity buffer (a
+//! `heapless::Vec` of one frame): it never blocks, never allocates, and after any bad
+//! frame it rescans the bytes it already holds for the next sync word, so a corrupted or
+//! truncated frame costs that frame only.
+
+use heapless::Vec;
 
 use crate::crc;
 
@@ -72,8 +75,8 @@ pub enum Event<'a> {
 
 /// The streaming decoder.
 pub struct Decoder {
-    buf: [u8; MAX_FRAME],
-    len: usize,
+    /// The bytes of the frame not yet complete: at most one frame.
+    buf: Vec<u8, MAX_FRAME>,
     /// Every byte received that is not part of a delivered frame: line noise, and the
     /// bytes of rejected frames. So bytes received = delivered frames' bytes + skipped
     /// + [`Decoder::buffered`].
@@ -86,13 +89,13 @@ impl Default for Decoder {
     }
 }
 
-enum Step {
+enum Step<'a> {
     /// Need more bytes.
     Wait,
     /// Drop this many bytes from the front and look again.
     Drop(usize),
-    /// A good frame of this total length at the front.
-    Frame(usize),
+    /// A good frame at the front, and its total length.
+    Frame(Frame<'a>, usize),
     /// A bad frame at the front: report it, drop its sync's first byte, rescan.
     Reject(FrameError),
 }
@@ -100,8 +103,7 @@ enum Step {
 impl Decoder {
     pub const fn new() -> Self {
         Decoder {
-            buf: [0; MAX_FRAME],
-            len: 0,
+            buf: Vec::new(),
             skipped_bytes: 0,
         }
     }
@@ -109,11 +111,9 @@ impl Decoder {
     /// Feeds received bytes; `on_event` is called for every frame and every rejected frame.
     pub fn feed(&mut self, bytes: &[u8], mut on_event: impl FnMut(Event<'_>)) {
         for &b in bytes {
-            // The buffer holds at most one frame, so it always has room after parsing.
-            if self.len < MAX_FRAME {
-                self.buf[self.len] = b;
-                self.len += 1;
-            }
+            // Never full here: parsing leaves less than a whole frame in the buffer
+            // (a frame of MAX_FRAME bytes is delivered or rejected at once).
+            let _ = self.buf.push(b);
             self.parse(&mut on_event);
         }
     }
@@ -126,16 +126,8 @@ impl Decoder {
                     self.skipped_bytes = self.skipped_bytes.saturating_add(n as u32);
                     self.consume(n);
                 }
-                Step::Frame(n) => {
-                    let b = &self.buf;
-                    on_event(Event::Frame(Frame {
-                        kind: b[3],
-                        sequence: u16::from_le_bytes([b[6], b[7]]),
-                        time_us: u64::from_le_bytes([
-                            b[8], b[9], b[10], b[11], b[12], b[13], b[14], b[15],
-                        ]),
-                        payload: &b[HEADER_LEN..n - CRC_LEN],
-                    }));
+                Step::Frame(frame, n) => {
+                    on_event(Event::Frame(frame));
                     self.consume(n);
                 }
                 Step::Reject(e) => {
@@ -149,13 +141,11 @@ impl Decoder {
 
     /// Bytes held for a frame not yet complete.
     pub fn buffered(&self) -> usize {
-        self.len
+        self.buf.len()
     }
 
-    fn step(&self) -> Step {
-        // `len` <= MAX_FRAME always (`feed`); the `min` proves it to the optimiser (no
-        // panic path, docs/no-panic.md).
-        let b = &self.buf[..self.len.min(MAX_FRAME)];
+    fn step(&self) -> Step<'_> {
+        let b = self.buf.as_slice();
         if b.is_empty() {
             return Step::Wait;
         }
@@ -186,7 +176,13 @@ impl Decoder {
         let body = &b[2..total - CRC_LEN];
         let sent = u16::from_le_bytes([b[total - 2], b[total - 1]]);
         if crc::crc16(body) == sent {
-            return Step::Frame(total);
+            let frame = Frame {
+                kind: b[3],
+                sequence: u16::from_le_bytes([b[6], b[7]]),
+                time_us: u64::from_le_bytes([b[8], b[9], b[10], b[11], b[12], b[13], b[14], b[15]]),
+                payload: &b[HEADER_LEN..total - CRC_LEN],
+            };
+            return Step::Frame(frame, total);
         }
         // A sync word with our version inside the span says the frame was cut short
         // and another began; otherwise the bytes were damaged in place.
@@ -201,10 +197,10 @@ impl Decoder {
     }
 
     fn consume(&mut self, n: usize) {
-        let len = self.len.min(MAX_FRAME);
+        let len = self.buf.len();
         let n = n.min(len);
-        self.buf.copy_within(n..len, 0);
-        self.len = len - n;
+        self.buf.copy_within(n.., 0);
+        self.buf.truncate(len - n);
     }
 }
 

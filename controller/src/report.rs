@@ -1,6 +1,8 @@
 //! Camera-to-ground frames: PERIODS (what was programmed) and STATUS (fault counters).
 //! Encoded by the firmware, decoded by the host tools; one codec for both sides.
 
+use heapless::Vec;
+
 use crate::bytes::{Reader, Writer};
 use crate::control::{Controller, Mode, SegmentOutput};
 use crate::fault::Fault;
@@ -44,13 +46,12 @@ pub fn encode_periods(c: &Controller, out: &mut [u8]) -> Option<usize> {
 }
 
 /// A decoded PERIODS payload.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Periods {
     pub mode: u8,
-    pub count: u8,
     /// The yaw steering request (rad), when the update formed one.
     pub yaw_request_rad: Option<f32>,
-    pub records: [SegmentOutput; MAX_SEGMENTS],
+    pub records: Vec<SegmentOutput, MAX_SEGMENTS>,
 }
 
 impl Periods {
@@ -61,14 +62,12 @@ impl Periods {
         let flags = r.u8()?;
         r.u8()?;
         let yaw = r.f32()?;
-        if usize::from(count) > MAX_SEGMENTS {
-            return None;
-        }
-        let mut records = [SegmentOutput::default(); MAX_SEGMENTS];
-        for rec in records.iter_mut().take(usize::from(count)) {
+        // More records than segments do not fit: `push` refuses the 17th.
+        let mut records = Vec::new();
+        for _ in 0..count {
             let index = r.u8()?;
             let flags = r.u8()?;
-            *rec = SegmentOutput {
+            let record = SegmentOutput {
                 index,
                 held: flags & FLAG_HELD != 0,
                 reversed: flags & FLAG_REVERSED != 0,
@@ -80,17 +79,17 @@ impl Periods {
                 worst_drift_rad: r.f32()?,
                 residual_drift_rad: r.f32()?,
             };
+            records.push(record).ok()?;
         }
         r.is_done().then_some(Periods {
             mode,
-            count,
             yaw_request_rad: (flags & FLAG_YAW_REQUEST != 0).then_some(yaw),
             records,
         })
     }
 
     pub fn records(&self) -> &[SegmentOutput] {
-        &self.records[..usize::from(self.count)]
+        &self.records
     }
 }
 

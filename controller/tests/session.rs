@@ -72,7 +72,7 @@ fn periods_after_each_update_status_every_second_and_at_the_end() {
     assert_eq!(periods.len(), 101);
     for (k, (t, p)) in periods.iter().enumerate() {
         assert_eq!(*t, k as u64 * 20_000);
-        assert_eq!(p.count, 10);
+        assert_eq!(p.records().len(), 10);
     }
     // STATUS at 0, 1 s, 2 s and the final one after END.
     let times: Vec<u64> = status.iter().map(|(t, _)| *t).collect();

@@ -30,6 +30,7 @@ pub mod link;
 #[cfg(not(feature = "defmt-rtt"))]
 pub mod logger;
 pub mod platform;
+pub mod rx;
 pub mod stack;
 pub mod synthetic;
 pub mod telemetry;

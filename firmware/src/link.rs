@@ -1,10 +1,12 @@
 //! The telemetry link as the rest of the firmware sees it: an `embedded-hal-nb` serial
 //! port of bytes (`serial::Read<u8>` and `serial::Write<u8>`, never blocking: a busy
 //! or empty port answers `WouldBlock`), plus [`RxWait`], the one thing those traits
-//! lack: a way to sleep until a byte may have arrived. Any board's UART driver, or a
-//! host test double, provides it (the boards: [`crate::board`]).
+//! lack: a way to sleep until a byte may have arrived. Both boards read the port
+//! from their receive interrupt into a queue ([`crate::rx`]); the loop reads the queue.
+//! Any board's UART driver, or a host test double, provides it (the boards:
+//! [`crate::board`]).
 
-use embedded_hal_nb::serial::{Read, Write};
+use embedded_hal_nb::serial::{self, ErrorKind, ErrorType, Read, Write};
 
 /// Sleeping until the receiver may have something. A UART with a receive interrupt
 /// sleeps here (WFI); a plain polled link returns at once.
@@ -13,9 +15,71 @@ pub trait RxWait {
 }
 
 /// Everything the telemetry loop needs of a link.
-pub trait Link: Read<u8> + Write<u8> + RxWait {}
+pub trait Link: ErrorType<Error = LinkError> + Read<u8> + Write<u8> + RxWait {}
 
-impl<T: Read<u8> + Write<u8> + RxWait> Link for T {}
+impl<T: ErrorType<Error = LinkError> + Read<u8> + Write<u8> + RxWait> Link for T {}
+
+/// Why a link lost bytes: what the UART reports, and the receive queue's overflow.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LinkError {
+    /// A byte arrived before the previous one was read.
+    Overrun,
+    FrameFormat,
+    Parity,
+    Noise,
+    /// Any other error the UART reports.
+    Other,
+    /// The receive interrupt read a byte and the queue had no room for it
+    /// ([`crate::rx`]: never expected, it reads only when there is room).
+    QueueOverflow,
+}
+
+impl LinkError {
+    pub const COUNT: usize = 6;
+    /// Every error, in discriminant order.
+    pub const ALL: [LinkError; LinkError::COUNT] = [
+        LinkError::Overrun,
+        LinkError::FrameFormat,
+        LinkError::Parity,
+        LinkError::Noise,
+        LinkError::Other,
+        LinkError::QueueOverflow,
+    ];
+
+    pub fn from_kind(kind: ErrorKind) -> LinkError {
+        match kind {
+            ErrorKind::Overrun => LinkError::Overrun,
+            ErrorKind::FrameFormat => LinkError::FrameFormat,
+            ErrorKind::Parity => LinkError::Parity,
+            ErrorKind::Noise => LinkError::Noise,
+            _ => LinkError::Other,
+        }
+    }
+
+    /// Its name, for the log.
+    pub fn name(self) -> &'static str {
+        match self {
+            LinkError::Overrun => "overrun",
+            LinkError::FrameFormat => "framing error",
+            LinkError::Parity => "parity error",
+            LinkError::Noise => "noise",
+            LinkError::Other => "other",
+            LinkError::QueueOverflow => "receive queue overflow",
+        }
+    }
+}
+
+impl serial::Error for LinkError {
+    fn kind(&self) -> ErrorKind {
+        match self {
+            LinkError::Overrun | LinkError::QueueOverflow => ErrorKind::Overrun,
+            LinkError::FrameFormat => ErrorKind::FrameFormat,
+            LinkError::Parity => ErrorKind::Parity,
+            LinkError::Noise => ErrorKind::Noise,
+            LinkError::Other => ErrorKind::Other,
+        }
+    }
+}
 
 /// How many times [`send_bounded`] polls a busy transmitter for one byte before it
 /// gives the frame up. Under QEMU a byte leaves in a few polls unless the host stops

@@ -14,7 +14,7 @@ use controller::{Config, Controller, Scene};
 use cortex_m_rt::entry;
 use firmware::board::{self, Parts};
 use firmware::line_clock::LineClocks;
-use firmware::{platform, stack, telemetry};
+use firmware::{platform, rx, stack, telemetry};
 use static_cell::StaticCell;
 
 /// The controller and its link state live here, not on `main`'s stack: the stack
@@ -70,6 +70,13 @@ fn main() -> ! {
                 );
             }
             let summary = telemetry::run(&mut link, &mut clocks, &mut clock, session);
+            let queue = rx::stats();
+            defmt::info!(
+                "receive queue: at most {=u32} of {=usize} bytes held, full {=u32} times (the UART waited)",
+                queue.high_water,
+                rx::QUEUE_SLOTS - 1,
+                queue.stalls
+            );
             if summary.tx_dropped == 0 && summary.rx_errors == 0 && clocks.errors == 0 {
                 0
             } else {

@@ -16,6 +16,8 @@ use defmt_rtt as _; // the global defmt logger on a real board
 pub const EXIT_PANIC: i32 = 101;
 /// Exit status of a HardFault.
 pub const EXIT_HARD_FAULT: i32 = 102;
+/// Exit status of an interrupt the firmware never unmasks (mps2-an386's default handler).
+pub const EXIT_UNEXPECTED_INTERRUPT: i32 = 103;
 
 /// Ends the program with `code` as the debugger's (QEMU's) exit status.
 pub fn exit(code: i32) -> ! {

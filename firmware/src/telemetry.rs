@@ -17,7 +17,6 @@
 
 use controller::session::Session;
 use controller::{LinePeriodSink, Mode};
-use embedded_hal_nb::serial::{Error as _, ErrorKind};
 
 use crate::board::Monotonic;
 use crate::link::{flush_bounded, send_bounded, Link};
@@ -66,7 +65,7 @@ pub fn run<L: Link, S: LinePeriodSink, C: Monotonic>(
                 summary.rx_errors = summary.rx_errors.saturating_add(1);
                 defmt::warn!(
                     "receive error: {=str} ({=u32} so far)",
-                    error_name(e.kind()),
+                    e.name(),
                     summary.rx_errors
                 );
                 continue;
@@ -102,17 +101,6 @@ pub fn run<L: Link, S: LinePeriodSink, C: Monotonic>(
             );
             return summary;
         }
-    }
-}
-
-/// A receive error's name, for the log.
-fn error_name(kind: ErrorKind) -> &'static str {
-    match kind {
-        ErrorKind::Overrun => "overrun",
-        ErrorKind::FrameFormat => "framing error",
-        ErrorKind::Parity => "parity error",
-        ErrorKind::Noise => "noise",
-        _ => "other",
     }
 }
 

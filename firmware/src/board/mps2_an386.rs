@@ -7,11 +7,11 @@
 //!
 //! UART, as modelled by QEMU: a one-byte receive buffer (STATE.RXFULL set on arrival,
 //! cleared by reading DATA) and QEMU offers the next byte only once it is empty, so the
-//! host side is flow-controlled and nothing is lost however slowly the firmware polls;
-//! a one-byte transmit buffer (STATE.TXFULL) that stays full while the host end of the
-//! chardev does not accept the byte. On silicon the receive side overruns instead
-//! (STATE.RXOVERRUN) if a byte is not read within one character time: a board build
-//! would read it from the RX interrupt into a ring buffer.
+//! host side is flow-controlled; a one-byte transmit buffer (STATE.TXFULL) that stays
+//! full while the host end of the chardev does not accept the byte. On silicon the
+//! receive side overruns instead (STATE.RXOVERRUN) if a byte is not read within one
+//! character time: so the receive interrupt reads every byte into the queue of
+//! [`crate::rx`], and the loop takes them from there.
 
 use core::sync::atomic::{AtomicBool, Ordering};
 
@@ -19,7 +19,9 @@ use embedded_hal_nb::serial::{ErrorKind, ErrorType, Read, Write};
 
 use super::{BoardError, Extended, Monotonic, Parts, LINK_BAUD};
 use crate::line_clock::ReloadRegister;
-use crate::link::RxWait;
+use crate::link::{LinkError, RxWait};
+use crate::platform;
+use crate::rx::{self, RxQueue};
 
 /// The board's name (the cargo feature).
 pub const NAME: &str = "mps2-an386";
@@ -39,8 +41,8 @@ const TIMER1_BASE: usize = 0x4000_1000;
 /// The APB clock of UARTs and timers on the mps2-an386 (Hz).
 const PCLK_HZ: u32 = 25_000_000;
 
-/// Brings the board up: UART0 at 115 200 Bd with its receive interrupt as a wake-up
-/// source, TIMER0 stopped until its first period, TIMER1 running. Call once.
+/// Brings the board up: UART0 at 115 200 Bd, its receive interrupt feeding the receive
+/// queue, TIMER0 stopped until its first period, TIMER1 running. Call once.
 pub fn take() -> Result<Parts<Link, LineClock, Clock>, BoardError> {
     // The same guard as a HAL's `Peripherals::take`: a second call gets nothing.
     static TAKEN: AtomicBool = AtomicBool::new(false);
@@ -48,10 +50,10 @@ pub fn take() -> Result<Parts<Link, LineClock, Clock>, BoardError> {
         return Err(BoardError::Taken);
     }
     // SAFETY: the guard above lets this run once, so nothing else owns UART0, TIMER0
-    // or TIMER1, and the firmware uses no interrupt handler.
+    // or TIMER1.
     let (link, line_clock, clock) = unsafe {
         (
-            Uart::uart0(LINK_BAUD),
+            Uart::uart0(LINK_BAUD).ok_or(BoardError::Taken)?,
             Timer::timer0(),
             FreeRunning::timer1(),
         )
@@ -88,10 +90,29 @@ mod uart_reg {
 #[derive(Clone, Copy)]
 struct Uart0Rx;
 
+const UART0_RX_IRQ: u16 = 0;
+
 // SAFETY: 0 is the NVIC line QEMU's mps2-an386 wires UART0's RX interrupt to.
 unsafe impl cortex_m::interrupt::InterruptNumber for Uart0Rx {
     fn number(self) -> u16 {
-        0
+        UART0_RX_IRQ
+    }
+}
+
+/// The receive interrupt's state: UART0's receiver and the queue's producer.
+static RX: rx::Handler<UartRx, Uart0Rx> = rx::Handler::new();
+
+/// Every device interrupt. The mps2-an386 has no peripheral access crate to name its
+/// vectors, so cortex-m-rt's default vector table sends them all here with their
+/// number; only UART0's receive interrupt is ever unmasked. (`unsafe` because
+/// cortex-m-rt asks it of a `DefaultHandler`; nothing in it is.)
+#[cortex_m_rt::exception]
+unsafe fn DefaultHandler(irqn: i16) {
+    if irqn == UART0_RX_IRQ as i16 {
+        RX.run();
+    } else {
+        defmt::error!("unexpected interrupt {=i16}", irqn);
+        platform::exit(platform::EXIT_UNEXPECTED_INTERRUPT)
     }
 }
 
@@ -121,48 +142,89 @@ impl Registers {
     }
 }
 
-/// A CMSDK APB UART, polled.
+/// A CMSDK APB UART: the loop's side (the transmitter, and the receive queue the
+/// interrupt fills).
 pub struct Uart {
+    /// Used for DATA writes and STATE.TXFULL only; the receive registers are the
+    /// interrupt's ([`UartRx`]).
+    tx: Registers,
+    rx: RxQueue<Uart0Rx>,
+}
+
+/// UART0's receiver, read by the receive interrupt only: DATA reads, STATE's receive
+/// bits, INTSTATUS (the transmitter's DATA writes and STATE.TXFULL are the loop's; the
+/// status bits are write-1-to-clear, so the two sides never undo each other's writes).
+struct UartRx {
     regs: Registers,
 }
 
 impl Uart {
     /// UART0 of the mps2-an386, enabled for transmit and receive at `baud` (8N1), its
-    /// receive interrupt enabled in the UART and the NVIC but masked in the core
-    /// (PRIMASK): it only wakes the core from [`RxWait::wait_for_rx`], no handler runs.
+    /// receive interrupt feeding the receive queue. None if the queue was taken before.
     ///
     /// # Safety
-    /// The caller must be the only owner of UART0 and the only user of interrupts
-    /// (this sets PRIMASK for good).
-    unsafe fn uart0(baud: u32) -> Uart {
-        let mut uart = Uart {
-            regs: Registers { base: UART0_BASE },
-        };
+    /// The caller must be the only owner of UART0.
+    unsafe fn uart0(baud: u32) -> Option<Uart> {
+        let mut tx = Registers { base: UART0_BASE };
         // The divider must be at least 16 (QEMU ignores smaller values).
         let div = (PCLK_HZ / baud.max(1)).max(16);
-        uart.regs.write(uart_reg::BAUDDIV, div);
-        cortex_m::interrupt::disable();
-        uart.regs.write(
+        tx.write(uart_reg::BAUDDIV, div);
+        tx.write(
             uart_reg::CTRL,
             uart_reg::CTRL_TX_EN | uart_reg::CTRL_RX_EN | uart_reg::CTRL_RX_INTEN,
         );
-        cortex_m::peripheral::NVIC::unpend(Uart0Rx);
-        // SAFETY: PRIMASK is set, so unmasking the line cannot run a handler or break
-        // a critical section.
-        unsafe { cortex_m::peripheral::NVIC::unmask(Uart0Rx) };
-        uart
+        let receiver = UartRx {
+            regs: Registers { base: UART0_BASE },
+        };
+        let rx = rx::start(&RX, receiver, Uart0Rx)?;
+        Some(Uart { tx, rx })
     }
 }
 
 impl ErrorType for Uart {
-    type Error = ErrorKind;
+    type Error = LinkError;
 }
 
 impl Read<u8> for Uart {
+    fn read(&mut self) -> nb::Result<u8, LinkError> {
+        self.rx.read()
+    }
+}
+
+impl Write<u8> for Uart {
+    fn write(&mut self, byte: u8) -> nb::Result<(), LinkError> {
+        self.flush()?;
+        self.tx.write(uart_reg::DATA, u32::from(byte));
+        Ok(())
+    }
+
+    /// Done when the one-byte transmit buffer is empty.
+    fn flush(&mut self) -> nb::Result<(), LinkError> {
+        if self.tx.read(uart_reg::STATE) & uart_reg::STATE_TX_FULL == 0 {
+            Ok(())
+        } else {
+            Err(nb::Error::WouldBlock)
+        }
+    }
+}
+
+impl RxWait for Uart {
+    fn wait_for_rx(&mut self) {
+        self.rx.wait();
+    }
+}
+
+impl ErrorType for UartRx {
+    type Error = ErrorKind;
+}
+
+impl Read<u8> for UartRx {
     /// The received byte; an overrun (a byte lost because the previous one was not read
     /// in time: never under QEMU, whose UART is flow-controlled) is reported once, then
-    /// the byte that is there is read.
+    /// the byte that is there is read. The receive interrupt's status is cleared first,
+    /// so a byte that arrives after this read raises it again.
     fn read(&mut self) -> nb::Result<u8, ErrorKind> {
+        self.regs.write(uart_reg::INTSTATUS, uart_reg::INT_RX);
         let state = self.regs.read(uart_reg::STATE);
         if state & uart_reg::STATE_RX_OVERRUN != 0 {
             self.regs.write(uart_reg::STATE, uart_reg::STATE_RX_OVERRUN);
@@ -172,38 +234,6 @@ impl Read<u8> for Uart {
             return Err(nb::Error::WouldBlock);
         }
         Ok(self.regs.read(uart_reg::DATA) as u8)
-    }
-}
-
-impl Write<u8> for Uart {
-    fn write(&mut self, byte: u8) -> nb::Result<(), ErrorKind> {
-        self.flush()?;
-        self.regs.write(uart_reg::DATA, u32::from(byte));
-        Ok(())
-    }
-
-    /// Done when the one-byte transmit buffer is empty.
-    fn flush(&mut self) -> nb::Result<(), ErrorKind> {
-        if self.regs.read(uart_reg::STATE) & uart_reg::STATE_TX_FULL == 0 {
-            Ok(())
-        } else {
-            Err(nb::Error::WouldBlock)
-        }
-    }
-}
-
-impl RxWait for Uart {
-    /// Sleeps (WFI) until the receive interrupt is pending. The order makes a lost
-    /// wake-up impossible: the pending bit and the UART's interrupt line are cleared
-    /// first, then RXFULL is checked, so a byte that arrived before the check is seen
-    /// there and one that arrives after it raises the line again and ends the WFI.
-    /// (WFI wakes on a pending interrupt even with PRIMASK set.)
-    fn wait_for_rx(&mut self) {
-        cortex_m::peripheral::NVIC::unpend(Uart0Rx);
-        self.regs.write(uart_reg::INTSTATUS, uart_reg::INT_RX);
-        if self.regs.read(uart_reg::STATE) & uart_reg::STATE_RX_FULL == 0 {
-            cortex_m::asm::wfi();
-        }
     }
 }
 

@@ -7,8 +7,9 @@
 //!   run the PLL from a crystal so that a timer counts the scene's 10 MHz line clock
 //!   exactly.
 //! - Link: USART1 on PA9 (TX) and PA10 (RX), 115 200 Bd 8N1, through the HAL's
-//!   `embedded-hal-nb` serial port. Its receive interrupt (RXNE) is enabled in the
-//!   USART and the NVIC but masked by PRIMASK: it only ends the loop's WFI.
+//!   `embedded-hal-nb` serial port, split: the receive interrupt (RXNE) reads the
+//!   receiver into the queue of [`crate::rx`], the loop takes the bytes from there and
+//!   keeps the transmitter.
 //! - Line clock: TIM2 (32-bit) counting the timer clock (PSC 0), segment 0's period in
 //!   its auto-reload register with preload (ARPE), so a new period starts at the end of
 //!   the current line, never in the middle of one.
@@ -21,16 +22,17 @@
 //! tree: ARR and PSC write and read back (the register path), the rates do not match
 //! the HSI's (the TIM5 "microseconds" run 62.5 times fast).
 
-use embedded_hal_nb::serial::{ErrorType, Read, Write};
-use stm32f4xx_hal::pac::{self, Interrupt, NVIC};
+use embedded_hal_nb::serial::{Error as _, ErrorType, Read, Write};
+use stm32f4xx_hal::pac::{self, interrupt, Interrupt};
 use stm32f4xx_hal::prelude::*;
-use stm32f4xx_hal::serial::{self, Event, RxISR, Serial};
+use stm32f4xx_hal::serial::{Event, Rx, Serial, Tx};
 use stm32f4xx_hal::timer::{CounterUs, Timer};
 use stm32f4xx_hal::Listen;
 
 use super::{BoardError, Extended, Monotonic, Parts, LINK_BAUD};
 use crate::line_clock::ReloadRegister;
-use crate::link::RxWait;
+use crate::link::{LinkError, RxWait};
+use crate::rx::{self, RxQueue};
 
 /// The board's name (the cargo feature).
 pub const NAME: &str = "stm32f405";
@@ -41,8 +43,16 @@ pub type Link = Usart1;
 pub type LineClock = Tim2Reload;
 pub type Clock = Tim5Clock;
 
-/// Brings the board up: HSI clocks, USART1 at 115 200 Bd with its receive interrupt as a
-/// wake-up source, TIM2 stopped until its first period, TIM5 counting. Call once.
+/// The receive interrupt's state: USART1's receiver and the queue's producer.
+static RX: rx::Handler<Rx<pac::USART1, u8>, Interrupt> = rx::Handler::new();
+
+#[interrupt]
+fn USART1() {
+    RX.run();
+}
+
+/// Brings the board up: HSI clocks, USART1 at 115 200 Bd, its receive interrupt feeding
+/// the receive queue, TIM2 stopped until its first period, TIM5 counting. Call once.
 pub fn take() -> Result<Parts<Link, LineClock, Clock>, BoardError> {
     let dp = pac::Peripherals::take().ok_or(BoardError::Taken)?;
     // The clocks as reset leaves them: HSI 16 MHz, every bus undivided (`freeze` would
@@ -53,16 +63,13 @@ pub fn take() -> Result<Parts<Link, LineClock, Clock>, BoardError> {
         .USART1
         .serial(
             (gpioa.pa9, gpioa.pa10),
-            serial::Config::default().baudrate(LINK_BAUD.bps()),
+            stm32f4xx_hal::serial::Config::default().baudrate(LINK_BAUD.bps()),
             &mut rcc,
         )
         .map_err(|_| BoardError::SerialConfig)?;
-    cortex_m::interrupt::disable();
     serial.listen(Event::RxNotEmpty);
-    NVIC::unpend(Interrupt::USART1);
-    // SAFETY: PRIMASK is set (above) and stays set, so unmasking the line cannot run a
-    // handler or break a critical section: it only wakes the core from WFI.
-    unsafe { NVIC::unmask(Interrupt::USART1) };
+    let (tx, receiver) = serial.split();
+    let rx = rx::start(&RX, receiver, Interrupt::USART1).ok_or(BoardError::Taken)?;
 
     let timer_clock_hz = rcc.clocks.timclk1().raw();
     let tim2 = Timer::new(dp.TIM2, &mut rcc).release();
@@ -77,7 +84,7 @@ pub fn take() -> Result<Parts<Link, LineClock, Clock>, BoardError> {
     let ticks = Extended::new(u64::from(u32::MAX), tim5.now().ticks());
 
     Ok(Parts {
-        link: Usart1 { serial },
+        link: Usart1 { tx, rx },
         line_clock: Tim2Reload { tim: tim2 },
         clock: Tim5Clock {
             counter: tim5,
@@ -87,39 +94,39 @@ pub fn take() -> Result<Parts<Link, LineClock, Clock>, BoardError> {
     })
 }
 
-/// USART1 as the HAL's serial port, with the receive interrupt as a wake-up.
+/// USART1, the loop's side: the HAL's transmitter, and the receive queue the interrupt
+/// fills.
 pub struct Usart1 {
-    serial: Serial<pac::USART1, u8>,
+    tx: Tx<pac::USART1, u8>,
+    rx: RxQueue<Interrupt>,
 }
 
 impl ErrorType for Usart1 {
-    type Error = serial::Error;
+    type Error = LinkError;
 }
 
 impl Read<u8> for Usart1 {
-    fn read(&mut self) -> nb::Result<u8, serial::Error> {
-        self.serial.read()
+    fn read(&mut self) -> nb::Result<u8, LinkError> {
+        self.rx.read()
     }
 }
 
 impl Write<u8> for Usart1 {
-    fn write(&mut self, byte: u8) -> nb::Result<(), serial::Error> {
-        self.serial.write(byte)
+    fn write(&mut self, byte: u8) -> nb::Result<(), LinkError> {
+        self.tx
+            .write(byte)
+            .map_err(|e| e.map(|e| LinkError::from_kind(e.kind())))
     }
-    fn flush(&mut self) -> nb::Result<(), serial::Error> {
-        self.serial.flush()
+    fn flush(&mut self) -> nb::Result<(), LinkError> {
+        self.tx
+            .flush()
+            .map_err(|e| e.map(|e| LinkError::from_kind(e.kind())))
     }
 }
 
 impl RxWait for Usart1 {
-    /// Sleeps (WFI) until USART1's interrupt is pending. As on the mps2: the pending bit
-    /// is cleared first, then RXNE is checked, so a byte that arrived before the check is
-    /// seen there and one that arrives after it pends the interrupt and ends the WFI.
     fn wait_for_rx(&mut self) {
-        NVIC::unpend(Interrupt::USART1);
-        if !self.serial.is_rx_not_empty() {
-            cortex_m::asm::wfi();
-        }
+        self.rx.wait();
     }
 }
 
