@@ -58,8 +58,10 @@ pub struct SegmentPlan {
     /// (`core_math::General::row_motion`).
     pub row: GeneralRow<f32>,
     pub samples: Vec<Sample, MAX_SAMPLES>,
-    /// The segment's centre pixel (its drift is reported there): its p2 on the row, and
-    /// its pixel constants for the steered residual (`General::motion_yawed`).
+    /// The segment's centre pixel (its drift is reported there): its p2 on the row (a
+    /// copy of `centre.u_m[1]`, kept apart because the update's code reads it 30
+    /// instructions cheaper: `cargo xtask bench`), and its pixel constants for the
+    /// steered residual (`General::motion_yawed`).
     pub centre_p2_m: f32,
     pub centre: GeneralPixel<f32>,
     /// Relative error allowed on the segment's velocity extremes.
@@ -304,6 +306,8 @@ impl Plan {
                 // Rounded to whole pixels; the ends are exact.
                 let n = libm::round(f64::from(spec.first_px) + spacing * j as f64) as i32;
                 // Checked like any pixel: the row form then needs no check of its own.
+                // (`focal_plane_m` alone checks the same but, inlined, costs 280 bytes of
+                // flash more: `cargo xtask size`.)
                 GENERAL_F32
                     .pixel(&camera, f64::from(n))
                     .map_err(|_| Fault::InvalidScene)?;

@@ -238,8 +238,8 @@ impl<T: Real> GeneralUpdate<T> {
     /// The update of the same instant with the camera turned by a further yaw `delta`
     /// (given by its sine and cosine): A becomes A Rz(delta), a turn about the boresight
     /// z_B, so every B-frame vector turns by Rz(delta)^T and nothing else changes (the
-    /// attitude rates' part w_A turns with them). Exact, and the cost of the yaw
-    /// steering request's residual drifts (no second update).
+    /// attitude rates' part w_A turns with them). Exact; the independent route that
+    /// [`General::motion_yawed`], the controller's, is tested against.
     pub fn yawed(&self, sin_delta: T, cos_delta: T) -> GeneralUpdate<T> {
         let turn = |x: [T; 3]| {
             [
