@@ -12,14 +12,14 @@
 //! refused computation leaves that segment's last good period in force, and nothing
 //! outside the physically possible period range is ever written.
 
-use core_math::earth::{Attitude, GeneralRowMotion, GeneralUpdate};
+use core_math::earth::{Attitude, GeneralUpdate};
 use core_math::ImageMotion;
 use core_math::{nearest_ticks, sinc, Backend, Ellipsoid, Real, GENERAL_F32};
 
 use crate::fault::{Counters, Fault};
 use crate::frame::{kind, Frame};
 use crate::nav::{attitude_at, Nav, Propagator};
-use crate::plan::{Plan, Sample, SegmentPlan, MAX_SPEED2_RATIO, MIN_SPEED2_RATIO};
+use crate::plan::{Plan, SegmentPlan, MAX_SPEED2_RATIO, MIN_SPEED2_RATIO};
 use crate::scene::{AttitudeEnvelope, Scene, Terrain, MAX_SEGMENTS};
 
 /// The Earth of the model: WGS 84, a = 6 378 137 m, f = 1/298.257223563.
@@ -482,7 +482,7 @@ impl Controller {
         let dt_us = (t_us as i64).wrapping_sub(nav.time_us as i64);
         let dt_s = match i32::try_from(dt_us) {
             Ok(dt) => dt as f32,
-            Err(_) => dt_us as f32,
+            Err(_) => i64_to_f32(dt_us),
         } * 1e-6;
         let state = nav.propagator.parts_at(dt_s);
         let attitude = attitude_at(&nav.attitude, dt_s);
@@ -588,20 +588,19 @@ impl Controller {
         // the camera); towards +P1 is the reversed transfer.
         // The samples and the centre lie on the segment's row: its constants once, then
         // about twenty operations a pixel.
-        let row = GENERAL_F32.row_motion(update, &seg.row);
-        let centre = row.motion_at(seg.centre_p2_m)?;
+        let Extremes {
+            centre,
+            lo,
+            hi,
+            drift_v2,
+            drift_v1,
+        } = extremes(update, seg)?;
         let reversed = centre.v1_mps > 0.0;
         let tan_centre = centre.v2_mps / centre.v1_mps;
         // v1's extremes are tracked signed, and its sign checked once after the loop;
         // the largest |v2/v1| as the pair (|v2|, |v1|) that gives it, compared by
         // cross-multiplying (|v1| > 0): one division at the end, not one a pixel. The loop
         // keeps no error exit of its own, so none of the exit's work is hoisted into it.
-        let Extremes {
-            lo,
-            hi,
-            drift_v2,
-            drift_v1,
-        } = extremes(&row, &seg.samples, centre)?;
         // Every sample must move the same way as the centre (one transfer direction per
         // segment).
         let (v_min, v_max) = if reversed { (lo, hi) } else { (-hi, -lo) };
@@ -669,37 +668,50 @@ impl Controller {
     }
 }
 
+/// `x as f32` out of line: inline, LLVM evaluated it (a 37-instruction software call)
+/// beside the one-instruction i32 conversion on every update, then picked one.
+#[cold]
+#[inline(never)]
+fn i64_to_f32(x: i64) -> f32 {
+    x as f32
+}
+
 /// What a segment's samples show: v1's signed extremes, and the (|v2|, |v1|) of the
 /// largest |v2/v1| over the samples and the centre.
 struct Extremes {
+    centre: ImageMotion<f32>,
     lo: f32,
     hi: f32,
     drift_v2: f32,
     drift_v1: f32,
 }
 
-/// The samples' [`Extremes`], the centre's drift included.
+/// The segment's row at this update, its centre, and the samples' [`Extremes`] (the
+/// centre's drift included).
 ///
 /// Its own function, never inlined: the loop's square root is a call
 /// (`core_math::sqrt`), which clobbers s0-s15; inlined into `segment`, whose values
 /// then live across it, every sample reloaded a dozen of them (68 instructions a sample,
-/// `cargo xtask bench --profile`). Here the row's constants and the running extremes fit
-/// the callee-saved s16-s31.
+/// `cargo xtask bench --profile`). Here the row's constants and the running extremes
+/// nearly fit the callee-saved s16-s31 (four reloads a sample). The row is formed here
+/// from the update in memory: formed by the caller and passed by reference, its 16
+/// constants went through the stack (190 instructions an update). Keeping the ground's
+/// update in one place in memory, or the steered centre in here too, cost more (300 and
+/// 600 instructions: LLVM then reloads the update's values across the calls).
 #[inline(never)]
-fn extremes(
-    row: &GeneralRowMotion<f32>,
-    samples: &[Sample],
-    centre: ImageMotion<f32>,
-) -> Result<Extremes, Fault> {
+fn extremes(update: &GeneralUpdate<f32>, seg: &SegmentPlan) -> Result<Extremes, Fault> {
+    let row = GENERAL_F32.row_motion(update, &seg.row);
+    let centre = row.motion_at(seg.centre_p2_m)?;
     // Comparisons, not f32::min/max: those are software calls on this core
     // (fminf/fmaxf, NaN handling). `motion_at` refuses a NaN v1.
     let mut e = Extremes {
+        centre,
         lo: f32::INFINITY,
         hi: f32::NEG_INFINITY,
         drift_v2: centre.v2_mps.abs(),
         drift_v1: centre.v1_mps.abs(),
     };
-    for sample in samples {
+    for sample in &seg.samples {
         let m = row.motion_at(sample.p2_m)?;
         if m.v1_mps < e.lo {
             e.lo = m.v1_mps;
