@@ -518,24 +518,27 @@ impl Controller {
         // Output slots by `get` (`index` < MAX_SEGMENTS by construction of the plan): no
         // panic path (docs/no-panic.md).
         // Segments over the same ground height share its update: made once per height
-        // in a row (a flat scene makes one, terrain one per segment).
-        let mut ground: Option<(f32, GeneralUpdate<f32>)> = None;
+        // in a row (a flat scene makes one, terrain one per segment). It stays in one
+        // place in memory, which the segment's out-of-line parts read.
+        let mut ground_h_m = f32::NAN;
+        let mut ground: Result<GeneralUpdate<f32>, Fault> = Err(Fault::OutOfRange);
         for k in 0..self.plan.segments.len() {
             let Some(seg) = self.plan.segments.get(k) else {
                 break;
             };
             let index = seg.index;
             let height_m = self.height(index);
-            let update = match ground {
-                Some((h, u)) if h == height_m => Ok(u),
-                _ => GENERAL_F32.ground(&instant, &EARTH, height_m),
-            };
-            if let Ok(u) = update {
-                ground = Some((height_m, u));
+            // NaN never equals: the first segment makes the first ground.
+            if height_m != ground_h_m {
+                ground = GENERAL_F32
+                    .ground(&instant, &EARTH, height_m)
+                    .map_err(Fault::from);
+                ground_h_m = height_m;
             }
-            let result = update
-                .map_err(Fault::from)
-                .and_then(|update| self.segment(&update, seg, steer));
+            let result = match &ground {
+                Ok(update) => self.segment(update, seg, steer),
+                Err(f) => Err(*f),
+            };
             let slot = usize::from(index);
             match result {
                 Ok(out) => {
@@ -645,14 +648,15 @@ impl Controller {
             // mismatch, no contrast promised.
             (f32::MAX, 0.0, 0)
         };
-        let drift_rad = drift_angle_rad(tan_centre);
-        let residual_drift_rad = match steer {
+        let tan_residual = match steer {
             Some((sin, cos, _)) => {
-                let m = GENERAL_F32.motion_yawed(update, &seg.centre, sin, cos)?;
-                drift_angle_rad(m.v2_mps / m.v1_mps)
+                let m = steered_centre(update, seg, sin, cos)?;
+                m.v2_mps / m.v1_mps
             }
-            None => drift_rad,
+            None => tan_centre,
         };
+        let [drift_rad, worst_drift_rad, residual_drift_rad] =
+            drift_angles_rad([tan_centre, tan_max, tan_residual]);
         Ok(SegmentOutput {
             index: seg.index,
             ticks,
@@ -660,7 +664,7 @@ impl Controller {
             mtf,
             max_stages,
             drift_rad,
-            worst_drift_rad: drift_angle_rad(tan_max),
+            worst_drift_rad,
             residual_drift_rad,
             reversed,
             held: false,
@@ -727,6 +731,20 @@ fn extremes(update: &GeneralUpdate<f32>, seg: &SegmentPlan) -> Result<Extremes, 
     Ok(e)
 }
 
+/// The segment's centre pixel seen by the camera turned by the yaw request
+/// (`General::motion_yawed`). Out of line, like [`extremes`], so that the ground's update
+/// can stay in memory for both: inlined, its reads of the update had kept the update in
+/// registers, copied to the stack for every segment.
+#[inline(never)]
+fn steered_centre(
+    update: &GeneralUpdate<f32>,
+    seg: &SegmentPlan,
+    sin: f32,
+    cos: f32,
+) -> Result<ImageMotion<f32>, core_math::ModelError> {
+    GENERAL_F32.motion_yawed(update, &seg.centre, sin, cos)
+}
+
 /// Whether `a` and its propagation at its rates `back_s` before and `ahead_s` after its
 /// instant stay inside `env` (linear in time: the ends are the extremes).
 fn inside_envelope(a: &Attitude<f32>, env: &AttitudeEnvelope, back_s: f32, ahead_s: f32) -> bool {
@@ -740,6 +758,14 @@ fn inside_envelope(a: &Attitude<f32>, env: &AttitudeEnvelope, back_s: f32, ahead
     rates.iter().all(|r| r.abs() <= env.max_rate_rad_s)
         && angle_ok(a.roll_rad, a.roll_rate_rad_s, env.max_roll_rad)
         && angle_ok(a.pitch_rad, a.pitch_rate_rad_s, env.max_pitch_rad)
+}
+
+/// A segment's three drift angles from their tangents, out of line: inlined three times
+/// into the segment's code, the arc tangent's reductions cost more registers there than
+/// they saved (`cargo xtask bench`).
+#[inline(never)]
+fn drift_angles_rad(tangents: [f32; 3]) -> [f32; 3] {
+    tangents.map(drift_angle_rad)
 }
 
 /// The drift angle atan(t) (rad) of a drift tangent t = v2/v1: `core_math::trig::atan_f32`
