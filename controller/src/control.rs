@@ -12,7 +12,7 @@
 //! refused computation leaves that segment's last good period in force, and nothing
 //! outside the physically possible period range is ever written.
 
-use core_math::earth::{Attitude, GeneralUpdate};
+use core_math::earth::{Attitude, GeneralRowMotion, GeneralUpdate};
 use core_math::ImageMotion;
 use core_math::{nearest_ticks, sinc, Backend, Ellipsoid, Real, GENERAL_F32};
 
@@ -705,7 +705,32 @@ struct Extremes {
 #[inline(never)]
 fn extremes(update: &GeneralUpdate<f32>, seg: &SegmentPlan) -> Result<Extremes, Fault> {
     let row = GENERAL_F32.row_motion(update, &seg.row);
-    let centre = row.motion_at(seg.centre_p2_m)?;
+    // The samples run from the segment's first pixel to its last, the centre between:
+    // when both ends face the ground, every pixel does, and each one costs one check
+    // instead of three (`GeneralRowMotion::motion_at_facing`: the same results and
+    // errors). Otherwise some pixel misses, and the checked route finds which first.
+    let ends = (seg.samples.first(), seg.samples.last());
+    match ends {
+        (Some(a), Some(b)) if row.faces_ground_over(a.p2_m, b.p2_m) => {
+            sweep(seg, |p2| row.motion_at_facing(p2))
+        }
+        _ => sweep_checked(&row, seg),
+    }
+}
+
+#[cold]
+#[inline(never)]
+fn sweep_checked(row: &GeneralRowMotion<f32>, seg: &SegmentPlan) -> Result<Extremes, Fault> {
+    sweep(seg, |p2| row.motion_at(p2))
+}
+
+/// The centre's motion, then the samples' extremes, by `motion_at`.
+#[inline(always)]
+fn sweep(
+    seg: &SegmentPlan,
+    motion_at: impl Fn(f32) -> Result<ImageMotion<f32>, core_math::ModelError>,
+) -> Result<Extremes, Fault> {
+    let centre = motion_at(seg.centre_p2_m)?;
     // Comparisons, not f32::min/max: those are software calls on this core
     // (fminf/fmaxf, NaN handling). `motion_at` refuses a NaN v1.
     let mut e = Extremes {
@@ -716,7 +741,7 @@ fn extremes(update: &GeneralUpdate<f32>, seg: &SegmentPlan) -> Result<Extremes, 
         drift_v1: centre.v1_mps.abs(),
     };
     for sample in &seg.samples {
-        let m = row.motion_at(sample.p2_m)?;
+        let m = motion_at(sample.p2_m)?;
         if m.v1_mps < e.lo {
             e.lo = m.v1_mps;
         }

@@ -467,4 +467,49 @@ impl<T: Real> GeneralRowMotion<T> {
             v2_mps: c[0] + p2 * (c[1] + c[2] * p2) - (c[3] + c[4] * p2) * q,
         })
     }
+
+    /// Whether every pixel of the row between `p2_a_m` and `p2_b_m` looks towards the
+    /// ground (beta < 0, [`GeneralRowMotion::motion_at`]'s first check): beta is affine in
+    /// p2, and its rounding, fl(beta0 + fl(beta1 p2)), monotone in p2, so the computed
+    /// beta takes its largest value over the interval at one of its ends.
+    #[inline(always)]
+    pub fn faces_ground_over(&self, p2_a_m: T, p2_b_m: T) -> bool {
+        let beta = |p2: T| self.beta[0] + self.beta[1] * p2;
+        beta(p2_a_m) < T::ZERO && beta(p2_b_m) < T::ZERO
+    }
+
+    /// [`GeneralRowMotion::motion_at`] at a pixel of an interval that
+    /// [`GeneralRowMotion::faces_ground_over`] accepted: the same results and the same
+    /// errors for one check instead of three. A negative discriminant makes the square
+    /// root NaN and v1 with it, which the speed check refuses; only then is the error
+    /// told apart (the line of sight misses, or v1 is too slow), as `motion_at` would.
+    #[inline(always)]
+    pub fn motion_at_facing(&self, p2_m: T) -> Result<ImageMotion<T>, ModelError> {
+        let p2 = p2_m;
+        let beta = self.beta[0] + self.beta[1] * p2;
+        let d = &self.disc;
+        let disc = d[0] + p2 * (d[1] + d[2] * p2);
+        let q = disc.sqrt() - beta;
+        let v1 = self.v1[0] + self.v1[1] * p2 - self.v1[2] * q;
+        if !(v1.abs() >= T::from_f64(MIN_V1_MPS)) {
+            return Err(refusal(disc));
+        }
+        let c = &self.v2;
+        Ok(ImageMotion {
+            v1_mps: v1,
+            v2_mps: c[0] + p2 * (c[1] + c[2] * p2) - (c[3] + c[4] * p2) * q,
+        })
+    }
+}
+
+/// Which check of [`GeneralRowMotion::motion_at`] refuses a pixel that faces the ground,
+/// given its discriminant.
+#[cold]
+#[inline(never)]
+fn refusal<T: Real>(disc: T) -> ModelError {
+    if disc >= T::ZERO {
+        ModelError::NoAlongTrackMotion
+    } else {
+        ModelError::LineOfSightMissesEarth
+    }
 }
