@@ -535,6 +535,7 @@ fn a_yawed_update_is_the_update_at_the_turned_yaw() {
 fn the_row_form_is_the_motion_on_the_row() {
     let mut rng = SplitMix64(0x0EA7_2026_1124_0A0E);
     let (mut compared, mut worst64, mut ratio32, mut far32) = (0, 0f64, 0f64, 0f64);
+    let (mut facing_checked, mut facing_refused) = (0, 0);
     for _ in 0..20_000 {
         let Some(c) = rng.earth_case() else { continue };
         let m = margin_deg(&c);
@@ -548,9 +549,31 @@ fn the_row_form_is_the_motion_on_the_row() {
         let row64 = GENERAL_F64
             .row_motion(&u64_, &GENERAL_F64.row(&c.camera).unwrap())
             .motion_at(p2_m);
-        let row32 = GENERAL_F32
-            .row_motion(&u32_, &GENERAL_F32.row(&c.camera).unwrap())
-            .motion_at(p2_m as f32);
+        let rows32 = GENERAL_F32.row_motion(&u32_, &GENERAL_F32.row(&c.camera).unwrap());
+        let row32 = rows32.motion_at(p2_m as f32);
+        // The one-check route, wherever the pixel faces the ground: the same bits and the
+        // same errors, right to the limb.
+        let p2 = p2_m as f32;
+        if rows32.faces_ground_over(p2, p2) {
+            let facing = rows32.motion_at_facing(p2);
+            assert_eq!(
+                facing.map(|m| (m.v1_mps.to_bits(), m.v2_mps.to_bits())),
+                row32.map(|m| (m.v1_mps.to_bits(), m.v2_mps.to_bits())),
+                "{c:?}"
+            );
+            facing_checked += 1;
+            facing_refused += usize::from(facing.is_err());
+        } else {
+            assert_eq!(row32.map(|_| ()), Err(ModelError::LineOfSightMissesEarth));
+        }
+        // Facing the ground at both ends of an interval: at every pixel between.
+        let (a, b) = (p2.min(-p2), p2.max(-p2));
+        if rows32.faces_ground_over(a, b) {
+            for k in 0..=16 {
+                let q = a + (b - a) * k as f32 / 16.0;
+                assert!(rows32.beta[0] + rows32.beta[1] * q < 0.0, "{q} {c:?}");
+            }
+        }
         let direct64 = GENERAL_F64.motion(&u64_, &GENERAL_F64.pixel(&c.camera, c.n_px).unwrap());
         let direct32 = GENERAL_F32.motion(&u32_, &GENERAL_F32.pixel(&c.camera, c.n_px).unwrap());
         if m.abs() < EITHER_DEG {
@@ -596,12 +619,15 @@ fn the_row_form_is_the_motion_on_the_row() {
         compared += 1;
     }
     assert!(compared > 10_000, "only {compared} cases compared");
+    assert!(facing_checked > 10_000, "only {facing_checked} facing");
+    assert!(facing_refused > 0, "no refusal on the one-check route");
     assert!(
         worst64 <= EARTH_F64_REL_TOLERANCE,
         "f64 row vs reference: {worst64:e}"
     );
     println!(
         "row form: {compared} cases, f64 {worst64:.2e}, f32 {far32:.2e} (kappa <= \
-         {EARTH_F32_KAPPA_LIMIT}, >= 1 deg from the limb), f32 err/(kappa u) {ratio32:.2}"
+         {EARTH_F32_KAPPA_LIMIT}, >= 1 deg from the limb), f32 err/(kappa u) {ratio32:.2}; \
+         one-check route {facing_checked} pixels ({facing_refused} refused) as motion_at"
     );
 }
