@@ -13,7 +13,7 @@ const PI: f64 = core::f64::consts::PI;
 /// Taylor coefficients of sin(x)/x in x^2, (-1)^k / (2k+1)!, k = 0..=10. On |x| <= pi the
 /// series truncated after k terms errs by less than its first omitted term,
 /// pi^(2k)/(2k+1)!: after 11 terms 1.2e-11 (f64, with the largest term under 1.7: good to
-/// ~1e-11), after 9 terms 7.3e-9, an eighth of f32's half-ulp of 1 (f32).
+/// ~1e-11). f32 takes [`SINC_MINIMAX_F32`] instead.
 const SINC_TAYLOR: [f64; 11] = [
     1.0,
     -1.0 / 6.0,
@@ -28,8 +28,19 @@ const SINC_TAYLOR: [f64; 11] = [
     1.0 / 51_090_942_171_709_440_000.0,
 ];
 
-/// Terms of [`SINC_TAYLOR`] an f32 evaluation takes (see there).
-const SINC_TERMS_F32: usize = 9;
+/// sin(x)/x on |x| <= pi in f32: the least-largest-error polynomial of degree 6 in x^2,
+/// its coefficients f32 values (`python3 tools/fit_sinc_f32.py` fits them; evaluated in
+/// f32 it errs by 1.7e-7 at most, like 9 terms of [`SINC_TAYLOR`] in f32:
+/// `core-math/tests/mtf_period.rs`). Two multiply-adds fewer than the series.
+const SINC_MINIMAX_F32: [f64; 7] = [
+    1.0,
+    -0.1666666567325592,
+    0.008333321660757065,
+    -0.00019840536697302014,
+    2.7535900244402e-06,
+    -2.4729255088118407e-08,
+    1.361460388871194e-10,
+];
 
 /// sin(x)/x, with sinc(0) = 1: a polynomial on |x| <= pi (no call, no 0/0), sin(x)/x beyond.
 ///
@@ -39,15 +50,15 @@ const SINC_TERMS_F32: usize = 9;
 pub fn sinc<T: Real>(x: T) -> T {
     let pi = T::from_f64(PI);
     if x <= pi && -x <= pi {
-        // A constant per type: 9 terms in f32, 11 in f64.
-        let terms = if T::EPSILON.to_f64() > 1e-10 {
-            SINC_TERMS_F32
+        // A constant per type: the minimax polynomial in f32, the series in f64.
+        let coefficients: &[f64] = if T::EPSILON.to_f64() > 1e-10 {
+            &SINC_MINIMAX_F32
         } else {
-            SINC_TAYLOR.len()
+            &SINC_TAYLOR
         };
         let x2 = x * x;
         let mut acc = T::ZERO;
-        for &c in SINC_TAYLOR[..terms].iter().rev() {
+        for &c in coefficients.iter().rev() {
             acc = acc * x2 + T::from_f64(c);
         }
         acc

@@ -169,12 +169,22 @@ fn scene_kinds() -> Result<(), FirmwareError> {
         pitch_rate_rad_s: -0.2f32.to_radians(),
         yaw_rate_rad_s: 0.05f32.to_radians(),
     };
+    let steered = controller::nav::Attitude {
+        yaw_rad: 3f32.to_radians() + 0.555,
+        ..agile
+    };
     let kinds: [(
         &str,
         &str,
         controller::Scene,
         controller::nav::Attitude<f32>,
-    ); 3] = [
+    ); 4] = [
+        (
+            "scene roll and pitch up to 25 deg, all segments, yaw steered: planned",
+            "scene roll and pitch up to 25 deg, all segments, yaw steered: evaluate everything",
+            all,
+            steered,
+        ),
         (
             "scene nadir only, all segments: planned",
             "scene nadir only, all segments: evaluate everything",
