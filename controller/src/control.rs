@@ -579,6 +579,7 @@ impl Controller {
         }
     }
 
+    #[inline(never)]
     fn segment(
         &self,
         update: &GeneralUpdate<f32>,
@@ -709,7 +710,7 @@ fn extremes(update: &GeneralUpdate<f32>, seg: &SegmentPlan) -> Result<Extremes, 
     // when both ends face the ground, every pixel does, and each one costs one check
     // instead of three (`GeneralRowMotion::motion_at_facing`: the same results and
     // errors). Otherwise some pixel misses, and the checked route finds which first.
-    let ends = (seg.samples.first(), seg.samples.last());
+    let ends = (seg.samples.get(1), seg.samples.last());
     match ends {
         (Some(a), Some(b)) if row.faces_ground_over(a.p2_m, b.p2_m) => {
             sweep(seg, |p2| row.motion_at_facing(p2))
@@ -724,23 +725,27 @@ fn sweep_checked(row: &GeneralRowMotion<f32>, seg: &SegmentPlan) -> Result<Extre
     sweep(seg, |p2| row.motion_at(p2))
 }
 
-/// The centre's motion, then the samples' extremes, by `motion_at`.
+/// The centre's motion, then the extremes over the centre and the samples, by
+/// `motion_at` (`SegmentPlan::samples`: the centre first).
 #[inline(always)]
 fn sweep(
     seg: &SegmentPlan,
     motion_at: impl Fn(f32) -> Result<ImageMotion<f32>, core_math::ModelError>,
 ) -> Result<Extremes, Fault> {
-    let centre = motion_at(seg.centre_p2_m)?;
+    let Some((first, samples)) = seg.samples.split_first() else {
+        return Err(Fault::InvalidScene);
+    };
+    let centre = motion_at(first.p2_m)?;
     // Comparisons, not f32::min/max: those are software calls on this core
     // (fminf/fmaxf, NaN handling). `motion_at` refuses a NaN v1.
     let mut e = Extremes {
         centre,
-        lo: f32::INFINITY,
-        hi: f32::NEG_INFINITY,
+        lo: centre.v1_mps,
+        hi: centre.v1_mps,
         drift_v2: centre.v2_mps.abs(),
         drift_v1: centre.v1_mps.abs(),
     };
-    for sample in &seg.samples {
+    for sample in samples {
         let m = motion_at(sample.p2_m)?;
         if m.v1_mps < e.lo {
             e.lo = m.v1_mps;

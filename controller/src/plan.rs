@@ -41,8 +41,9 @@ const PROBE_YAWS_RAD: [f64; 3] = [-0.1, 0.0, 0.1];
 /// One sample pixel of a segment.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Sample {
-    /// Pixel offset n.
-    pub px: i32,
+    /// Pixel offset n (a half-integer at the centre of an even count of pixels, any
+    /// value between whole pixels inside the segment).
+    pub px: f32,
     /// Its p2 = n x pixel pitch (m) on the segment's row.
     pub p2_m: f32,
 }
@@ -57,12 +58,13 @@ pub struct SegmentPlan {
     /// on it, so that an update evaluates them by the row form
     /// (`core_math::General::row_motion`).
     pub row: GeneralRow<f32>,
+    /// The pixels evaluated at every update: first the segment's centre (its drift is
+    /// reported there), then the samples, equally spaced from the segment's first pixel
+    /// to its last in ascending order. The middle sample of an odd count is the centre
+    /// itself, not repeated. The centre counts in the extremes like any sample: it is a
+    /// pixel of the segment.
     pub samples: Vec<Sample, MAX_SAMPLES>,
-    /// The segment's centre pixel (its drift is reported there): its p2 on the row (a
-    /// copy of `centre.u_m[1]`, kept apart because the update's code reads it 30
-    /// instructions cheaper: `cargo xtask bench`), and its pixel constants for the
-    /// steered residual (`General::motion_yawed`).
-    pub centre_p2_m: f32,
+    /// The centre's pixel constants, for the steered residual (`General::motion_yawed`).
     pub centre: GeneralPixel<f32>,
     /// Relative error allowed on the segment's velocity extremes.
     pub sampling_budget: f32,
@@ -301,30 +303,36 @@ impl Plan {
                 k += 1;
             }
             let spacing = width / (k - 1) as f64;
+            let (first, last) = (f64::from(spec.first_px), f64::from(spec.last_px));
+            let centre_px = spec.centre_px();
+            // The centre, then the samples (the ends exact); an odd count's middle sample
+            // is the centre.
+            let pixels = core::iter::once(centre_px).chain(
+                (0..k)
+                    .filter(|j| 2 * j + 1 != k)
+                    .map(|j| if j + 1 == k { last } else { first + spacing * j as f64 }),
+            );
             let mut samples = Vec::new();
-            for j in 0..k {
-                // Rounded to whole pixels; the ends are exact.
-                let n = libm::round(f64::from(spec.first_px) + spacing * j as f64) as i32;
+            for n in pixels {
                 // Checked like any pixel: the row form then needs no check of its own.
                 // (`focal_plane_m` alone checks the same but, inlined, costs 280 bytes of
                 // flash more: `cargo xtask size`.)
                 GENERAL_F32
-                    .pixel(&camera, f64::from(n))
+                    .pixel(&camera, n)
                     .map_err(|_| Fault::InvalidScene)?;
-                let p2_m = (f64::from(n) * camera.pixel_m) as f32;
+                let p2_m = (n * camera.pixel_m) as f32;
                 samples
-                    .push(Sample { px: n, p2_m })
+                    .push(Sample { px: n as f32, p2_m })
                     .map_err(|_| Fault::InvalidScene)?;
             }
             let centre = GENERAL_F32
-                .pixel(&camera, spec.centre_px())
+                .pixel(&camera, centre_px)
                 .map_err(|_| Fault::InvalidScene)?;
             let segment = SegmentPlan {
                 index: index as u8,
                 tdi_stages: spec.tdi_stages,
                 row: GENERAL_F32.row(&camera).map_err(|_| Fault::InvalidScene)?,
                 samples,
-                centre_p2_m: centre.u_m[1],
                 centre,
                 sampling_budget: budget as f32,
                 interpolation_mps: error(k) as f32,

@@ -31,7 +31,7 @@ fn the_default_scene_plan() {
     assert_eq!(plan.active().len(), 10);
     for s in plan.active() {
         eprintln!(
-            "segment {}: {} samples, interpolation {:.2e} m/s, bound {:.2e} at the slowest image, budget {:.2e}",
+            "segment {}: {} pixels (the centre and the samples), interpolation {:.2e} m/s, bound {:.2e} at the slowest image, budget {:.2e}",
             s.index, s.samples.len(), s.interpolation_mps, s.sampling_bound, s.sampling_budget
         );
         assert!(s.samples.len() >= 2);
@@ -43,8 +43,30 @@ fn the_default_scene_plan() {
             s.sampling_budget
         );
         let spec = scene.segments[usize::from(s.index)];
-        assert_eq!(s.samples[0].px, spec.first_px);
-        assert_eq!(s.samples.last().unwrap().px, spec.last_px);
+        // The centre first, then the samples from the first pixel to the last, equally
+        // spaced, an odd count's middle one being the centre.
+        assert_eq!(f64::from(s.samples[0].px), spec.centre_px());
+        assert_eq!(s.samples[1].px, spec.first_px as f32);
+        assert_eq!(s.samples.last().unwrap().px, spec.last_px as f32);
+        // Equally spaced from the first pixel to the last: the samples alone (an even
+        // count), or with the centre in the middle (an odd one).
+        let spaced = |xs: &[f64]| {
+            let h = (xs[xs.len() - 1] - xs[0]) / (xs.len() - 1) as f64;
+            xs.iter()
+                .enumerate()
+                .all(|(j, x)| (x - (xs[0] + h * j as f64)).abs() < 4e-3)
+        };
+        let rest: Vec<f64> = s.samples[1..].iter().map(|p| f64::from(p.px)).collect();
+        let mut all = rest.clone();
+        all.push(spec.centre_px());
+        all.sort_by(f64::total_cmp);
+        assert!(
+            (rest.len() % 2 == 0 && spaced(&rest)) || (all.len() % 2 == 1 && spaced(&all)),
+            "segment {}: {:?}",
+            s.index,
+            s.samples
+        );
+        assert!(s.samples[1..].windows(2).all(|w| w[0].px < w[1].px));
     }
 }
 
