@@ -307,11 +307,14 @@ impl Plan {
             let centre_px = spec.centre_px();
             // The centre, then the samples (the ends exact); an odd count's middle sample
             // is the centre.
-            let pixels = core::iter::once(centre_px).chain(
-                (0..k)
-                    .filter(|j| 2 * j + 1 != k)
-                    .map(|j| if j + 1 == k { last } else { first + spacing * j as f64 }),
-            );
+            let pixels =
+                core::iter::once(centre_px).chain((0..k).filter(|j| 2 * j + 1 != k).map(|j| {
+                    if j + 1 == k {
+                        last
+                    } else {
+                        first + spacing * j as f64
+                    }
+                }));
             let mut samples = Vec::new();
             for n in pixels {
                 // Checked like any pixel: the row form then needs no check of its own.

@@ -61,7 +61,8 @@ fn the_default_scene_plan() {
         all.push(spec.centre_px());
         all.sort_by(f64::total_cmp);
         assert!(
-            (rest.len() % 2 == 0 && spaced(&rest)) || (all.len() % 2 == 1 && spaced(&all)),
+            (rest.len().is_multiple_of(2) && spaced(&rest))
+                || (!all.len().is_multiple_of(2) && spaced(&all)),
             "segment {}: {:?}",
             s.index,
             s.samples
