@@ -849,7 +849,10 @@ mod tests {
             }
             assert!(dm >= dc.abs(), "{c} {m}: {dm} < |{dc}|");
         }
-        assert!(worst_err <= 4.0 * f64::from(f32::EPSILON) / 2.0, "{worst_err:e}");
+        assert!(
+            worst_err <= 4.0 * f64::from(f32::EPSILON) / 2.0,
+            "{worst_err:e}"
+        );
         std::eprintln!("drift angles: worst error {worst_err:.2e} rad");
     }
 }
