@@ -635,9 +635,18 @@ impl Controller {
             let worst = if below > above { below } else { above };
             let half_pi_m = core::f32::consts::FRAC_PI_2 * stages as f32;
             // Past the sinc's first zero no contrast is left; its negative lobe is a
-            // phase reversal, not an MTF below 0.
-            let mtf =
-                sinc(half_pi_m * worst).clamp(0.0, 1.0) * sinc(half_pi_m * tan_max).clamp(0.0, 1.0);
+            // phase reversal, not an MTF below 0. Never above 1: the polynomial's
+            // (sinc(x) - 1) / x^2 part is negative on its whole range, and past pi
+            // |sinc| < 1/pi.
+            let contrast = |x: f32| {
+                let s = sinc(x);
+                if s > 0.0 {
+                    s
+                } else {
+                    0.0
+                }
+            };
+            let mtf = contrast(half_pi_m * worst) * contrast(half_pi_m * tan_max);
             let m = self
                 .plan
                 .stage_rule

@@ -75,7 +75,7 @@ fn sinc_beyond_pi<T: Real>(x: T) -> T {
     if !x.is_finite() {
         return T::ZERO;
     }
-    x.sin_cos().0 / x
+    x.sin() / x
 }
 
 /// MTF_mismatch at Nyquist for `stages` TDI stages and a relative mismatch dv/v (Eq. 19).

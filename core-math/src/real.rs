@@ -35,6 +35,11 @@ pub trait Real:
     fn sqrt(self) -> Self;
     /// (sin x, cos x), each within 2 ulp (f32: `trig::sin_cos_f32`, 1.54 ulp measured).
     fn sin_cos(self) -> (Self, Self);
+    /// sin x, the same value as `sin_cos(x).0` (f32: `trig::sin_f32`, one polynomial
+    /// instead of two).
+    fn sin(self) -> Self {
+        self.sin_cos().0
+    }
     fn is_finite(self) -> bool;
     /// |x| (one `vabs.f32` on the target).
     fn abs(self) -> Self;
@@ -132,6 +137,10 @@ impl Real for f32 {
     #[inline(always)]
     fn sin_cos(self) -> (Self, Self) {
         crate::trig::sin_cos_f32(self)
+    }
+    #[inline(always)]
+    fn sin(self) -> Self {
+        crate::trig::sin_f32(self)
     }
     #[inline(always)]
     fn is_finite(self) -> bool {

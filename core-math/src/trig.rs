@@ -19,10 +19,50 @@ const FAST_LIMIT: f32 = 12_800.0;
 /// sin r and cos r for |r| <= pi/4 (Cephes coefficients).
 #[inline(always)]
 fn kernel(r: f32) -> (f32, f32) {
+    (kernel_sin(r), kernel_cos(r))
+}
+
+#[inline(always)]
+fn kernel_sin(r: f32) -> f32 {
     let z = r * r;
-    let s = r + r * z * (-1.666_665_5e-1 + z * (8.332_161e-3 + z * -1.951_529_6e-4));
-    let c = 1.0 - 0.5 * z + z * z * (4.166_664_6e-2 + z * (-1.388_731_6e-3 + z * 2.443_315_7e-5));
-    (s, c)
+    r + r * z * (-1.666_665_5e-1 + z * (8.332_161e-3 + z * -1.951_529_6e-4))
+}
+
+#[inline(always)]
+fn kernel_cos(r: f32) -> f32 {
+    let z = r * r;
+    1.0 - 0.5 * z + z * z * (4.166_664_6e-2 + z * (-1.388_731_6e-3 + z * 2.443_315_7e-5))
+}
+
+/// The nearest quadrant k of x and the remainder r = x - k pi/2 (|x| < [`FAST_LIMIT`]).
+#[inline(always)]
+fn reduce(x: f32) -> (i32, f32) {
+    // Nearest quadrant; `as i32` of a value under 2^13 in magnitude is exact.
+    let q = x * TWO_OVER_PI;
+    let k = (q + if q >= 0.0 { 0.5 } else { -0.5 }) as i32;
+    let kf = k as f32;
+    (k, ((x - kf * P1) - kf * P2) - kf * P3)
+}
+
+/// sin x in f32: `sin_cos_f32(x).0` bit for bit, evaluating only the polynomial its
+/// quadrant needs (the sinc beyond its first zero: the drift smear of an unsteered
+/// camera).
+#[inline(always)]
+pub fn sin_f32(x: f32) -> f32 {
+    if !(x.abs() < FAST_LIMIT) {
+        return sin_cos_huge(x).0;
+    }
+    let (k, r) = reduce(x);
+    let v = if k & 1 == 0 {
+        kernel_sin(r)
+    } else {
+        kernel_cos(r)
+    };
+    if k & 2 == 0 {
+        v
+    } else {
+        -v
+    }
 }
 
 /// (sin x, cos x) in f32.
@@ -35,11 +75,7 @@ pub fn sin_cos_f32(x: f32) -> (f32, f32) {
     if !(x.abs() < FAST_LIMIT) {
         return sin_cos_huge(x);
     }
-    // Nearest quadrant; `as i32` of a value under 2^13 in magnitude is exact.
-    let q = x * TWO_OVER_PI;
-    let k = (q + if q >= 0.0 { 0.5 } else { -0.5 }) as i32;
-    let kf = k as f32;
-    let r = ((x - kf * P1) - kf * P2) - kf * P3;
+    let (k, r) = reduce(x);
     let (s, c) = kernel(r);
     match k & 3 {
         0 => (s, c),
@@ -136,6 +172,21 @@ fn atan_reduced(x: f32) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// `sin_f32` is `sin_cos_f32`'s sine, bit for bit, over every magnitude and sign.
+    #[test]
+    fn sin_alone_is_the_sine_of_sin_cos() {
+        let mut x = 1e-30f32;
+        while x < 1e30 {
+            for v in [x, -x] {
+                assert_eq!(sin_f32(v).to_bits(), sin_cos_f32(v).0.to_bits(), "x = {v:e}");
+            }
+            x = f32::from_bits(x.to_bits() + 7_919);
+        }
+        for v in [0.0f32, -0.0, f32::INFINITY, f32::NAN, 12_800.0, -12_800.0] {
+            assert_eq!(sin_f32(v).to_bits(), sin_cos_f32(v).0.to_bits(), "x = {v:e}");
+        }
+    }
 
     /// The inlined ranges of `atan_f32` give bit for bit what the general reduced form
     /// gives (the accuracy test in `tests/trig.rs` then covers both).

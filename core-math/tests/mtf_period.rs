@@ -21,6 +21,18 @@ fn sinc_polynomial_matches_libm() {
     assert_eq!(sinc(0.0f64), 1.0);
     // Beyond pi the direct quotient is used; check it too.
     assert!((sinc(4.0f64) - libm::sin(4.0) / 4.0).abs() < 1e-15);
+    // Never above 1 in f32 (the controller's MTF clamps only below): every f32 in
+    // [0, pi] near 0 and a dense grid beyond, and the quotient past pi.
+    let mut x = 0.0f32;
+    while x < 1e-3 {
+        assert!(sinc(x) <= 1.0 && sinc(-x) <= 1.0, "{x:e}");
+        x = f32::from_bits(x.to_bits() + 1_009);
+    }
+    for i in 0..=2_000_000 {
+        let x = i as f32 * 1e-5;
+        assert!(sinc(x) <= 1.0, "{x}");
+    }
+    assert_eq!(sinc(0.0f32), 1.0);
 }
 
 #[test]

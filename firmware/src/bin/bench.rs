@@ -134,6 +134,31 @@ fn full_update_region<M: Model, B: Backend<M>>(
     });
 }
 
+/// The update every update period: the one after an earlier update, its instant the one
+/// scheduled (the first after a start or a gap also divides 64-bit time to find it).
+fn steady_update_region(label: &str, c: &mut Controller) -> Result<(), FirmwareError> {
+    update_region_at(label, c, 1_000_000, 1_020_000)
+}
+
+/// The first update after the NAV frame: the same, plus the update instant found by a
+/// 64-bit division.
+fn first_update_region(label: &str, c: &mut Controller) -> Result<(), FirmwareError> {
+    update_region(label, c, 1_020_000)
+}
+
+/// An update at `warm_us` (not measured), then the one at `t_us`.
+fn update_region_at(
+    label: &str,
+    c: &mut Controller,
+    warm_us: u64,
+    t_us: u64,
+) -> Result<(), FirmwareError> {
+    if !c.advance(warm_us, &mut NoRegisters) {
+        return Err(FirmwareError::Telemetry);
+    }
+    update_region(label, c, t_us)
+}
+
 /// One whole controller update (update constants, every planned segment, outputs).
 fn update_region(label: &str, c: &mut Controller, t_us: u64) -> Result<(), FirmwareError> {
     let mut regs = NoRegisters;
@@ -206,10 +231,15 @@ fn scene_kinds() -> Result<(), FirmwareError> {
     ];
     for (planned, everything, scene, attitude) in kinds {
         let mut c = controller_with_nav(scene, false, attitude)?;
-        update_region(planned, &mut c, 1_020_000)?;
+        steady_update_region(planned, &mut c)?;
         let mut c = controller_with_nav(scene, true, attitude)?;
-        update_region(everything, &mut c, 1_020_000)?;
+        steady_update_region(everything, &mut c)?;
     }
+    let mut c = controller_with_nav(all, false, agile)?;
+    first_update_region(
+        "scene roll and pitch up to 25 deg, all segments: planned, the first update after NAV",
+        &mut c,
+    )?;
     Ok(())
 }
 
