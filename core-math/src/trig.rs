@@ -179,12 +179,20 @@ mod tests {
         let mut x = 1e-30f32;
         while x < 1e30 {
             for v in [x, -x] {
-                assert_eq!(sin_f32(v).to_bits(), sin_cos_f32(v).0.to_bits(), "x = {v:e}");
+                assert_eq!(
+                    sin_f32(v).to_bits(),
+                    sin_cos_f32(v).0.to_bits(),
+                    "x = {v:e}"
+                );
             }
             x = f32::from_bits(x.to_bits() + 7_919);
         }
         for v in [0.0f32, -0.0, f32::INFINITY, f32::NAN, 12_800.0, -12_800.0] {
-            assert_eq!(sin_f32(v).to_bits(), sin_cos_f32(v).0.to_bits(), "x = {v:e}");
+            assert_eq!(
+                sin_f32(v).to_bits(),
+                sin_cos_f32(v).0.to_bits(),
+                "x = {v:e}"
+            );
         }
     }
 
