@@ -519,7 +519,7 @@ impl Controller {
         // panic path (docs/no-panic.md).
         // Segments over the same ground height share its update: made once per height
         // in a row (a flat scene makes one, terrain one per segment). It stays in one
-        // place in memory, which the segment's out-of-line parts read.
+        // place in memory, which the out-of-line `segment` and `extremes` read.
         let mut ground_h_m = f32::NAN;
         let mut ground: Result<GeneralUpdate<f32>, Fault> = Err(Fault::OutOfRange);
         for k in 0..self.plan.segments.len() {
@@ -579,6 +579,10 @@ impl Controller {
         }
     }
 
+    /// Out of line, so that the plan's values it reads are loaded where they are used:
+    /// inlined into the update's loop, they were hoisted out of it into registers that
+    /// every call in the segment's work then saved and restored (`cargo xtask bench`:
+    /// with its helpers inlined here, 9 739 instructions an update against 10 656).
     #[inline(never)]
     fn segment(
         &self,
@@ -709,9 +713,9 @@ struct Extremes {
 /// `cargo xtask bench --profile`). Here the row's constants and the running extremes
 /// nearly fit the callee-saved s16-s31 (four reloads a sample). The row is formed here
 /// from the update in memory: formed by the caller and passed by reference, its 16
-/// constants went through the stack (190 instructions an update). Keeping the ground's
-/// update in one place in memory, or the steered centre in here too, cost more (300 and
-/// 600 instructions: LLVM then reloads the update's values across the calls).
+/// constants went through the stack (190 instructions an update). Computing the steered
+/// centre in here too cost 600 instructions more (the update's values reloaded across
+/// the calls).
 #[inline(never)]
 fn extremes(update: &GeneralUpdate<f32>, seg: &SegmentPlan) -> Result<Extremes, Fault> {
     let row = GENERAL_F32.row_motion(update, &seg.row);
@@ -771,10 +775,8 @@ fn sweep(
 }
 
 /// The segment's centre pixel seen by the camera turned by the yaw request
-/// (`General::motion_yawed`). Out of line, like [`extremes`], so that the ground's update
-/// can stay in memory for both: inlined, its reads of the update had kept the update in
-/// registers, copied to the stack for every segment.
-#[inline(never)]
+/// (`General::motion_yawed`).
+#[inline(always)]
 fn steered_centre(
     update: &GeneralUpdate<f32>,
     seg: &SegmentPlan,
@@ -805,10 +807,8 @@ fn inside_envelope(a: &Attitude<f32>, env: &AttitudeEnvelope, back_s: f32, ahead
 /// The worst is the centre's magnitude plus atan of the tangent of their difference,
 /// (tan_max - |t|) / (1 + tan_max |t|): a small tangent, which `atan_f32` takes without
 /// reduction, where the worst drift itself (0.8 rad in a roll slew) needs one; and the
-/// sum is never below the centre's. Out of line: inlined into the segment's code, the
-/// arc tangents' reductions cost more registers there than they saved
-/// (`cargo xtask bench`).
-#[inline(never)]
+/// sum is never below the centre's.
+#[inline(always)]
 fn drift_angles_rad(tan_centre: f32, tan_max: f32, tan_residual: f32) -> [f32; 3] {
     let centre_rad = drift_angle_rad(tan_centre);
     let t = tan_centre.abs();
