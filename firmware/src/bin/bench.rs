@@ -237,7 +237,7 @@ fn scene_kinds() -> Result<(), FirmwareError> {
     }
     let mut c = controller_with_nav(all, false, agile)?;
     first_update_region(
-        "scene roll and pitch up to 25 deg, all segments: planned, the first update after NAV",
+        "scene roll and pitch up to 25 deg, the first update after NAV, all segments: planned",
         &mut c,
     )?;
     Ok(())
