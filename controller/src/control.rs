@@ -837,13 +837,8 @@ mod tests {
     /// within 4 f32 ulp of 1 rad, never below the centre's magnitude.
     #[test]
     fn drift_angles_match_atan() {
-        let mut seed = 0x5EED_2026_1124u64;
-        let mut next = || {
-            seed = seed
-                .wrapping_mul(6_364_136_223_846_793_005)
-                .wrapping_add(1_442_695_040_888_963_407);
-            (seed >> 40) as f64 / (1u64 << 24) as f64
-        };
+        let mut rng = core_math::sample::SplitMix64(0x5EED_2026_1124);
+        let mut next = || rng.uniform(0.0, 1.0);
         let mut worst_err = 0f64;
         for _ in 0..200_000 {
             // Tangents over drifts of 0 to 1.5 rad, either sign.
