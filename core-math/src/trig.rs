@@ -128,10 +128,7 @@ pub fn atan_f32(x: f32) -> f32 {
     }
     if a <= TAN_3PI_8 {
         let r = (a - 1.0) / (a + 1.0);
-        let z = r * r;
-        let p = atan_poly(z) * z * r + r;
-        let p = p + PI_4_LO;
-        return (core::f32::consts::FRAC_PI_4 + p).copysign(x);
+        return atan_from(core::f32::consts::FRAC_PI_4, PI_4_LO, r, x);
     }
     atan_reduced(x)
 }
@@ -162,6 +159,13 @@ fn atan_reduced(x: f32) -> f32 {
     } else {
         (0.0, 0.0, a)
     };
+    atan_from(base, base_lo, r, x)
+}
+
+/// atan x from its reduction: the base angle (an f32 plus its rounding error, added to
+/// the small part first) and the reduced argument r, |r| <= tan(pi/8).
+#[inline(always)]
+fn atan_from(base: f32, base_lo: f32, r: f32, x: f32) -> f32 {
     let z = r * r;
     let p = atan_poly(z) * z * r + r;
     let p = p + base_lo;

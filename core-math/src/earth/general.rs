@@ -443,29 +443,14 @@ pub struct GeneralRowMotion<T> {
 
 impl<T: Real> GeneralRowMotion<T> {
     /// (v1, v2) at the row's pixel p2 (m): [`Backend::motion`] at u = (p1, p2, -f), with
-    /// its checks and errors, rounded differently.
+    /// its checks and errors (a pixel facing away from the ground, a miss, v1 too slow,
+    /// in that order), rounded differently.
     #[inline(always)]
     pub fn motion_at(&self, p2_m: T) -> Result<ImageMotion<T>, ModelError> {
-        let p2 = p2_m;
-        let beta = self.beta[0] + self.beta[1] * p2;
-        if !(beta < T::ZERO) {
+        if !self.faces_ground_over(p2_m, p2_m) {
             return Err(ModelError::LineOfSightMissesEarth);
         }
-        let d = &self.disc;
-        let disc = d[0] + p2 * (d[1] + d[2] * p2);
-        if !(disc >= T::ZERO) {
-            return Err(ModelError::LineOfSightMissesEarth);
-        }
-        let q = disc.sqrt() - beta;
-        let v1 = self.v1[0] + self.v1[1] * p2 - self.v1[2] * q;
-        if !(v1.abs() >= T::from_f64(MIN_V1_MPS)) {
-            return Err(ModelError::NoAlongTrackMotion);
-        }
-        let c = &self.v2;
-        Ok(ImageMotion {
-            v1_mps: v1,
-            v2_mps: c[0] + p2 * (c[1] + c[2] * p2) - (c[3] + c[4] * p2) * q,
-        })
+        self.motion_at_facing(p2_m)
     }
 
     /// Whether every pixel of the row between `p2_a_m` and `p2_b_m` looks towards the

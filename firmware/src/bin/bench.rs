@@ -185,7 +185,9 @@ fn scene_kinds() -> Result<(), FirmwareError> {
     for (k, s) in one.segments.iter_mut().enumerate() {
         s.active = k == 9;
     }
-    // An agile instant: rolled and pitched, yaw steered, every angle moving.
+    // An agile instant: rolled and pitched, every angle moving (a roll slew, the yaw not
+    // steered: drift 0.55 rad at the array centre); `steered` below is the same instant
+    // turned by the controller's yaw request.
     let agile = controller::nav::Attitude {
         roll_rad: 20f32.to_radians(),
         pitch_rad: -10f32.to_radians(),
