@@ -33,6 +33,12 @@ impl Dual {
     }
 }
 
+impl crate::vector::Sqrt for Dual {
+    fn sqrt(self) -> Dual {
+        Dual::sqrt(self)
+    }
+}
+
 impl Add for Dual {
     type Output = Dual;
     fn add(self, o: Dual) -> Dual {

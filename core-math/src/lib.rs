@@ -51,6 +51,7 @@ pub mod reference;
 pub mod sample;
 mod sqrt;
 pub mod trig;
+pub mod vector;
 
 pub use closed_form::ClosedForm;
 #[cfg(feature = "reference")]

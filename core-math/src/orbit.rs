@@ -9,6 +9,7 @@
 //! multiplied by sin(i0) = 0.
 
 use crate::error::{ModelError, Param};
+use crate::vector::{cross, dot};
 
 /// ECI state vector (z along the Earth's spin axis).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -34,18 +35,6 @@ pub struct OrbitState {
     /// Radial velocity over radius, (r . v) / |r|^2 (1/s): zero on a circular orbit; the
     /// round-Earth model of a circular orbit ignores it, so callers can bound it.
     pub radial_rate_per_s: f64,
-}
-
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
 }
 
 /// Largest |r| accepted, m (beyond the Moon: nothing real, and no overflow in |r|^2 |v|).

@@ -2,23 +2,8 @@
 //! period, the circular case, and small steps against the Taylor series.
 
 use core_math::earth::kepler::{Kepler, V3};
+use core_math::vector::{add, cross, dot};
 use core_math::GM_M3_S2;
-
-fn dot(a: V3, b: V3) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-fn add(a: V3, b: V3) -> V3 {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
-}
-
-fn cross(a: V3, b: V3) -> V3 {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
 
 /// Energy and angular momentum are conserved, a full period returns to the start,
 /// and the circular orbit turns at its mean motion.

@@ -38,6 +38,7 @@ use crate::error::ModelError;
 use crate::model::{Backend, ImageMotion};
 use crate::orbit::StateVector;
 use crate::real::Real;
+use crate::vector::dot;
 
 /// The general real-Earth backend in scalar `T` (`f64` or `f32`).
 #[derive(Clone, Copy, Debug, Default)]
@@ -79,13 +80,9 @@ pub struct GeneralUpdate<T> {
     pub v_b_mps: [T; 3],
 }
 
-fn dot3<T: Real>(a: [T; 3], b: [T; 3]) -> T {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
 /// A^T x with A = Rx(roll) Ry(pitch) Rz(yaw) given by its columns.
 fn at_mul<T: Real>(cols: &[[T; 3]; 3], x: [T; 3]) -> [T; 3] {
-    [dot3(cols[0], x), dot3(cols[1], x), dot3(cols[2], x)]
+    [dot(cols[0], x), dot(cols[1], x), dot(cols[2], x)]
 }
 
 /// The height-independent constants of one instant: what [`GeneralUpdate`] holds before
@@ -152,7 +149,7 @@ impl<T: Real> General<T> {
 
         let rn = r2.sqrt();
         // |h| > 0: check_state refused any state with |h|^2 <= 1e-12 |r|^2 |v|^2.
-        let hn = dot3(h, h).sqrt();
+        let hn = dot(h, h).sqrt();
         // n = z in L: x_L,z = (y_L x z_L)_z, y_L,z = h_z/|h|, z_L,z = r_z/|r|.
         let inv_hr = T::ONE / (hn * rn);
         let n_l = [
@@ -164,7 +161,7 @@ impl<T: Real> General<T> {
         // Forward speed |h|/|r| and the orbit rate |h|/|r|^2.
         let v_fwd = hn * inv_r;
         let nu = v_fwd * inv_r;
-        let rdot = dot3(r, v) * inv_r;
+        let rdot = dot(r, v) * inv_r;
         let wr = w * rn;
         let v_l = [v_fwd - wr * n_l[1], wr * n_l[0], rdot];
         let w_l = [-w * n_l[0], nu - w * n_l[1], -w * n_l[2]];
@@ -295,8 +292,8 @@ impl<T: Real> Backend<Earth> for General<T> {
 /// g = c'/s at the pixel u (|u|^2 = `uu`): the near root, then -W x u - V / s.
 #[inline(always)]
 fn g_at<T: Real>(up: &GeneralUpdate<T>, u: [T; 3], uu: T) -> Result<[T; 3], ModelError> {
-    let nu = dot3(up.n_b, u);
-    let beta = dot3(up.rho_b_m, u);
+    let nu = dot(up.n_b, u);
+    let beta = dot(up.rho_b_m, u);
     // Both roots share the sign of -beta (C > 0: the satellite is outside).
     if !(beta < T::ZERO) {
         return Err(ModelError::LineOfSightMissesEarth);

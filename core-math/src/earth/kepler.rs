@@ -24,6 +24,8 @@
 //! error of a few 1e-16 of itself (1e-13 m over the 0.4 s of the model's stencil), not
 //! of |r0|; Newton converges to the last bit of dE (about 1e-20 rad for dE ~ 1e-4).
 
+use crate::vector::dot;
+
 pub type V3 = [f64; 3];
 
 /// An elliptic two-body orbit through a state vector.
@@ -40,10 +42,6 @@ pub struct Kepler {
     /// sigma0 / sqrt(a) = e sin E0 and 1 - r0 / a = e cos E0.
     e_sin: f64,
     e_cos: f64,
-}
-
-fn dot(a: V3, b: V3) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
 /// 1 - cos x without cancellation.

@@ -23,6 +23,7 @@ use crate::error::{ModelError, Param};
 use crate::model::{domain, Model};
 use crate::orbit::StateVector;
 use crate::real::{Real, Scalar};
+use crate::vector::{cross, dot};
 
 pub mod general;
 #[cfg(feature = "reference")]
@@ -200,11 +201,6 @@ fn finite3(x: [f64; 3]) -> bool {
     x.iter().all(|c| c.is_finite())
 }
 
-#[cfg(feature = "reference")]
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
 impl EarthCamera {
     /// Checks the optics and returns the pixel's focal-plane position (p1, p2) (m).
     pub fn focal_plane_m(&self, n_px: f64) -> Result<(f64, f64), ModelError> {
@@ -345,7 +341,6 @@ impl<T: Real> EarthGeometry<T> {
 /// vertical is degenerate for every scalar, so f32 and f64 agree on it). Returns |r|^2
 /// and the angular momentum r x v (never zero after the check).
 pub fn check_state<S: Real>(r: [S; 3], v: [S; 3]) -> Result<(S, [S; 3]), ModelError> {
-    let dot = |a: [S; 3], b: [S; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
     let (r2, v2) = (dot(r, r), dot(v, v));
     // Squared bounds: no square root.
     if !(r2 <= S::from_f64(MAX_POSITION_M * MAX_POSITION_M)) {
@@ -354,11 +349,7 @@ pub fn check_state<S: Real>(r: [S; 3], v: [S; 3]) -> Result<(S, [S; 3]), ModelEr
     if !(v2 <= S::from_f64(MAX_VELOCITY_MPS * MAX_VELOCITY_MPS)) {
         return Err(ModelError::OutOfDomain(Param::Velocity));
     }
-    let h = [
-        r[1] * v[2] - r[2] * v[1],
-        r[2] * v[0] - r[0] * v[2],
-        r[0] * v[1] - r[1] * v[0],
-    ];
+    let h = cross(r, v);
     if !(dot(h, h) > S::from_f64(MIN_SIN2_FLIGHT_PATH) * (r2 * v2)) {
         return Err(ModelError::DegenerateState);
     }
@@ -446,11 +437,7 @@ pub fn limb_margin_rad(
     let ds = [pixel[0], pixel[1], pixel[2] * kappa];
     let rn = libm::sqrt(dot(rs, rs));
     // Angle between -r' and d' by atan2 (accurate at every angle).
-    let cr = [
-        rs[1] * ds[2] - rs[2] * ds[1],
-        rs[2] * ds[0] - rs[0] * ds[2],
-        rs[0] * ds[1] - rs[1] * ds[0],
-    ];
+    let cr = cross(rs, ds);
     let eta = libm::atan2(libm::sqrt(dot(cr, cr)), -dot(rs, ds));
     let limb = libm::asin(ground.eq_m / rn);
     Ok(limb - eta)

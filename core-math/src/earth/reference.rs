@@ -16,6 +16,7 @@ use crate::dual::Dual;
 use crate::earth::{Earth, EarthCamera, EarthGeometry};
 use crate::error::ModelError;
 use crate::model::{Backend, ImageMotion, GM_M3_S2};
+use crate::vector::{cross, unit};
 
 type V3 = [Dual; 3];
 type M3 = [[Dual; 3]; 3];
@@ -46,19 +47,6 @@ pub struct EarthChain {
 
 fn c(x: f64) -> Dual {
     Dual::constant(x)
-}
-
-fn cross(a: V3, b: V3) -> V3 {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-fn unit(a: V3) -> V3 {
-    let n = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
-    [a[0] / n, a[1] / n, a[2] / n]
 }
 
 fn mat_mul(a: &M3, b: &M3) -> M3 {
