@@ -17,11 +17,10 @@
 
 use std::fmt::Write as _;
 
-use core_math::accuracy::{f32_rel_tolerance, limb_margin_rad, F32_V2_TOLERANCE};
-use core_math::{
-    line_period_s, line_period_ticks, mtf_mismatch, Backend, Camera, Geometry, ImageMotion,
-    ModelError, Reference, CLOSED_F32,
-};
+use core_math::sphere::accuracy::{f32_rel_tolerance, limb_margin_rad, F32_V2_TOLERANCE};
+use core_math::sphere::speed_line_period_s;
+use core_math::sphere::{Geometry, Reference, CLOSED_F32};
+use core_math::{line_period_ticks, mtf_mismatch, Backend, Camera, ImageMotion, ModelError};
 
 /// The paper's camera and orbit (the firmware's default scene).
 const FOCAL_M: f64 = 0.555;
@@ -241,7 +240,7 @@ fn host_f32_motion(c: &MotionCase) -> String {
     match m {
         Ok(m) => {
             let speed = m.speed_mps();
-            let period = line_period_s(PIXEL_M as f32, speed);
+            let period = speed_line_period_s(PIXEL_M as f32, speed);
             let ticks = period.and_then(|p| line_period_ticks(p, LINE_CLOCK_HZ as f32));
             let period_src = match period {
                 Ok(p) => format!("Ok({})", f32_src(p)),

@@ -1,29 +1,15 @@
-//! TDI line period: the time the image takes to cross one pixel, in seconds and in
-//! ticks of the line-clock counter.
+//! TDI line period: the time the image takes to cross one pixel along the transfer
+//! direction, in seconds and in ticks of the line-clock counter.
 
 use crate::error::{ModelError, Param};
+use crate::model::ImageMotion;
 use crate::real::Real;
 
-/// Line period A / |v_P| (s).
-pub fn line_period_s<T: Real>(pixel_m: T, speed_mps: T) -> Result<T, ModelError> {
-    if !pixel_m.is_finite() {
-        return Err(ModelError::NonFinite(Param::PixelPitch));
-    }
-    if !(pixel_m > T::ZERO) {
-        return Err(ModelError::NonPositivePixelPitch);
-    }
-    if !(speed_mps > T::ZERO) {
-        return Err(ModelError::NoImageMotion);
-    }
-    let t = pixel_m / speed_mps;
-    if !t.is_finite() {
-        return Err(ModelError::NoImageMotion);
-    }
-    // An infinite speed, or one so large the quotient underflows: no period to clock.
-    if !(t > T::ZERO) {
-        return Err(ModelError::LinePeriodOutOfRange);
-    }
-    Ok(t)
+/// Line period (s) from the image motion: the charge moves along P1, so the line rate
+/// follows v1 (EARTH-MODEL.md, derived outputs): `pixel_m / |v1|`. The period the
+/// controller clocks; the caller has checked that |v1| is not 0.
+pub fn line_period_s<T: Real>(pixel_m: T, motion: &ImageMotion<T>) -> T {
+    pixel_m / motion.v1_mps.abs()
 }
 
 /// A line period as a whole number of clock ticks.

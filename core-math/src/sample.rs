@@ -2,8 +2,9 @@
 //! (the error report's, the tests') is the same on any machine.
 
 use crate::earth::{Attitude, EarthCamera, EarthGeometry, Ellipsoid};
-use crate::model::{Camera, Geometry};
 use crate::orbit::StateVector;
+#[cfg(feature = "sphere")]
+use crate::{model::Camera, sphere::Geometry};
 
 pub struct SplitMix64(pub u64);
 
@@ -20,7 +21,10 @@ impl SplitMix64 {
     pub fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
         lo + (hi - lo) * ((self.next_u64() >> 11) as f64 / (1u64 << 53) as f64)
     }
+}
 
+#[cfg(feature = "sphere")]
+impl SplitMix64 {
     /// A circular-orbit geometry drawn uniformly over the envelope the error report and
     /// the tests share: roll within +/-45 deg, inclination 0-180 deg, argument of
     /// latitude 0-360 deg, altitude 200-2000 km, R = 6 371 km; rounded to f32 and

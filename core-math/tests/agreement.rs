@@ -3,11 +3,11 @@
 //! inclination and argument of latitude, lines of sight from nadir to 1e-6 rad short
 //! of the limb on either side, several optics.
 
-use core_math::accuracy::{f64_rel_tolerance, F32_REL_TOLERANCE, F32_V2_TOLERANCE};
-use core_math::{
-    Backend, Camera, Geometry, MicroF32, NaiveF32, Reference, CLOSED_F32, CLOSED_F64,
-    CLOSED_MICROMATH,
+use core_math::sphere::accuracy::{f64_rel_tolerance, F32_REL_TOLERANCE, F32_V2_TOLERANCE};
+use core_math::sphere::{
+    Geometry, MicroF32, NaiveF32, Reference, CLOSED_F32, CLOSED_F64, CLOSED_MICROMATH,
 };
+use core_math::{Backend, Camera};
 use proptest::prelude::*;
 
 #[derive(Clone, Copy, Debug)]

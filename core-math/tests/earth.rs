@@ -3,14 +3,16 @@
 //! form, and the typed errors of `shared/EARTH-MODEL.md` on every backend.
 
 use core_math::accuracy::{
-    earth_kappa, f64_rel_tolerance, EARTH_F32_KAPPA_C, EARTH_F32_KAPPA_LIMIT,
-    EARTH_F32_NEAR_LIMB_TOLERANCE, EARTH_F32_REL_TOLERANCE, EARTH_F64_REL_TOLERANCE,
+    earth_kappa, EARTH_F32_KAPPA_C, EARTH_F32_KAPPA_LIMIT, EARTH_F32_NEAR_LIMB_TOLERANCE,
+    EARTH_F32_REL_TOLERANCE, EARTH_F64_REL_TOLERANCE,
 };
-use core_math::earth::{from_sphere, limb_margin_rad, Attitude, EarthCamera, EarthGeometry};
+use core_math::earth::{limb_margin_rad, Attitude, EarthCamera, EarthGeometry};
 use core_math::sample::{EarthCase, SplitMix64};
+use core_math::sphere::accuracy::f64_rel_tolerance;
+use core_math::sphere::CLOSED_F64;
 use core_math::{
     Backend, Camera, Earth, EarthReference, Ellipsoid, ImageMotion, ModelError, Param, StateVector,
-    CLOSED_F64, GENERAL_F32, GENERAL_F64,
+    GENERAL_F32, GENERAL_F64,
 };
 
 /// Draws of the envelope per test (about 0.1 s of evaluation each).
@@ -149,15 +151,15 @@ fn general_reduces_to_the_round_earth_closed_form() {
         // The sampler rounds every field to f32; the orbit rate must be the circular one
         // of the rounded altitude for the two models to describe the same orbit.
         let r = rng.envelope_geometry();
-        let g = core_math::Geometry {
-            orbit_rate_rad_s: core_math::orbital_rate_rad_s(r.earth_radius_m, r.altitude_m),
+        let g = core_math::sphere::Geometry {
+            orbit_rate_rad_s: core_math::sphere::orbital_rate_rad_s(r.earth_radius_m, r.altitude_m),
             ..r
         };
         let Some(n_px) = rng.envelope_pixel(&g, &camera) else {
             continue;
         };
         let sphere = CLOSED_F64.evaluate(&camera, &g, n_px);
-        let general = GENERAL_F64.evaluate(&earth_camera, &from_sphere(&g), n_px);
+        let general = GENERAL_F64.evaluate(&earth_camera, &g.to_earth(), n_px);
         match (sphere, general) {
             (Ok(s), Ok(e)) => {
                 let d = rel(&e, &s);

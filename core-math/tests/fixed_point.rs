@@ -11,11 +11,10 @@
 
 mod common;
 
-use core_math::accuracy::limb_margin_rad;
-use core_math::fixed_point::{geometry_from_f64, motion_to_f64};
-use core_math::{
-    Backend, Camera, FixedReal, Geometry, ImageMotion, ModelError, Param, Reference, FIXED,
-};
+use core_math::sphere::accuracy::limb_margin_rad;
+use core_math::sphere::fixed_point::{geometry_from_f64, motion_to_f64};
+use core_math::sphere::{FixedReal, Geometry, Reference, FIXED};
+use core_math::{Backend, Camera, ImageMotion, ModelError, Param};
 use proptest::prelude::*;
 
 /// Relative error of |v_P| and v1, and error of v2 over |v_P|, accepted anywhere in the

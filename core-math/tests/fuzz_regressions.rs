@@ -1,9 +1,8 @@
 //! The findings of the fuzzers (docs/fuzzing.md, F1-F5), each kept as a test.
 
-use core_math::{
-    line_period_s, mtf_mismatch, Backend, Camera, Geometry, ModelError, Reference, StageRule,
-    CLOSED_F32, CLOSED_F64,
-};
+use core_math::sphere::speed_line_period_s;
+use core_math::sphere::{Geometry, Reference, CLOSED_F32, CLOSED_F64};
+use core_math::{mtf_mismatch, Backend, Camera, ModelError, StageRule};
 use std::f64::consts::TAU;
 
 /// F1: an overflowing sinc argument gave NaN; the limit is 0.
@@ -21,15 +20,15 @@ fn f1_mtf_of_an_overflowing_argument_is_zero_not_nan() {
 #[test]
 fn f2_no_zero_line_period() {
     assert_eq!(
-        line_period_s(13e-6, f64::INFINITY),
+        speed_line_period_s(13e-6, f64::INFINITY),
         Err(ModelError::LinePeriodOutOfRange)
     );
     assert_eq!(
-        line_period_s(13e-6f32, f32::INFINITY),
+        speed_line_period_s(13e-6f32, f32::INFINITY),
         Err(ModelError::LinePeriodOutOfRange)
     );
     assert_eq!(
-        line_period_s::<f64>(1e-300, 1e300),
+        speed_line_period_s::<f64>(1e-300, 1e300),
         Err(ModelError::LinePeriodOutOfRange)
     );
 }

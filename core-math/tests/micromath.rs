@@ -11,7 +11,8 @@
 //! asserted is 5 x 0.002. Measured: 2.8e-3 (`cargo xtask report`, 200 000 cases).
 
 use core_math::sample::SplitMix64 as Rng;
-use core_math::{Backend, Camera, MicroF32, Reference, CLOSED_MICROMATH};
+use core_math::sphere::{MicroF32, Reference, CLOSED_MICROMATH};
+use core_math::{Backend, Camera};
 
 const CAMERA: Camera = Camera {
     focal_m: 0.555,
@@ -30,7 +31,7 @@ fn micromath_variant_stays_within_its_documented_error() {
             libm::tan(rng.uniform(-40.0, 40.0).to_radians()) * CAMERA.focal_m / CAMERA.pixel_m;
         // At least 1 deg from the limb, where a sin/cos off by 0.002 cannot move the
         // line of sight off the Earth.
-        let Ok(margin) = core_math::accuracy::limb_margin_rad(&CAMERA, &g, n_px) else {
+        let Ok(margin) = core_math::sphere::accuracy::limb_margin_rad(&CAMERA, &g, n_px) else {
             continue;
         };
         if margin < 1f64.to_radians() {

@@ -1,9 +1,8 @@
 //! MTF_mismatch, the TDI stage limit and the line period, each against an independent
 //! computation (libm's sin, a brute-force search, exact integer arithmetic).
 
-use core_math::{
-    line_period_s, line_period_ticks, mtf_mismatch, nearest_ticks, sinc, ModelError, StageRule,
-};
+use core_math::sphere::speed_line_period_s;
+use core_math::{line_period_ticks, mtf_mismatch, nearest_ticks, sinc, ModelError, StageRule};
 
 #[test]
 fn sinc_polynomial_matches_libm() {
@@ -114,7 +113,7 @@ fn stage_rule_refuses_bad_floors() {
 #[test]
 fn line_period_and_ticks() {
     // 13 um at 5.81 mm/s.
-    let t = line_period_s(13e-6, 5.81e-3f64).unwrap();
+    let t = speed_line_period_s(13e-6, 5.81e-3f64).unwrap();
     assert!((t - 13e-6 / 5.81e-3).abs() < 1e-18);
     // 10 MHz clock: exact integer rounding and its error.
     let ticks = line_period_ticks(t, 10e6).unwrap();
@@ -123,7 +122,7 @@ fn line_period_and_ticks() {
     assert!((ticks.rounding_error_s - (ticks.ticks as f64 - exact) / 10e6).abs() < 1e-18);
     assert!(ticks.rounding_error_s.abs() <= 0.5 / 10e6);
     // The same in f32.
-    let t32 = line_period_s(13e-6f32, 5.81e-3).unwrap();
+    let t32 = speed_line_period_s(13e-6f32, 5.81e-3).unwrap();
     assert_eq!(line_period_ticks(t32, 10e6f32).unwrap().ticks, ticks.ticks);
 }
 
@@ -174,22 +173,25 @@ fn nearest_ticks_takes_any_input() {
 
 #[test]
 fn line_period_refusals() {
-    assert_eq!(line_period_s(13e-6, 0.0f64), Err(ModelError::NoImageMotion));
     assert_eq!(
-        line_period_s(13e-6, -1.0f64),
+        speed_line_period_s(13e-6, 0.0f64),
         Err(ModelError::NoImageMotion)
     );
     assert_eq!(
-        line_period_s(13e-6, f64::NAN),
+        speed_line_period_s(13e-6, -1.0f64),
         Err(ModelError::NoImageMotion)
     );
     assert_eq!(
-        line_period_s(13e-6f32, 1e-44),
+        speed_line_period_s(13e-6, f64::NAN),
+        Err(ModelError::NoImageMotion)
+    );
+    assert_eq!(
+        speed_line_period_s(13e-6f32, 1e-44),
         Err(ModelError::NoImageMotion),
         "overflow to inf"
     );
     assert_eq!(
-        line_period_s(0.0, 1.0f64),
+        speed_line_period_s(0.0, 1.0f64),
         Err(ModelError::NonPositivePixelPitch)
     );
     // Largest and smallest periods the 32-bit counter holds.

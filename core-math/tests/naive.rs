@@ -10,9 +10,10 @@
 mod common;
 
 use common::{NAIVE_BOUND as BOUND, NAIVE_BUCKETS_DEG as BUCKETS_DEG};
-use core_math::accuracy::limb_margin_rad;
 use core_math::sample::SplitMix64 as Rng;
-use core_math::{Backend, Camera, Geometry, NaiveF32, Reference};
+use core_math::sphere::accuracy::limb_margin_rad;
+use core_math::sphere::{Geometry, NaiveF32, Reference};
+use core_math::{Backend, Camera};
 
 const CAMERA: Camera = Camera {
     focal_m: 0.555,

@@ -1,7 +1,8 @@
 //! State vector to orbit quantities, against states built from known elements by
 //! rotation matrices (an independent route), including the degenerate orbits.
 
-use core_math::{ModelError, OrbitState, StateVector};
+use core_math::sphere::OrbitState;
+use core_math::{ModelError, StateVector};
 use proptest::prelude::*;
 use std::f64::consts::PI;
 

@@ -43,12 +43,10 @@
 mod common;
 
 use common::*;
-use core_math::accuracy::{f64_rel_tolerance, limb_margin_rad, F32_REL_TOLERANCE};
-use core_math::fixed_point::{envelope, geometry_from_f64, motion_to_f64};
-use core_math::{
-    domain, line_period_ticks, Backend, Camera, FixedReal, Geometry, ImageMotion, ModelError,
-    NaiveF32, Param, Reference, CLOSED_F32, CLOSED_F64, FIXED,
-};
+use core_math::sphere::accuracy::{f64_rel_tolerance, limb_margin_rad, F32_REL_TOLERANCE};
+use core_math::sphere::fixed_point::{envelope, geometry_from_f64, motion_to_f64};
+use core_math::sphere::{FixedReal, Geometry, NaiveF32, Reference, CLOSED_F32, CLOSED_F64, FIXED};
+use core_math::{domain, line_period_ticks, Backend, Camera, ImageMotion, ModelError, Param};
 
 const R: f64 = 6_370e3;
 const H: f64 = 645e3;

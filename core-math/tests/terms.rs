@@ -1,8 +1,9 @@
 //! The reduced closed forms a scene plan may select agree with the full one wherever
 //! their preconditions hold, and still refuse rays that miss the Earth.
 
-use core_math::closed_form::LIMB_BRANCH_RAD;
-use core_math::{Backend, Camera, Geometry, ModelError, CLOSED_F32};
+use core_math::sphere::closed_form::LIMB_BRANCH_RAD;
+use core_math::sphere::{Geometry, CLOSED_F32};
+use core_math::{Backend, Camera, ModelError};
 use proptest::prelude::*;
 
 const CAM: Camera = Camera {

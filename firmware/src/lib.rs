@@ -6,7 +6,7 @@
 //!   waiting) and [`telemetry`] (the loop: bytes through the `controller` crate's
 //!   `Session`, frames back out);
 //! - scene and math: the `controller` crate (the scene in force, its plan, the updates,
-//!   on core-math's `CLOSED_F32`); no hardware in it;
+//!   on core-math's real-Earth general form in f32, `GENERAL_F32`); no hardware in it;
 //! - line periods out: [`line_clock`] (the `controller::LinePeriodSink`: segment 0's
 //!   period into a timer's reload register, the others into a table) and the PERIODS
 //!   frames the session sends;

@@ -13,11 +13,10 @@
 
 use arbitrary::Arbitrary;
 use core_math::earth::{Attitude, EarthCamera, EarthGeometry, Ellipsoid};
-use core_math::fixed_point::{geometry_from_f64, motion_to_f64};
-use core_math::{
-    line_period_s, line_period_ticks, mtf_mismatch, Backend, Camera, Geometry, ImageMotion, Real,
-    StageRule, CLOSED_F32, CLOSED_F64, FIXED,
-};
+use core_math::sphere::fixed_point::{geometry_from_f64, motion_to_f64};
+use core_math::sphere::speed_line_period_s;
+use core_math::{line_period_ticks, mtf_mismatch, Backend, Camera, ImageMotion, Real, StageRule};
+use core_math::sphere::{Geometry, CLOSED_F32, CLOSED_F64, FIXED};
 use libfuzzer_sys::fuzz_target;
 
 #[derive(Arbitrary, Debug, Clone, Copy)]
@@ -134,7 +133,7 @@ fn check_earth<T: Real>(m: &ImageMotion<T>, pixel_m: f64, what: &str, e: &EarthI
         m.v1_mps.is_finite() && m.v2_mps.is_finite() && m.speed_mps().is_finite(),
         "{what}: Ok but non-finite motion {m:?} for {e:?}"
     );
-    let period = core_math::earth::line_period_s(T::from_f64(pixel_m), m);
+    let period = core_math::line_period_s(T::from_f64(pixel_m), m);
     assert!(
         period.is_finite() && period > T::ZERO,
         "{what}: line period {period:?} for {e:?}"
@@ -208,7 +207,7 @@ fuzz_target!(|input: Input| {
     let earth_radius_m = input.earth_radius.get(0.0, 1.1e8);
     let altitude_m = input.altitude.get(0.0, 2.0e7);
     let orbit_rate_rad_s = if input.circular {
-        core_math::orbital_rate_rad_s(earth_radius_m, altitude_m)
+        core_math::sphere::orbital_rate_rad_s(earth_radius_m, altitude_m)
     } else {
         input.orbit_rate.get(-1.1, 1.1)
     };
@@ -223,7 +222,7 @@ fuzz_target!(|input: Input| {
     };
 
     {
-        if let Ok(m) = core_math::Reference.evaluate(&camera, &g, n_px) {
+        if let Ok(m) = core_math::sphere::Reference.evaluate(&camera, &g, n_px) {
             check_motion(&m, "Reference", &input);
         }
         // F3 (docs/fuzzing.md, fixed): rolls beyond pi are checked like any other.
@@ -273,13 +272,13 @@ fuzz_target!(|input: Input| {
     ticks::<f32>(period as f32, clock as f32, f64::from(f32::EPSILON));
     // F2 (docs/fuzzing.md, fixed): no zero period any more, so every Ok is finite and
     // strictly positive.
-    if let Ok(p) = line_period_s(camera.pixel_m, period) {
+    if let Ok(p) = speed_line_period_s(camera.pixel_m, period) {
         assert!(
             p.is_finite() && p > 0.0,
             "line_period_s f64 {p} for {input:?}"
         );
     }
-    if let Ok(p) = line_period_s(camera.pixel_m as f32, period as f32) {
+    if let Ok(p) = speed_line_period_s(camera.pixel_m as f32, period as f32) {
         assert!(
             p.is_finite() && p > 0.0,
             "line_period_s f32 {p} for {input:?}"

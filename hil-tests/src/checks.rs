@@ -4,7 +4,9 @@
 
 use core::hint::black_box;
 
-use core_math::{line_period_s, line_period_ticks, mtf_mismatch, Backend, ModelError, CLOSED_F32};
+use core_math::sphere::speed_line_period_s;
+use core_math::sphere::CLOSED_F32;
+use core_math::{line_period_ticks, mtf_mismatch, Backend, ModelError};
 
 use crate::golden::{
     Expected, HostF32, MotionCase, LINE_CLOCK_HZ, MOTION_CASES, MTF_CASES, TICK_CASES,
@@ -61,7 +63,7 @@ fn target_motion(c: &MotionCase) -> Result<TargetMotion, ModelError> {
     let n_px = black_box(c.n_px);
     let m = CLOSED_F32.evaluate(&camera, &geometry, n_px)?;
     let speed = m.speed_mps();
-    let period = line_period_s(camera.pixel_m as f32, speed);
+    let period = speed_line_period_s(camera.pixel_m as f32, speed);
     let ticks =
         period.and_then(|p| line_period_ticks(p, black_box(LINE_CLOCK_HZ)).map(|t| t.ticks));
     Ok(TargetMotion {

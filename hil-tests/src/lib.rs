@@ -20,8 +20,9 @@ use defmt_semihosting as _;
 /// The generated cases (see `build.rs`).
 pub mod golden {
     // `Param` appears in the generated file only when a refusal names a parameter.
+    use core_math::sphere::Geometry;
     #[allow(unused_imports)]
-    use core_math::{Camera, Geometry, ModelError, Param};
+    use core_math::{Camera, ModelError, Param};
 
     /// The f64 reference's answer for one image-motion case.
     #[derive(Clone, Copy, Debug)]
@@ -29,9 +30,9 @@ pub mod golden {
         pub v1_mps: f64,
         pub v2_mps: f64,
         pub speed_mps: f64,
-        /// Relative tolerance of v1 and |v| (core_math::accuracy::f32_rel_tolerance).
+        /// Relative tolerance of v1 and |v| (core_math::sphere::accuracy::f32_rel_tolerance).
         pub rel_tol: f64,
-        /// Tolerance of v2 as a fraction of |v| (core_math::accuracy::F32_V2_TOLERANCE).
+        /// Tolerance of v2 as a fraction of |v| (core_math::sphere::accuracy::F32_V2_TOLERANCE).
         pub v2_tol_of_speed: f64,
         /// pixel / |v| (s) and its relative tolerance.
         pub period_s: f64,

@@ -27,7 +27,7 @@ fn state(t_s: f64) -> StateVector {
     let (r_e, h) = (6_371_000.0, 645e3);
     let a = r_e + h;
     let speed = libm::sqrt(GM_M3_S2 / a);
-    let u = 0.3 + core_math::orbital_rate_rad_s(r_e, h) * t_s;
+    let u = 0.3 + core_math::sphere::orbital_rate_rad_s(r_e, h) * t_s;
     let i = 97.98f64.to_radians();
     let (si, ci) = (libm::sin(i), libm::cos(i));
     let (su, cu) = (libm::sin(u), libm::cos(u));

@@ -5,7 +5,8 @@
 
 mod earth;
 
-use core_math::{Backend, Camera, Geometry, Reference, CLOSED_F32, CLOSED_F64};
+use core_math::sphere::{Geometry, Reference, CLOSED_F32, CLOSED_F64};
+use core_math::{Backend, Camera};
 
 use crate::eval::Model;
 
@@ -187,7 +188,7 @@ fn sweep_geometry(camera: &Camera, g: &Geometry<f64>, step: usize, stats: &mut [
             let e_in = ((m32.speed_mps() as f64) - exact.speed_mps()).abs() / exact.speed_mps();
             s.max_cond = s.max_cond.max(cond);
             s.max_input_rounding = s.max_input_rounding.max(e_in);
-            let bound = cond * U32 + core_math::accuracy::F32_REL_TOLERANCE;
+            let bound = cond * U32 + core_math::sphere::accuracy::F32_REL_TOLERANCE;
             s.max_explained = s.max_explained.max(e_in / bound);
         }
     }

@@ -4,7 +4,7 @@
 //! for the default scene over one orbit; writes the table of `docs/earth-model.md`.
 //!
 //! The numerical model (`motion`) shares no formula with `core_math`; on a sphere it
-//! reproduces `core_math::Reference` (its tests, and the validation line of the output).
+//! reproduces `core_math::sphere::Reference` (its tests, and the validation line of the output).
 
 mod costs;
 mod motion;
@@ -12,10 +12,8 @@ mod motion;
 use std::time::Instant;
 
 use controller::Scene;
-use core_math::{
-    mtf_mismatch, Backend, Camera, Geometry, ImageMotion, OrbitState, Reference, StageRule,
-    CLOSED_F32, EARTH_RATE_RAD_S,
-};
+use core_math::sphere::{Geometry, OrbitState, Reference, CLOSED_F32};
+use core_math::{mtf_mismatch, Backend, Camera, ImageMotion, StageRule, EARTH_RATE_RAD_S};
 
 use motion::{Orbit, Scenario, Spheroid};
 
@@ -167,7 +165,7 @@ pub struct EllipsoidSummary {
     /// round-Earth error with them.
     pub stages: u32,
     pub mtf_at_worst: f64,
-    /// Numerical model on the sphere against `core_math::Reference` (worst component
+    /// Numerical model on the sphere against `core_math::sphere::Reference` (worst component
     /// difference / |v_P|): the validation of the ellipsoid model's machinery.
     pub validation_worst: f64,
     /// Cases compared.
@@ -470,7 +468,7 @@ fn render(s: &EllipsoidSummary) -> Result<String, String> {
     o.push_str(&format!(
         "\nFigures ({CMD}):\n\n\
          - Validation: on the sphere R = 6371 km the numerical model agrees with \
-         `core_math::Reference` to {} of |v_P| (worst component over all {} cases) ({CMD}).\n\
+         `core_math::sphere::Reference` to {} of |v_P| (worst component over all {} cases) ({CMD}).\n\
          - Round Earth (R = 6371 km, H = |r| - R), the firmware's model: worst {} at \
          latitude {:+.1} deg (u = {:.0} deg, roll {:+.0} deg, n = {:+.0}, ground point at latitude {:+.1} deg); \
          range {} to {}, RMS {} ({CMD}). \

@@ -5,11 +5,10 @@
 
 mod earth;
 
-use core_math::fixed_point::{geometry_from_f64, motion_to_f64};
-use core_math::{
-    line_period_s, Backend, Camera, Geometry, ModelError, Real, Reference, CLOSED_F32, CLOSED_F64,
-    FIXED,
-};
+use core_math::sphere::fixed_point::{geometry_from_f64, motion_to_f64};
+use core_math::sphere::{speed_line_period_s, Sphere};
+use core_math::sphere::{Geometry, Reference, CLOSED_F32, CLOSED_F64, FIXED};
+use core_math::{Backend, Camera, ModelError, Real};
 
 use crate::csv::{Table, Writer};
 
@@ -161,7 +160,7 @@ fn parse_case(row: &[String], cols: &[usize]) -> Result<Case, EvalError> {
 
 /// v1, v2, |v| and the line period, formatted in the backend's own precision
 /// (shortest text that reads back to the same value).
-fn evaluate<B: Backend>(
+fn evaluate<B: Backend<Sphere>>(
     backend: &B,
     case: &Case,
     to_real: impl Fn(Geometry<f64>) -> Geometry<B::Real>,
@@ -171,7 +170,7 @@ where
 {
     let m = backend.evaluate(&case.camera, &to_real(case.geometry), case.n_px)?;
     let speed = m.speed_mps();
-    let period = line_period_s(B::Real::from_f64(case.camera.pixel_m), speed)?;
+    let period = speed_line_period_s(B::Real::from_f64(case.camera.pixel_m), speed)?;
     Ok([
         m.v1_mps.to_string(),
         m.v2_mps.to_string(),
@@ -186,7 +185,7 @@ fn evaluate_fixed(case: &Case) -> Result<[String; 4], EvalError> {
     let g = geometry_from_f64(&case.geometry)?;
     let m = motion_to_f64(&FIXED.evaluate(&case.camera, &g, case.n_px)?);
     let speed = m.speed_mps();
-    let period = line_period_s(case.camera.pixel_m, speed)?;
+    let period = speed_line_period_s(case.camera.pixel_m, speed)?;
     Ok([
         m.v1_mps.to_string(),
         m.v2_mps.to_string(),

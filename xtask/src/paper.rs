@@ -3,7 +3,7 @@
 //! of the headline numbers next to the paper's and a table of candidate explanations
 //! for where they differ. `docs/paper-reproduction.md` discusses the results.
 //!
-//! Everything is computed with [`core_math::Reference`] (the paper's transform chain,
+//! Everything is computed with [`core_math::sphere::Reference`] (the paper's transform chain,
 //! Eqs. 1-13, on dual numbers). The only other formulas here are in [`Variant`]: the
 //! paper's printed Eq. 14 with switches for the suspected mistakes, used only to explain
 //! the differences, never to produce our numbers; with every switch off it is checked
@@ -14,9 +14,8 @@
 
 use std::path::PathBuf;
 
-use core_math::{
-    mtf_mismatch, Backend, Camera, Geometry, ImageMotion, Reference, StageRule, EARTH_RATE_RAD_S,
-};
+use core_math::sphere::{Geometry, Reference};
+use core_math::{mtf_mismatch, Backend, Camera, ImageMotion, StageRule, EARTH_RATE_RAD_S};
 
 use crate::csv::Writer;
 use crate::plot::{Legend, Plot, Series};

@@ -19,11 +19,11 @@
 //!
 //! `flash_bytes`: [`crate::footprint`], one link per backend.
 
-use core_math::fixed_point::{geometry_from_f64, motion_to_f64};
-use core_math::{
-    Backend, Camera, Geometry, MicroF32, NaiveF32, Reference, CLOSED_F32, CLOSED_F64,
-    CLOSED_MICROMATH, FIXED,
+use core_math::sphere::fixed_point::{geometry_from_f64, motion_to_f64};
+use core_math::sphere::{
+    Geometry, MicroF32, NaiveF32, Reference, CLOSED_F32, CLOSED_F64, CLOSED_MICROMATH, FIXED,
 };
+use core_math::{Backend, Camera};
 
 use crate::target::{bench_counts, BenchCounts};
 use core_math::sample::SplitMix64 as Rng;
@@ -270,7 +270,7 @@ fn positive(v: &str) -> Result<usize, String> {
 fn case(rng: &mut Rng) -> Option<(Geometry<f64>, f64, f64)> {
     let g = rng.envelope_geometry();
     let n_px = rng.envelope_pixel(&g, &CAMERA)?;
-    let margin = core_math::accuracy::limb_margin_rad(&CAMERA, &g, n_px).ok()?;
+    let margin = core_math::sphere::accuracy::limb_margin_rad(&CAMERA, &g, n_px).ok()?;
     (margin > 0.0).then_some((g, n_px, margin.to_degrees()))
 }
 

@@ -372,16 +372,10 @@ pub fn check_altitude<S: Real>(c_m2: S, r2: S, eq_m: S) -> Result<(), ModelError
     Ok(())
 }
 
-/// Line period (s) from the image motion: the charge moves along P1, so the line rate
-/// follows v1 (EARTH-MODEL.md, derived outputs), `pixel_m / |v1|`.
-pub fn line_period_s<T: Real>(pixel_m: T, motion: &crate::ImageMotion<T>) -> T {
-    pixel_m / motion.v1_mps.abs()
-}
-
 /// The inertial state of a circular orbit of radius `radius_m` (two-body speed
 /// sqrt(GM/r)), inclination `inclination_rad`, at argument of latitude `arg_latitude_rad`
 /// from the ascending node, the node on +x. With it the real-Earth model reduces to the
-/// round-Earth [`crate::Geometry`] of the same i0 and gamma0.
+/// round-Earth geometry of the same i0 and gamma0.
 pub fn circular_state(radius_m: f64, inclination_rad: f64, arg_latitude_rad: f64) -> StateVector {
     let (si, ci) = libm::sincos(inclination_rad);
     let (su, cu) = libm::sincos(arg_latitude_rad);
@@ -389,30 +383,6 @@ pub fn circular_state(radius_m: f64, inclination_rad: f64, arg_latitude_rad: f64
     StateVector {
         position_m: [radius_m * cu, radius_m * su * ci, radius_m * su * si],
         velocity_mps: [-speed * su, speed * cu * ci, speed * cu * si],
-    }
-}
-
-/// The real-Earth geometry that is exactly the round-Earth `g`: a sphere of radius R
-/// (flattening 0), ground height 0, the circular orbit of radius R + H, the roll, no
-/// pitch, yaw or rates. (`g`'s orbit rate must be the circular one, as
-/// [`crate::Geometry::circular`] makes it.)
-pub fn from_sphere(g: &crate::Geometry<f64>) -> EarthGeometry<f64> {
-    EarthGeometry {
-        state: circular_state(
-            g.earth_radius_m + g.altitude_m,
-            g.inclination_rad,
-            g.arg_latitude_rad,
-        ),
-        attitude: Attitude {
-            roll_rad: g.roll_rad,
-            ..Attitude::default()
-        },
-        ground_h_m: 0.0,
-        ellipsoid: Ellipsoid {
-            a_m: g.earth_radius_m,
-            flattening: 0.0,
-        },
-        earth_rate_rad_s: g.earth_rate_rad_s,
     }
 }
 

@@ -6,14 +6,12 @@
 //! Each test crate compiles this module on its own and uses only part of it.
 #![allow(dead_code)]
 
-use core_math::accuracy::{
+use core_math::sphere::accuracy::{
     f64_rel_tolerance, limb_margin_rad, F32_REL_TOLERANCE, F32_V2_TOLERANCE,
 };
-use core_math::fixed_point::{geometry_from_f64, motion_to_f64};
-use core_math::{
-    Backend, Camera, Geometry, ImageMotion, ModelError, NaiveF32, Reference, CLOSED_F32,
-    CLOSED_F64, FIXED,
-};
+use core_math::sphere::fixed_point::{geometry_from_f64, motion_to_f64};
+use core_math::sphere::{Geometry, NaiveF32, Reference, CLOSED_F32, CLOSED_F64, FIXED};
+use core_math::{Backend, Camera, ImageMotion, ModelError};
 
 /// The paper's camera: f = 0.555 m, A = 13 um.
 pub const CAMERA: Camera = Camera {
@@ -21,7 +19,7 @@ pub const CAMERA: Camera = Camera {
     pixel_m: 13e-6,
 };
 
-/// `core_math::Fixed` against the reference, on |v_P|, v1 (relative) and v2 / |v_P|,
+/// `core_math::sphere::Fixed` against the reference, on |v_P|, v1 (relative) and v2 / |v_P|,
 /// anywhere in its envelope, the limb included: the tolerance of docs/fixed-point.md
 /// ("Tolerance of the tests: 5e-7"; measured maximum 1.1e-7, requirement 2e-6).
 pub const FIXED_REL_TOLERANCE: f64 = 5.0e-7;

@@ -13,11 +13,11 @@
 use core::hint::black_box;
 
 use core_math::earth::{circular_state, Attitude, EarthCamera, EarthGeometry, Ellipsoid};
-use core_math::fixed_point::geometry_from_f64;
-use core_math::{
-    Backend, Camera, EarthReference, Geometry, MicroF32, Model, NaiveF32, Reference, CLOSED_F32,
-    CLOSED_F64, CLOSED_MICROMATH, FIXED, GENERAL_F32, GENERAL_F64,
+use core_math::sphere::fixed_point::geometry_from_f64;
+use core_math::sphere::{
+    Geometry, MicroF32, NaiveF32, Reference, CLOSED_F32, CLOSED_F64, CLOSED_MICROMATH, FIXED,
 };
+use core_math::{Backend, Camera, EarthReference, Model, GENERAL_F32, GENERAL_F64};
 use cortex_m_rt::entry;
 use firmware::platform;
 use firmware::synthetic::{controller_with_nav, NoRegisters};
@@ -475,7 +475,7 @@ fn run() -> Result<(), FirmwareError> {
         (&update, &axis),
         |(u, p)| -> Result<u32, FirmwareError> {
             let speed = CLOSED_F32.motion(u, p)?.speed_mps();
-            let period = core_math::line_period_s(CAMERA.pixel_m as f32, speed)?;
+            let period = core_math::sphere::speed_line_period_s(CAMERA.pixel_m as f32, speed)?;
             Ok(core_math::line_period_ticks(period, LINE_CLOCK_HZ)?.ticks)
         },
     );

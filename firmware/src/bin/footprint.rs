@@ -13,8 +13,9 @@ use core::hint::black_box;
 
 #[allow(unused_imports)]
 use core_math::earth::{circular_state, Attitude, EarthCamera, EarthGeometry, Ellipsoid};
+use core_math::sphere::{Geometry, Sphere};
 #[allow(unused_imports)]
-use core_math::{Backend, Camera, Earth, Geometry};
+use core_math::{Backend, Camera, Earth};
 use cortex_m_rt::entry;
 use firmware::platform;
 
@@ -32,7 +33,7 @@ const GEOMETRY: Geometry<f64> = Geometry {
 
 /// Boot, update and per-pixel work of `backend`, the result kept.
 #[allow(dead_code)]
-fn exercise<B: Backend>(backend: &B, g: &Geometry<B::Real>) {
+fn exercise<B: Backend<Sphere>>(backend: &B, g: &Geometry<B::Real>) {
     let camera = black_box(Camera {
         focal_m: 0.555,
         pixel_m: 13e-6,
@@ -79,18 +80,18 @@ fn main() -> ! {
     #[allow(unused_variables)] // "none" keeps only the input
     let g = black_box(GEOMETRY);
     #[cfg(footprint = "naive-f32")]
-    exercise(&core_math::NaiveF32, &g.to());
+    exercise(&core_math::sphere::NaiveF32, &g.to());
     #[cfg(footprint = "reference")]
-    exercise(&core_math::Reference, &g);
+    exercise(&core_math::sphere::Reference, &g);
     #[cfg(footprint = "f64")]
-    exercise(&core_math::CLOSED_F64, &g);
+    exercise(&core_math::sphere::CLOSED_F64, &g);
     #[cfg(footprint = "f32")]
-    exercise(&core_math::CLOSED_F32, &g.to());
+    exercise(&core_math::sphere::CLOSED_F32, &g.to());
     #[cfg(footprint = "f32-micromath")]
-    exercise(&core_math::CLOSED_MICROMATH, &g.to());
+    exercise(&core_math::sphere::CLOSED_MICROMATH, &g.to());
     #[cfg(footprint = "fixed")]
-    if let Ok(gq) = core_math::fixed_point::geometry_from_f64(&g) {
-        exercise(&core_math::FIXED, &gq);
+    if let Ok(gq) = core_math::sphere::fixed_point::geometry_from_f64(&g) {
+        exercise(&core_math::sphere::FIXED, &gq);
     }
     #[cfg(footprint = "earth-reference")]
     exercise_earth(&core_math::EarthReference, |g| g);

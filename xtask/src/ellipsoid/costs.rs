@@ -2,7 +2,7 @@
 //! `core_math::EarthReference` (the definition of `shared/EARTH-MODEL.md` on dual
 //! numbers, the golden source, itself checked against this module's sibling `motion` by
 //! the two-route test), the simplified model either the paper's round Earth
-//! (`core_math::Reference` on a `core_math::Geometry` from the state vector, as the
+//! (`core_math::sphere::Reference` on a `core_math::sphere::Geometry` from the state vector, as the
 //! firmware does today) or the truth with one input dropped. One simplification at a
 //! time, at the default scene over one orbit and over a seeded sample of the envelope.
 //!
@@ -12,9 +12,10 @@
 
 use core_math::earth::{limb_margin_rad, Attitude};
 use core_math::sample::SplitMix64;
+use core_math::sphere::{Geometry, OrbitState, Reference};
 use core_math::{
-    Backend, Camera, EarthCamera, EarthGeometry, EarthReference, Ellipsoid, Geometry, ImageMotion,
-    OrbitState, Reference, StateVector, EARTH_RATE_RAD_S, GM_M3_S2,
+    Backend, Camera, EarthCamera, EarthGeometry, EarthReference, Ellipsoid, ImageMotion,
+    StateVector, EARTH_RATE_RAD_S, GM_M3_S2,
 };
 
 use super::motion::{eccentric_state, envelope_draw, general_motion, norm, Orbit, Spheroid};

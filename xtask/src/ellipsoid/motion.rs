@@ -9,7 +9,7 @@
 //! is the five-point central difference of those projections (Richardson's extrapolation
 //! of the h and 2h central differences), truncation error O(h^4).
 //!
-//! Conventions are those of `core_math::Reference` (README, "Conventions"): pixel n sits
+//! Conventions are those of `core_math::sphere::Reference` (README, "Conventions"): pixel n sits
 //! at P2 = n A, P1 = 0; roll > 0 turns the boresight toward +2 (left); v1 = dP1/dt (TDI
 //! direction, negative for forward flight), v2 = dP2/dt. The argument of latitude is
 //! measured from the ascending node, so the orbit frame here is the paper's at gamma0.
@@ -505,7 +505,8 @@ pub fn envelope_draw(rng: &mut SplitMix64) -> (EarthGeometry<f64>, EarthCamera, 
 mod tests {
     use super::*;
     use core_math::earth::limb_margin_rad;
-    use core_math::{Backend, EarthReference, Geometry, ModelError, Reference};
+    use core_math::sphere::{Geometry, Reference};
+    use core_math::{Backend, EarthReference, ModelError};
 
     const CAMERA: Camera = Camera {
         focal_m: 0.555,

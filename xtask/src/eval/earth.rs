@@ -1,7 +1,8 @@
 //! `cargo xtask eval --model earth --backend <reference|f64|f32>`: the real-Earth model
 //! on user-supplied cases, exactly as `shared/EARTH-MODEL.md` ("Eval CSV") specifies.
 
-use core_math::earth::{line_period_s, Attitude, EarthCamera, EarthGeometry};
+use core_math::earth::{Attitude, EarthCamera, EarthGeometry};
+use core_math::line_period_s;
 use core_math::{
     Backend, Earth, EarthReference, Ellipsoid, ModelError, Real, StateVector, EARTH_RATE_RAD_S,
     GENERAL_F32, GENERAL_F64,

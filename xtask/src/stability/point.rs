@@ -1,9 +1,10 @@
 //! One point of a map: the f32 and fixed-point backends against the f64 reference, and
 //! the problem's condition number there.
 
-use core_math::fixed_point::{geometry_from_f64, motion_to_f64};
-use core_math::reference::RefPixel;
-use core_math::{Backend, Camera, Geometry, ImageMotion, Reference, CLOSED_F32, FIXED};
+use core_math::sphere::fixed_point::{geometry_from_f64, motion_to_f64};
+use core_math::sphere::reference::RefPixel;
+use core_math::sphere::{Geometry, Reference, CLOSED_F32, FIXED};
+use core_math::{Backend, Camera, ImageMotion};
 
 /// The camera of every map (the paper's: f = 0.555 m, A = 13 um).
 pub const CAMERA: Camera = Camera {

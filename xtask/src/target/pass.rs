@@ -6,7 +6,7 @@
 //! `-chardev socket` + `-serial chardev:`; stdout stays the defmt stream), collects
 //! the PERIODS and STATUS frames the firmware sends back, and checks them:
 //!
-//! - against the f64 reference (`core_math::Reference`) at the same instants: per
+//! - against the f64 reference (`core_math::sphere::Reference`) at the same instants: per
 //!   segment, |v| at the plan's sample points, period A (1/v_min + 1/v_max) / 2, in
 //!   ticks; the firmware's ticks must be within 1e-6 relative plus half a tick;
 //! - against a twin run: the same `controller::session::Session` on the host, fed the

@@ -11,7 +11,8 @@
 use controller::golden::{self, NavInput};
 use controller::Controller;
 use core_math::earth::{Attitude, EarthGeometry};
-use core_math::{Backend, Geometry, OrbitState, Reference, EARTH_RATE_RAD_S};
+use core_math::sphere::{Geometry, OrbitState, Reference};
+use core_math::{Backend, EARTH_RATE_RAD_S};
 
 use super::check::Downlink;
 use super::scenario::AgileTruth;

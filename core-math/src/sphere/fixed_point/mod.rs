@@ -1,7 +1,7 @@
 //! The closed form in fixed point, for controllers without an FPU (Cortex-M0+/M3):
 //! `update` and `motion` use integer arithmetic only; `pixel` (boot) stays in f64.
 //!
-//! The formulas are those of [`crate::closed_form`]: q^2 = m (2 - m) with
+//! The formulas are those of [`crate::sphere::closed_form`]: q^2 = m (2 - m) with
 //! m = 1 - k|sin eta| formed directly, or within 9.7e-4 rad of the limb from the limb
 //! distance delta = (L -/+ phi) -/+ alpha carried in Q61 (the near-limb form). Formats,
 //! range analysis and measured error: `docs/fixed-point.md`. In short (Qn = integer
@@ -31,8 +31,9 @@ mod turns;
 use fixed::types::{I0F32, I1F31, I24F40, I2F30, I3F61, I7F25};
 
 use crate::error::{ModelError, Param};
-use crate::model::{Backend, Camera, Geometry, ImageMotion};
+use crate::model::{Backend, Camera, ImageMotion};
 use crate::real::Scalar;
+use crate::sphere::{Geometry, Sphere};
 
 pub use fixed;
 
@@ -77,7 +78,7 @@ pub mod envelope {
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Fixed;
 
-/// The fixed-point backend (a value, like [`crate::CLOSED_F32`]).
+/// The fixed-point backend (a value, like [`crate::sphere::CLOSED_F32`]).
 pub const FIXED: Fixed = Fixed;
 
 /// Constants of one field point, computed at boot in f64 and rounded once (build it
@@ -214,7 +215,7 @@ fn i7f25(bits: i128) -> I7F25 {
     I7F25::from_bits(bits as i32)
 }
 
-impl Backend for Fixed {
+impl Backend<Sphere> for Fixed {
     type Real = I24F40;
     type Pixel = PixelConst;
     type Update = UpdateConst;

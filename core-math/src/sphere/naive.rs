@@ -4,7 +4,7 @@
 //!
 //! It exists to be measured, not flown: `cargo xtask bench` shows its cost on the
 //! Cortex-M4 (libm's `sinf`/`cosf` work in soft f64 there, ~1 200 instructions each) and
-//! `core-math/tests/naive.rs` its error against [`crate::Reference`] (about 1e-5 away from
+//! `core-math/tests/naive.rs` its error against [`crate::sphere::Reference`] (about 1e-5 away from
 //! the limb, growing like u/q^2 toward it: the asin of Eq. 1 and the difference
 //! `pi - phi - alpha - beta` of Eq. 3 both lose digits there). The flight firmware builds
 //! core-math without the `naive` feature and never links it.
@@ -18,7 +18,8 @@
 use core::f32::consts::{FRAC_PI_2, PI};
 
 use crate::error::ModelError;
-use crate::model::{Backend, Camera, Geometry, ImageMotion};
+use crate::model::{Backend, Camera, ImageMotion};
+use crate::sphere::{Geometry, Sphere};
 
 /// The naive f32 backend (paper's route, libm f32 trig, all of it per pixel).
 #[derive(Clone, Copy, Debug, Default)]
@@ -32,7 +33,7 @@ pub struct NaivePixel {
     pub focal_m: f32,
 }
 
-impl Backend for NaiveF32 {
+impl Backend<Sphere> for NaiveF32 {
     type Real = f32;
     type Pixel = NaivePixel;
     type Update = Geometry<f32>;

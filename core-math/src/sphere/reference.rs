@@ -3,7 +3,7 @@
 //! Ground point from Eqs. 1-6 (law of sines, asin, geocentric angle), then the nine
 //! homogeneous transforms of Eqs. 7-12, P(t) = M9 M8 M7 M6(t) M5 M4(t) M3 M2 M1 G,
 //! evaluated on dual numbers so that dP/dt at t = 0 (Eq. 13) is exact. It shares no
-//! formula with [`crate::closed_form`]; agreement between the two is the proof of the
+//! formula with [`crate::sphere::closed_form`]; agreement between the two is the proof of the
 //! derivation. It is slow (hundreds of flops and four libm calls per pixel) and meant
 //! for the host, golden values and tests, though it builds for the target too.
 //!
@@ -13,7 +13,8 @@
 
 use crate::dual::Dual;
 use crate::error::ModelError;
-use crate::model::{Backend, Camera, Geometry, ImageMotion};
+use crate::model::{Backend, Camera, ImageMotion};
+use crate::sphere::{Geometry, Sphere};
 
 type Vec4 = [Dual; 4];
 type Mat4 = [[Dual; 4]; 4];
@@ -164,7 +165,7 @@ impl Reference {
     }
 }
 
-impl Backend for Reference {
+impl Backend<Sphere> for Reference {
     type Real = f64;
     type Pixel = RefPixel;
     type Update = Geometry<f64>;

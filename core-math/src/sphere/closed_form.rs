@@ -21,8 +21,9 @@
 use core::marker::PhantomData;
 
 use crate::error::ModelError;
-use crate::model::{Backend, Camera, Geometry, ImageMotion};
+use crate::model::{Backend, Camera, ImageMotion};
 use crate::real::Real;
+use crate::sphere::{Geometry, Sphere};
 
 /// The closed-form backend in scalar `T` (`f64` or `f32`).
 #[derive(Clone, Copy, Debug, Default)]
@@ -98,7 +99,7 @@ fn split<T: Real>(x: f64) -> (T, T) {
     (hi, T::from_f64(x - hi.to_f64()))
 }
 
-impl<T: Real> Backend for ClosedForm<T> {
+impl<T: Real> Backend<Sphere> for ClosedForm<T> {
     type Real = T;
     type Pixel = PixelConst<T>;
     type Update = UpdateConst<T>;
