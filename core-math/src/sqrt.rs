@@ -1,7 +1,7 @@
 //! Correctly rounded f32 square root at the cost of one FPU instruction on the Cortex-M4F.
 //!
 //! `f32::sqrt` lives in `std`, and `libm::sqrtf` is a software loop on this target
-//! (about 48 instructions). The FPv4-SP unit has `vsqrt.f32`, correctly rounded like
+//! (its cost: shared/EMBEDDED-NOTES.md). The FPv4-SP unit has `vsqrt.f32`, correctly rounded like
 //! `sqrtf`, so results are bit-identical to the host's `libm::sqrtf`. Stable Rust refuses
 //! inline `asm!` with `sreg` operands on thumbv7em (no `vfp2` target feature at the asm
 //! level), so the instruction sits in a two-instruction `global_asm!` leaf function that

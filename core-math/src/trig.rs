@@ -1,12 +1,12 @@
 //! f32 sine, cosine and arc tangent in f32 arithmetic only, for the per-update work.
 //!
 //! `libm::sincosf` is correctly rounded to 0.5 ulp but evaluates in (soft) f64 on the
-//! Cortex-M4F: about 2 200 instructions a call (shared/EMBEDDED-NOTES.md). Here: reduce by
-//! pi/2 with a three-part Cody-Waite constant (each k * part exact for |k| < 2^13, i.e.
-//! |x| < 12 800 rad), then the minimax polynomials of Cephes' `sinf`/`cosf` on
-//! [-pi/4, pi/4]. Measured error against f64 over |x| <= 100 rad: at most 1.54 ulp
-//! (`core-math/tests/trig.rs`). Larger arguments, which the model never produces, fall
-//! back to libm's f64 `sincos`, rounded.
+//! Cortex-M4F, many times the cost of a polynomial (counts: shared/EMBEDDED-NOTES.md,
+//! docs/bench.md). Here: reduce by pi/2 with a three-part Cody-Waite constant (each
+//! k * part exact for |k| < 2^13, i.e. |x| < 12 800 rad), then the minimax polynomials
+//! of Cephes' `sinf`/`cosf` on [-pi/4, pi/4]. Measured error against f64 over
+//! |x| <= 100 rad: at most 1.54 ulp (`core-math/tests/trig.rs`). Larger arguments, which
+//! the model never produces, fall back to libm's f64 `sincos`, rounded.
 
 /// pi/2 = P1 + P2 + P3, P1 and P2 with trailing zero bits (Cephes' DP1..DP3, doubled).
 const P1: f32 = 1.570_312_5;
@@ -68,8 +68,8 @@ pub fn sin_f32(x: f32) -> f32 {
 /// (sin x, cos x) in f32.
 ///
 /// Inlined, with libm's route for huge arguments kept out of line: as one function the
-/// fallback's register saves made every call pay a prologue (about 20 instructions,
-/// `cargo xtask bench --profile`).
+/// fallback's register saves made every call pay a prologue (`cargo xtask bench
+/// --profile` shows it).
 #[inline(always)]
 pub fn sin_cos_f32(x: f32) -> (f32, f32) {
     if !(x.abs() < FAST_LIMIT) {
@@ -103,15 +103,15 @@ const TAN_PI_8: f32 = 0.414_213_57;
 
 /// atan x in f32 (rad), for the drift angles of every segment.
 ///
-/// `libm::atanf` is pure f32 here but branches through four ranges and a long polynomial
-/// (about 100 instructions a call on the Cortex-M4). Here: Cephes' `atanf`, the argument
+/// `libm::atanf` is pure f32 here but branches through four ranges and a long
+/// polynomial. Here: Cephes' `atanf`, the argument
 /// reduced to |x| <= tan(pi/8) by atan x = pi/4 + atan((x-1)/(x+1)) or
 /// pi/2 + atan(-1/x) (one `vdiv.f32`), then its degree-9 odd minimax polynomial. Measured
 /// error against f64 over every magnitude: 2.18 ulp (`core-math/tests/trig.rs`). NaN stays NaN;
 /// +-inf gives +-pi/2.
 ///
 /// Inlined up to tan(3 pi/8): below tan(pi/8) no reduction is needed (the drift
-/// tangents of a steered camera, a dozen instructions), and up to tan(3 pi/8) (an
+/// tangents of a steered camera: the polynomial alone), and up to tan(3 pi/8) (an
 /// unsteered camera in a roll slew, drifts to 1.2 rad) the reduction is one division.
 /// Beyond, and NaN, out of line. The same operations in the same order as
 /// [`atan_reduced`], so bit for bit the same results.
@@ -120,8 +120,7 @@ pub fn atan_f32(x: f32) -> f32 {
     let a = x.abs();
     if a <= TAN_PI_8 {
         // The polynomial is odd and IEEE rounding symmetric: on x itself it gives
-        // copysign(p(|x|), x) exactly, without the sign's transfer (five instructions
-        // here). The `+ 0.0` turns the -0 of z p(z) at z = 0 into +0 and changes no
+        // copysign(p(|x|), x) exactly, without the sign's transfer. The `+ 0.0` turns the -0 of z p(z) at z = 0 into +0 and changes no
         // other value, so that atan(-0) = -0 + (-0) keeps its sign.
         let z = x * x;
         return (atan_poly(z) * z + 0.0) * x + x;

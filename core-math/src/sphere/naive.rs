@@ -3,7 +3,7 @@
 //! libm's f32 functions, every transcendental evaluated per pixel.
 //!
 //! It exists to be measured, not flown: `cargo xtask bench` shows its cost on the
-//! Cortex-M4 (libm's `sinf`/`cosf` work in soft f64 there, ~1 200 instructions each) and
+//! Cortex-M4 (libm's `sinf`/`cosf` work in soft f64 there) and
 //! `core-math/tests/naive.rs` its error against [`crate::sphere::Reference`] (about 1e-5 away from
 //! the limb, growing like u/q^2 toward it: the asin of Eq. 1 and the difference
 //! `pi - phi - alpha - beta` of Eq. 3 both lose digits there). The flight firmware builds
