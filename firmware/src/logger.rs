@@ -62,7 +62,7 @@ static STATE: State = State {
 };
 
 /// Frames dropped because they were logged from inside another frame (a fault handler
-/// that interrupted a log line). 0 in every run so far.
+/// that interrupted a log line).
 pub fn dropped_frames() -> u32 {
     STATE.dropped.load(Ordering::Relaxed)
 }

@@ -16,7 +16,7 @@
 //!
 //! | feature | module | link | line clock | clock |
 //! |---|---|---|---|---|
-//! | `mps2-an386` (default) | [`mps2_an386`] | CMSDK UART0 | CMSDK TIMER0 RELOAD | CMSDK TIMER1 |
+//! | `mps2-an386` (default) | [`mps2_an386`] on [`cmsdk`] | CMSDK UART0 | CMSDK TIMER0 RELOAD | CMSDK TIMER1 |
 //! | `stm32f405` | `stm32f405` (stm32f4xx-hal) | USART1 | TIM2 ARR | TIM5 (1 MHz) |
 
 #[cfg(all(feature = "mps2-an386", feature = "stm32f405"))]
@@ -26,6 +26,9 @@ compile_error!(
 #[cfg(not(any(feature = "mps2-an386", feature = "stm32f405")))]
 compile_error!("no board selected: enable the feature `mps2-an386` or `stm32f405`");
 
+// The CMSDK APB UART and timer: every board built on the CMSDK shares them.
+#[cfg(feature = "mps2-an386")]
+pub mod cmsdk;
 #[cfg(feature = "mps2-an386")]
 pub mod mps2_an386;
 #[cfg(feature = "mps2-an386")]

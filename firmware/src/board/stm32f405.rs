@@ -73,8 +73,8 @@ pub fn take() -> Result<Parts<Link, LineClock, Clock>, BoardError> {
 
     let timer_clock_hz = rcc.clocks.timclk1().raw();
     let tim2 = Timer::new(dp.TIM2, &mut rcc).release();
-    // SAFETY: 0 is a valid prescaler (count every timer clock tick).
-    tim2.psc().write(|w| unsafe { w.bits(0) });
+    // Prescaler 0: count every timer clock tick.
+    tim2.psc().write(|w| w.psc().set(0));
     tim2.cr1().modify(|_, w| w.arpe().set_bit());
 
     let mut tim5 = dp.TIM5.counter_us(&mut rcc);
@@ -139,15 +139,15 @@ impl ReloadRegister for Tim2Reload {
     /// Sets the period; the first one also loads it at once (update event) and starts
     /// the counter. Later ones wait in the preload register for the current period's end.
     fn set_reload(&mut self, value: u32) {
-        // SAFETY: TIM2's ARR takes any 32-bit value.
-        self.tim.arr().write(|w| unsafe { w.bits(value) });
+        // TIM2's ARR field is 32 bits wide: it takes any value.
+        self.tim.arr().write(|w| w.arr().set(value));
         if self.tim.cr1().read().cen().bit_is_clear() {
             self.tim.egr().write(|w| w.ug().set_bit());
             self.tim.cr1().modify(|_, w| w.cen().set_bit());
         }
     }
     fn reload(&self) -> u32 {
-        self.tim.arr().read().bits()
+        self.tim.arr().read().arr().bits()
     }
 }
 

@@ -1,0 +1,352 @@
+//! The Cortex-M System Design Kit's APB UART and APB timer, as typed register blocks and
+//! as the board layer's link, line clock and clock: the code every board built on the
+//! CMSDK shares (QEMU's MPS2 images; a board module adds only its addresses, interrupt
+//! lines, APB clock and wiring).
+//!
+//! Register maps from the Cortex-M System Design Kit TRM (ARM DDI0479C) as QEMU models
+//! them (hw/char/cmsdk-apb-uart.c, hw/timer/cmsdk-apb-timer.c). Each peripheral is a
+//! `#[repr(C)]` block of `volatile_register::RW<u32>`, its field offsets checked against
+//! the TRM at compile time, reached through a zero-sized [`Peripheral`] handle that
+//! dereferences to the block at the instance's fixed address: the shape of `cortex-m`'s
+//! `peripheral` modules. No address arithmetic: the compiler lays the registers out.
+//!
+//! UART, as modelled by QEMU: a one-byte receive buffer (STATE.RXFULL set on arrival,
+//! cleared by reading DATA) and QEMU offers the next byte only once it is empty, so the
+//! host side is flow-controlled; a one-byte transmit buffer (STATE.TXFULL) that stays
+//! full while the host end of the chardev does not accept the byte. On silicon the
+//! receive side overruns instead (STATE.RXOVERRUN) if a byte is not read within one
+//! character time: so the receive interrupt reads every byte into the queue of
+//! [`crate::rx`], and the loop takes them from there.
+
+use core::marker::PhantomData;
+use core::ops::Deref;
+
+use cortex_m::interrupt::InterruptNumber;
+use embedded_hal_nb::serial::{ErrorKind, ErrorType, Read, Write};
+
+use super::{Extended, Monotonic};
+use crate::line_clock::ReloadRegister;
+use crate::link::{LinkError, RxWait};
+use crate::rx::{self, RxQueue};
+
+/// The APB UART's registers (TRM, "APB UART"; QEMU hw/char/cmsdk-apb-uart.c).
+pub mod uart {
+    use core::mem::{offset_of, size_of};
+    use volatile_register::RW;
+
+    /// The UART's register block.
+    #[repr(C)]
+    pub struct RegisterBlock {
+        /// 0x00 DATA: read, the received byte (clears STATE.RXFULL); write, the byte to
+        /// send.
+        pub data: RW<u32>,
+        /// 0x04 STATE: buffer full and overrun flags; the overrun flags are write 1 to
+        /// clear.
+        pub state: RW<u32>,
+        /// 0x08 CTRL: enables (transmitter, receiver, their interrupts).
+        pub ctrl: RW<u32>,
+        /// 0x0C INTSTATUS on read, INTCLEAR on write (write 1 to clear).
+        pub intstatus: RW<u32>,
+        /// 0x10 BAUDDIV: the APB clock cycles per bit (at least 16).
+        pub bauddiv: RW<u32>,
+    }
+
+    const _: () = {
+        assert!(offset_of!(RegisterBlock, data) == 0x00);
+        assert!(offset_of!(RegisterBlock, state) == 0x04);
+        assert!(offset_of!(RegisterBlock, ctrl) == 0x08);
+        assert!(offset_of!(RegisterBlock, intstatus) == 0x0C);
+        assert!(offset_of!(RegisterBlock, bauddiv) == 0x10);
+        assert!(size_of::<RegisterBlock>() == 0x14);
+    };
+
+    /// STATE: transmit buffer full.
+    pub const STATE_TX_FULL: u32 = 1 << 0;
+    /// STATE: receive buffer full.
+    pub const STATE_RX_FULL: u32 = 1 << 1;
+    /// STATE: receive overrun (write 1 to clear).
+    pub const STATE_RX_OVERRUN: u32 = 1 << 3;
+    /// CTRL: transmitter enable.
+    pub const CTRL_TX_EN: u32 = 1 << 0;
+    /// CTRL: receiver enable.
+    pub const CTRL_RX_EN: u32 = 1 << 1;
+    /// CTRL: receive interrupt enable.
+    pub const CTRL_RX_INTEN: u32 = 1 << 3;
+    /// INTSTATUS / INTCLEAR: receive interrupt.
+    pub const INT_RX: u32 = 1 << 1;
+    /// The smallest BAUDDIV the UART accepts (QEMU ignores smaller values).
+    pub const BAUDDIV_MIN: u32 = 16;
+}
+
+/// The APB timer's registers (TRM, "APB timer"; QEMU hw/timer/cmsdk-apb-timer.c).
+pub mod timer {
+    use core::mem::{offset_of, size_of};
+    use volatile_register::RW;
+
+    /// The timer's register block.
+    #[repr(C)]
+    pub struct RegisterBlock {
+        /// 0x0 CTRL: enable, external input as enable or clock, interrupt enable.
+        pub ctrl: RW<u32>,
+        /// 0x4 VALUE: the down-counter.
+        pub value: RW<u32>,
+        /// 0x8 RELOAD: loaded into VALUE when it reaches zero.
+        pub reload: RW<u32>,
+        /// 0xC INTSTATUS on read, INTCLEAR on write (write 1 to clear).
+        pub intstatus: RW<u32>,
+    }
+
+    const _: () = {
+        assert!(offset_of!(RegisterBlock, ctrl) == 0x0);
+        assert!(offset_of!(RegisterBlock, value) == 0x4);
+        assert!(offset_of!(RegisterBlock, reload) == 0x8);
+        assert!(offset_of!(RegisterBlock, intstatus) == 0xC);
+        assert!(size_of::<RegisterBlock>() == 0x10);
+    };
+
+    /// CTRL: counter enable.
+    pub const CTRL_EN: u32 = 1 << 0;
+}
+
+/// The register block `B` of the peripheral instance at `ADDR`: a zero-sized handle that
+/// dereferences to the block, as `cortex-m`'s `SYST` or `NVIC` do. Only its constructor is
+/// `unsafe`; reads through it are safe, writes are `volatile_register`'s `unsafe` ones.
+pub struct Peripheral<B, const ADDR: usize> {
+    // `B` holds `UnsafeCell`s: the handle is `Send` (a driver can move into the
+    // receive interrupt's static) but not `Sync`.
+    _block: PhantomData<B>,
+}
+
+impl<B, const ADDR: usize> Peripheral<B, ADDR> {
+    /// The block's address.
+    const PTR: *const B = {
+        assert!(ADDR != 0 && ADDR.is_multiple_of(core::mem::align_of::<B>()));
+        ADDR as *const B
+    };
+
+    /// The handle.
+    ///
+    /// # Safety
+    /// A `B` must be mapped at `ADDR` for the whole program (a device's registers, not
+    /// memory Rust owns), and the caller must own the registers it uses through the
+    /// handle: no other code writes them meanwhile (two handles to one block may split
+    /// its registers between them, as the UART's transmitter and receiver do).
+    pub const unsafe fn new() -> Self {
+        // Evaluated here, so that a misaligned or null address fails the build.
+        let _ = Self::PTR;
+        Peripheral {
+            _block: PhantomData,
+        }
+    }
+}
+
+impl<B, const ADDR: usize> Deref for Peripheral<B, ADDR> {
+    type Target = B;
+
+    fn deref(&self) -> &B {
+        // SAFETY: `new`'s contract: a `B` is mapped at `ADDR` (aligned and non-null,
+        // checked at compile time) for the program's life. Its registers are volatile
+        // cells, so a shared reference allows exactly the volatile accesses the drivers
+        // make.
+        unsafe { &*Self::PTR }
+    }
+}
+
+/// The registers of the CMSDK APB UART at `ADDR`.
+pub type UartRegisters<const ADDR: usize> = Peripheral<uart::RegisterBlock, ADDR>;
+/// The registers of the CMSDK APB timer at `ADDR`.
+pub type TimerRegisters<const ADDR: usize> = Peripheral<timer::RegisterBlock, ADDR>;
+
+/// A CMSDK APB UART at `ADDR`, the loop's side: the transmitter, and the receive queue
+/// that the receive interrupt (line `I`) fills.
+pub struct Uart<const ADDR: usize, I> {
+    /// Used for DATA writes and STATE.TXFULL only; the receive registers are the
+    /// interrupt's ([`UartRx`]).
+    tx: UartRegisters<ADDR>,
+    rx: RxQueue<I>,
+}
+
+/// The receiver of the UART at `ADDR`, read by the receive interrupt only: DATA reads,
+/// STATE's receive bits, INTSTATUS (the transmitter's DATA writes and STATE.TXFULL are
+/// the loop's; the status bits are write-1-to-clear, so the two sides never undo each
+/// other's writes).
+pub struct UartRx<const ADDR: usize> {
+    regs: UartRegisters<ADDR>,
+}
+
+impl<const ADDR: usize, I: InterruptNumber> Uart<ADDR, I> {
+    /// The UART, enabled for transmit and receive at `baud` (8N1) from the APB clock
+    /// `pclk_hz`, its receive interrupt `line` feeding the receive queue through
+    /// `handler` (the line's interrupt handler must call `handler.run()`). None if the
+    /// queue was taken before.
+    ///
+    /// # Safety
+    /// A CMSDK APB UART must be mapped at `ADDR`, and the caller must be its only owner.
+    pub unsafe fn start(
+        pclk_hz: u32,
+        baud: u32,
+        handler: &'static rx::Handler<UartRx<ADDR>, I>,
+        line: I,
+    ) -> Option<Self> {
+        // SAFETY: the caller's contract; this handle and the receiver's below split the
+        // UART's registers as their types document.
+        let (tx, regs) = unsafe { (UartRegisters::new(), UartRegisters::new()) };
+        let div = (pclk_hz / baud.max(1)).max(uart::BAUDDIV_MIN);
+        // SAFETY: a divider of at least the minimum sets the bit rate, nothing else; the
+        // enables start the transmitter and the receiver with its interrupt, whose
+        // handler (`handler`) is installed, before the line is unmasked, by `rx::start`.
+        unsafe {
+            tx.bauddiv.write(div);
+            tx.ctrl
+                .write(uart::CTRL_TX_EN | uart::CTRL_RX_EN | uart::CTRL_RX_INTEN);
+        }
+        let rx = rx::start(handler, UartRx { regs }, line)?;
+        Some(Uart { tx, rx })
+    }
+}
+
+impl<const ADDR: usize, I> ErrorType for Uart<ADDR, I> {
+    type Error = LinkError;
+}
+
+impl<const ADDR: usize, I: InterruptNumber> Read<u8> for Uart<ADDR, I> {
+    fn read(&mut self) -> nb::Result<u8, LinkError> {
+        self.rx.read()
+    }
+}
+
+impl<const ADDR: usize, I: InterruptNumber> Write<u8> for Uart<ADDR, I> {
+    fn write(&mut self, byte: u8) -> nb::Result<(), LinkError> {
+        self.flush()?;
+        // SAFETY: the transmit buffer is empty (`flush`): DATA takes the byte to send.
+        unsafe { self.tx.data.write(u32::from(byte)) };
+        Ok(())
+    }
+
+    /// Done when the one-byte transmit buffer is empty.
+    fn flush(&mut self) -> nb::Result<(), LinkError> {
+        if self.tx.state.read() & uart::STATE_TX_FULL == 0 {
+            Ok(())
+        } else {
+            Err(nb::Error::WouldBlock)
+        }
+    }
+}
+
+impl<const ADDR: usize, I: InterruptNumber> RxWait for Uart<ADDR, I> {
+    fn wait_for_rx(&mut self) {
+        self.rx.wait();
+    }
+}
+
+impl<const ADDR: usize> ErrorType for UartRx<ADDR> {
+    type Error = ErrorKind;
+}
+
+impl<const ADDR: usize> Read<u8> for UartRx<ADDR> {
+    /// The received byte; an overrun (a byte lost because the previous one was not read
+    /// in time: never under QEMU, whose UART is flow-controlled) is reported once, then
+    /// the byte that is there is read. The receive interrupt's status is cleared first,
+    /// so a byte that arrives after this read raises it again.
+    fn read(&mut self) -> nb::Result<u8, ErrorKind> {
+        // SAFETY: writing 1 clears the receive interrupt's status bit, the other bits
+        // written 0 are left alone.
+        unsafe { self.regs.intstatus.write(uart::INT_RX) };
+        let state = self.regs.state.read();
+        if state & uart::STATE_RX_OVERRUN != 0 {
+            // SAFETY: writing 1 clears the receive overrun flag, the other bits written
+            // 0 (the transmitter's included) are left alone.
+            unsafe { self.regs.state.write(uart::STATE_RX_OVERRUN) };
+            return Err(nb::Error::Other(ErrorKind::Overrun));
+        }
+        if state & uart::STATE_RX_FULL == 0 {
+            return Err(nb::Error::WouldBlock);
+        }
+        Ok(self.regs.data.read() as u8)
+    }
+}
+
+/// A CMSDK APB timer at `ADDR` as a line clock: a 32-bit down-counter on the APB clock
+/// that reloads from RELOAD when it reaches zero (one period = RELOAD + 1 clock cycles).
+pub struct Timer<const ADDR: usize> {
+    regs: TimerRegisters<ADDR>,
+}
+
+impl<const ADDR: usize> Timer<ADDR> {
+    /// The timer, stopped until its first period is set.
+    ///
+    /// # Safety
+    /// A CMSDK APB timer must be mapped at `ADDR`, and the caller must be its only owner.
+    pub unsafe fn stopped() -> Self {
+        // SAFETY: the caller's contract.
+        let regs = unsafe { TimerRegisters::new() };
+        // SAFETY: CTRL 0 stops the counter, with its interrupt disabled.
+        unsafe { regs.ctrl.write(0) };
+        Timer { regs }
+    }
+}
+
+impl<const ADDR: usize> ReloadRegister for Timer<ADDR> {
+    /// Sets the period; the first one also starts the counter (a running counter with
+    /// RELOAD 0 would have no period).
+    fn set_reload(&mut self, value: u32) {
+        // SAFETY: RELOAD takes any 32-bit value; CTRL_EN alone starts the counter on the
+        // APB clock with its interrupt disabled.
+        unsafe {
+            self.regs.reload.write(value);
+            if self.regs.ctrl.read() & timer::CTRL_EN == 0 {
+                self.regs.ctrl.write(timer::CTRL_EN);
+            }
+        }
+    }
+    fn reload(&self) -> u32 {
+        self.regs.reload.read()
+    }
+}
+
+/// A CMSDK APB timer at `ADDR` counting down from 2^32 - 1 on the APB clock of
+/// `PCLK_HZ`, round and round (it wraps every 2^32 ticks), as a [`Monotonic`]. Under
+/// QEMU it runs on the virtual clock, which without `-icount` follows the host's.
+pub struct FreeRunning<const ADDR: usize, const PCLK_HZ: u32> {
+    regs: TimerRegisters<ADDR>,
+    ticks: Extended,
+}
+
+impl<const ADDR: usize, const PCLK_HZ: u32> FreeRunning<ADDR, PCLK_HZ> {
+    /// APB clock ticks per microsecond (a whole number, at least 1: checked when built).
+    const TICKS_PER_US: u64 = {
+        assert!(PCLK_HZ >= 1_000_000 && PCLK_HZ.is_multiple_of(1_000_000));
+        PCLK_HZ as u64 / 1_000_000
+    };
+
+    /// The timer, started.
+    ///
+    /// # Safety
+    /// A CMSDK APB timer must be mapped at `ADDR`, and the caller must be its only owner.
+    pub unsafe fn start() -> Self {
+        // SAFETY: the caller's contract.
+        let regs = unsafe { TimerRegisters::new() };
+        // SAFETY: stopped, then the full 32-bit range loaded into RELOAD and VALUE, then
+        // started on the APB clock with its interrupt disabled.
+        unsafe {
+            regs.ctrl.write(0);
+            regs.reload.write(u32::MAX);
+            regs.value.write(u32::MAX);
+            regs.ctrl.write(timer::CTRL_EN);
+        }
+        let ticks = Extended::new(1 << 32, Self::elapsed(&regs));
+        FreeRunning { regs, ticks }
+    }
+
+    /// Ticks since the count started, modulo 2^32 (the counter counts down).
+    fn elapsed(regs: &timer::RegisterBlock) -> u32 {
+        !regs.value.read()
+    }
+}
+
+impl<const ADDR: usize, const PCLK_HZ: u32> Monotonic for FreeRunning<ADDR, PCLK_HZ> {
+    fn now_us(&mut self) -> u64 {
+        let ticks = self.ticks.update(Self::elapsed(&self.regs));
+        ticks / Self::TICKS_PER_US
+    }
+}
