@@ -36,6 +36,12 @@ pub enum Param {
     LeapSeconds,
     /// UT1 - UTC, `dut1_s`.
     Dut1,
+    /// A geodetic latitude.
+    Latitude,
+    /// A geodetic longitude.
+    Longitude,
+    /// A geodetic height above the ellipsoid.
+    Height,
 }
 
 impl Param {
@@ -69,6 +75,9 @@ impl Param {
             Param::GpsTime => "gps_time",
             Param::LeapSeconds => "leap_seconds",
             Param::Dut1 => "dut1",
+            Param::Latitude => "latitude",
+            Param::Longitude => "longitude",
+            Param::Height => "height",
         }
     }
 }

@@ -1,7 +1,7 @@
 //! The satellite bus's frames (`core_math::earth::frames`) against ERFA (pyerfa), the
 //! goldens of `tools/goldens/erfa_frames.py` in `tests/data/`: C2T against
-//! `eraC2t06a(TT, UT1, 0, 0)` and each of its pieces against its ERFA routine; the typed
-//! refusals.
+//! `eraC2t06a(TT, UT1, 0, 0)` and each of its pieces against its ERFA routine; geodetic
+//! conversions against `eraGd2gce` / `eraGc2gde` and by round trip; the typed refusals.
 //!
 //! `cargo test --release -p core-math --test frames -- --nocapture` prints the measured
 //! maxima quoted in `docs/earth-model.md`, "Earth orientation (Part II)".
@@ -9,13 +9,18 @@
 use core_math::earth::frames::cio::{s06, S06_TRUNCATION_BOUND_RAD};
 use core_math::earth::frames::era::{era00, sp00};
 use core_math::earth::frames::fw::{fw2m, pfw06};
+use core_math::earth::frames::geodetic::GEODETIC_MAX_FLATTENING;
 use core_math::earth::frames::nutation::{nut00b, nut06b};
 use core_math::earth::frames::time::{tt_from_gps_s, ut1_from_gps_s, GPS_S_MAX, JD_J2000};
-use core_math::earth::frames::{c2t, c2t_from_cio, Mat3, TimeScales, C2T_TOLERANCE_RAD};
+use core_math::earth::frames::{
+    c2t, c2t_from_cio, geodetic_from_itrf, itrf_from_geodetic, Mat3, TimeScales, C2T_TOLERANCE_RAD,
+};
 use core_math::sample::SplitMix64;
-use core_math::{ModelError, Param};
+use core_math::{Ellipsoid, ModelError, Param};
+use std::f64::consts::{FRAC_PI_2, PI};
 
 const C2T_CSV: &str = include_str!("data/erfa_c2t.csv");
+const GEODETIC_CSV: &str = include_str!("data/erfa_geodetic.csv");
 
 /// The rows of a golden file as (header, fields), comments skipped.
 fn rows(csv: &str) -> (Vec<&str>, Vec<Vec<&str>>) {
@@ -34,6 +39,10 @@ impl Row<'_> {
     fn f(&self, name: &str) -> f64 {
         let i = self.head.iter().position(|h| *h == name).expect(name);
         self.fields[i].parse().expect(name)
+    }
+    fn s(&self, name: &str) -> &str {
+        let i = self.head.iter().position(|h| *h == name).expect(name);
+        self.fields[i]
     }
 }
 
@@ -308,4 +317,238 @@ fn tt_is_split_exactly_at_the_gps_epoch_and_j2000() {
     let tt = tt_from_gps_s(630_763_148.816).unwrap();
     assert_eq!(tt.whole_d, 0.0);
     assert!((tt.frac_d * 86_400.0).abs() <= 6.0e-8, "{}", tt.frac_d);
+}
+
+fn ellipsoid(row: &Row) -> Ellipsoid {
+    Ellipsoid {
+        a_m: row.f("a_m"),
+        flattening: row.f("flattening"),
+    }
+}
+
+/// |a - b| reduced to (-pi, pi].
+fn dlon(a: f64, b: f64) -> f64 {
+    let d = (a - b).rem_euclid(2.0 * PI);
+    d.min(2.0 * PI - d)
+}
+
+#[test]
+fn geodetic_matches_erfa_gd2gce_and_gc2gde() {
+    let (head, data) = rows(GEODETIC_CSV);
+    assert!(data.len() >= 300);
+    let (mut fwd, mut lat_e, mut lon_e, mut h_e, mut vs_gc) =
+        (0.0f64, 0.0f64, 0.0f64, 0.0f64, 0.0f64);
+    let mut names = std::collections::BTreeSet::new();
+    for fields in &data {
+        let row = Row {
+            head: &head,
+            fields,
+        };
+        names.insert(row.s("ellipsoid").to_string());
+        let ell = ellipsoid(&row);
+        let (lat, lon, h) = (row.f("lat_rad"), row.f("lon_rad"), row.f("h_m"));
+        let xyz = [row.f("x_m"), row.f("y_m"), row.f("z_m")];
+        let ours = itrf_from_geodetic(lat, lon, h, &ell).unwrap();
+        let d =
+            ((ours[0] - xyz[0]).powi(2) + (ours[1] - xyz[1]).powi(2) + (ours[2] - xyz[2]).powi(2))
+                .sqrt();
+        fwd = fwd.max(d);
+        let (la, lo, hh) = geodetic_from_itrf(xyz, &ell).unwrap();
+        lat_e = lat_e.max((la - lat).abs());
+        h_e = h_e.max((hh - h).abs());
+        // Longitude is only defined off the axis: there its error moves the point by
+        // rho dlon (m), below 1e-4 m (the golden x, y at a pole are 1e-10 m).
+        let rho = xyz[0].hypot(xyz[1]);
+        lon_e = lon_e.max(rho * dlon(lo, lon));
+        let (gla, glo, gh) = (
+            row.f("gc2gde_lat_rad"),
+            row.f("gc2gde_lon_rad"),
+            row.f("gc2gde_h_m"),
+        );
+        vs_gc = vs_gc
+            .max((la - gla).abs())
+            .max(rho * dlon(lo, glo) / ell.a_m)
+            .max((hh - gh).abs() / ell.a_m);
+    }
+    println!(
+        "geodetic vs ERFA over {} rows ({names:?}): itrf_from_geodetic vs eraGd2gce {fwd:.2e} m; \
+         geodetic_from_itrf of eraGd2gce's points: lat {lat_e:.2e} rad, lon {lon_e:.2e} m along \
+         the parallel, h {h_e:.2e} m; vs eraGc2gde {vs_gc:.2e} (rad, or m / a)",
+        data.len()
+    );
+    assert_eq!(names.len(), 3);
+    assert!(fwd <= 1.0e-4, "{fwd:e}");
+    assert!(lat_e <= 1.0e-9, "{lat_e:e}");
+    assert!(lon_e <= 1.0e-4, "{lon_e:e}");
+    assert!(h_e <= 1.0e-4, "{h_e:e}");
+    assert!(vs_gc <= 1.0e-9, "{vs_gc:e}");
+}
+
+#[test]
+fn geodetic_round_trips() {
+    let mut rng = SplitMix64(2023);
+    let ells = [
+        Ellipsoid::WGS84,
+        Ellipsoid {
+            a_m: 6_378_245.0,
+            flattening: 1.0 / 298.3,
+        },
+        Ellipsoid {
+            a_m: 3_396_190.0,
+            flattening: GEODETIC_MAX_FLATTENING,
+        },
+    ];
+    let (mut dpos, mut dlat, mut dh) = (0.0f64, 0.0f64, 0.0f64);
+    for i in 0..30_000 {
+        let ell = ells[i % ells.len()];
+        let lat = match i % 50 {
+            0 => FRAC_PI_2,
+            1 => -FRAC_PI_2,
+            2 => 0.0,
+            _ => rng.uniform(-1.0, 1.0).asin(),
+        };
+        let lon = rng.uniform(-PI, PI);
+        let h = if i % 2 == 0 {
+            rng.uniform(-500.0, 2.0e6)
+        } else {
+            rng.uniform(-0.25 * ell.a_m, 4.0e7)
+        };
+        let r = itrf_from_geodetic(lat, lon, h, &ell).unwrap();
+        let (la, lo, hh) = geodetic_from_itrf(r, &ell).unwrap();
+        let back = itrf_from_geodetic(la, lo, hh, &ell).unwrap();
+        let d =
+            ((back[0] - r[0]).powi(2) + (back[1] - r[1]).powi(2) + (back[2] - r[2]).powi(2)).sqrt();
+        dpos = dpos.max(
+            d / (r[0] * r[0] + r[1] * r[1] + r[2] * r[2])
+                .sqrt()
+                .max(ell.a_m)
+                * ell.a_m,
+        );
+        dlat = dlat.max((la - lat).abs());
+        dh = dh.max((hh - h).abs());
+    }
+    println!(
+        "geodetic round trips (30 000, h -a/4 .. 40 000 km): position {dpos:.2e} m (scaled to |r| = a \
+         beyond a), lat {dlat:.2e} rad, h {dh:.2e} m"
+    );
+    assert!(dpos <= 1.0e-4, "{dpos:e}");
+    assert!(dlat <= 1.0e-9, "{dlat:e}");
+    assert!(dh <= 1.0e-4, "{dh:e}");
+}
+
+#[test]
+fn geodetic_poles_and_axis() {
+    let e = Ellipsoid::WGS84;
+    let b = e.b_m();
+    for (z, lat) in [(b + 100.0, FRAC_PI_2), (-(b + 100.0), -FRAC_PI_2)] {
+        let (la, lo, h) = geodetic_from_itrf([0.0, 0.0, z], &e).unwrap();
+        assert_eq!((la, lo), (lat, 0.0));
+        assert!((h - 100.0).abs() < 1e-8, "{h}");
+    }
+    let (la, lo, h) = geodetic_from_itrf([e.a_m + 5.0, 0.0, 0.0], &e).unwrap();
+    assert_eq!((la, lo), (0.0, 0.0));
+    assert!((h - 5.0).abs() < 1e-8, "{h}");
+    let (_, lo, _) = geodetic_from_itrf([-e.a_m, 0.0, 0.0], &e).unwrap();
+    assert_eq!(lo, PI);
+}
+
+#[test]
+fn geodetic_refusals_are_typed() {
+    let e = Ellipsoid::WGS84;
+    for (r, err) in [
+        ([0.0, 0.0, 0.0], ModelError::OutOfDomain(Param::Position)),
+        (
+            [1.0e6, 0.0, 1.0e6],
+            ModelError::OutOfDomain(Param::Position),
+        ),
+        ([f64::NAN, 0.0, 7e6], ModelError::NonFinite(Param::Position)),
+        (
+            [0.0, f64::INFINITY, 7e6],
+            ModelError::NonFinite(Param::Position),
+        ),
+        ([2.0e9, 0.0, 0.0], ModelError::OutOfDomain(Param::Position)),
+    ] {
+        assert_eq!(geodetic_from_itrf(r, &e), Err(err), "{r:?}");
+    }
+    let r = [7.0e6, 0.0, 0.0];
+    for (ell, err) in [
+        (
+            Ellipsoid {
+                a_m: f64::NAN,
+                flattening: 0.0,
+            },
+            ModelError::NonFinite(Param::SemiMajorAxis),
+        ),
+        (
+            Ellipsoid {
+                a_m: 6.4e6,
+                flattening: f64::NAN,
+            },
+            ModelError::NonFinite(Param::Flattening),
+        ),
+        (
+            Ellipsoid {
+                a_m: 0.0,
+                flattening: 0.0,
+            },
+            ModelError::InvalidInput(Param::SemiMajorAxis),
+        ),
+        (
+            Ellipsoid {
+                a_m: 6.4e6,
+                flattening: -0.1,
+            },
+            ModelError::InvalidInput(Param::Flattening),
+        ),
+        (
+            Ellipsoid {
+                a_m: 6.4e6,
+                flattening: 1.0,
+            },
+            ModelError::InvalidInput(Param::Flattening),
+        ),
+        (
+            Ellipsoid {
+                a_m: 6.4e6,
+                flattening: 0.2,
+            },
+            ModelError::OutOfDomain(Param::Flattening),
+        ),
+        (
+            Ellipsoid {
+                a_m: 1.0,
+                flattening: 0.0,
+            },
+            ModelError::OutOfDomain(Param::SemiMajorAxis),
+        ),
+    ] {
+        assert_eq!(geodetic_from_itrf(r, &ell), Err(err), "{ell:?}");
+        assert_eq!(itrf_from_geodetic(0.0, 0.0, 0.0, &ell), Err(err), "{ell:?}");
+    }
+    for (lat, lon, h, err) in [
+        (f64::NAN, 0.0, 0.0, ModelError::NonFinite(Param::Latitude)),
+        (
+            0.0,
+            f64::INFINITY,
+            0.0,
+            ModelError::NonFinite(Param::Longitude),
+        ),
+        (0.0, 0.0, f64::NAN, ModelError::NonFinite(Param::Height)),
+        (1.6, 0.0, 0.0, ModelError::InvalidInput(Param::Latitude)),
+        (-1.6, 0.0, 0.0, ModelError::InvalidInput(Param::Latitude)),
+        (0.0, 7.0, 0.0, ModelError::OutOfDomain(Param::Longitude)),
+        (
+            0.0,
+            0.0,
+            -0.26 * e.a_m,
+            ModelError::OutOfDomain(Param::Height),
+        ),
+        (0.0, 0.0, 2.0e9, ModelError::OutOfDomain(Param::Height)),
+    ] {
+        assert_eq!(
+            itrf_from_geodetic(lat, lon, h, &e),
+            Err(err),
+            "{lat} {lon} {h}"
+        );
+    }
 }

@@ -1,6 +1,6 @@
 //! The satellite bus's own frames (`shared/EARTH-MODEL.md`, Part II): GPS time to TT and
-//! UT1, the celestial-to-terrestrial matrix C2T (GCRF to ITRF, polar motion zero).
-//! Building blocks only: f64, `libm`, no allocation, every
+//! UT1, the celestial-to-terrestrial matrix C2T (GCRF to ITRF, polar motion zero), and
+//! exact geodetic coordinates. Building blocks only: f64, `libm`, no allocation, every
 //! refusal a [`crate::ModelError`].
 //!
 //! One file per family of functions, each following a SOFA routine (cited on each
@@ -12,17 +12,21 @@
 //! - [`cio`]: the CIO locator s (`iauS06`, truncated below 1 microarcsecond);
 //! - [`era`]: the Earth rotation angle (`iauEra00`) and the TIO locator s' (`iauSp00`);
 //! - [`c2t`]: the matrix itself (`iauC2ixys`, `iauC2tcio`, as `iauC2t06a`), with its
-//!   documented error [`C2T_TOLERANCE_RAD`] against `iauC2t06a`.
+//!   documented error [`C2T_TOLERANCE_RAD`] against `iauC2t06a`;
+//! - [`geodetic`]: geodetic latitude, longitude and height from ITRF positions
+//!   (Vermeille's closed form) and back (as `iauGd2gce`).
 
 pub mod c2t;
 pub mod cio;
 pub mod era;
 pub mod fw;
+pub mod geodetic;
 pub mod nutation;
 mod rot;
 pub mod time;
 
 pub use c2t::{c2t, c2t_from_cio, c2t_from_dates, C2T_TOLERANCE_RAD};
+pub use geodetic::{geodetic_from_itrf, itrf_from_geodetic};
 pub use rot::Mat3;
 pub use time::{JulianDays, TimeScales};
 
