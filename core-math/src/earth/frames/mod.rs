@@ -11,7 +11,7 @@
 //! - [`nutation`]: IAU 2000B nutation, 77 luni-solar terms (`iauNut00b`);
 //! - [`cio`]: the CIO locator s (`iauS06`, truncated below 1 microarcsecond);
 //! - [`era`]: the Earth rotation angle (`iauEra00`) and the TIO locator s' (`iauSp00`);
-//! - [`c2t`]: the matrix itself (`iauC2ixys`, `iauC2tcio`, as `iauC2t06a`), with its
+//! - [`c2t`](mod@c2t): the matrix itself (`iauC2ixys`, `iauC2tcio`, as `iauC2t06a`), with its
 //!   documented error [`C2T_TOLERANCE_RAD`] against `iauC2t06a`;
 //! - [`geodetic`]: geodetic latitude, longitude and height from ITRF positions
 //!   (Vermeille's closed form) and back (as `iauGd2gce`).
