@@ -30,6 +30,18 @@ pub enum Param {
     FocalPlaneP1,
     /// The drift tangent v2 / v1 of the drift-smear MTF.
     Drift,
+    /// GPS time `gps_s` (Part II).
+    GpsTime,
+    /// GPS - UTC, the leap seconds `gps_utc_s`.
+    LeapSeconds,
+    /// UT1 - UTC, `dut1_s`.
+    Dut1,
+    /// A geodetic latitude.
+    Latitude,
+    /// A geodetic longitude.
+    Longitude,
+    /// A geodetic height above the ellipsoid.
+    Height,
 }
 
 impl Param {
@@ -60,6 +72,12 @@ impl Param {
             Param::Flattening => "flattening",
             Param::FocalPlaneP1 => "p1",
             Param::Drift => "drift",
+            Param::GpsTime => "gps_time",
+            Param::LeapSeconds => "leap_seconds",
+            Param::Dut1 => "dut1",
+            Param::Latitude => "latitude",
+            Param::Longitude => "longitude",
+            Param::Height => "height",
         }
     }
 }

@@ -25,6 +25,7 @@ use crate::orbit::StateVector;
 use crate::real::{Real, Scalar};
 use crate::vector::{cross, dot};
 
+pub mod frames;
 pub mod general;
 #[cfg(feature = "reference")]
 pub mod kepler;
