@@ -554,7 +554,7 @@ pub fn run(args: &Args) -> Result<(), String> {
         println!("{block}");
         println!("{costs_block}");
     } else {
-        let path = crate::target::workspace_root().join(DOC);
+        let path = crate::qemu::workspace_root().join(DOC);
         let doc = std::fs::read_to_string(&path).map_err(|e| format!("reading {DOC}: {e}"))?;
         let new =
             replace_block(&doc, &block).ok_or(format!("{DOC} lacks the ellipsoid markers"))?;

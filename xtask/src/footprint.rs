@@ -10,7 +10,7 @@ use std::path::Path;
 
 use object::{Object, ObjectSection, SectionFlags};
 
-use crate::target::build_bin_with;
+use crate::qemu::build_bin_with;
 
 /// Loadable bytes of the footprint binary built for `variant`.
 fn image_bytes(variant: &str) -> Result<u64, String> {

@@ -16,7 +16,7 @@ use std::time::Instant;
 
 use object::{Object, ObjectSection, ObjectSymbol, SectionKind, SymbolKind};
 
-use crate::target::{workspace_root, TARGET};
+use crate::qemu::{workspace_root, TARGET};
 
 /// The undefined function the check build's panic handlers call (firmware/src/platform.rs).
 const SYMBOL: &str = "NO_PANIC_CHECK__a_panic_path_is_reachable__see_docs_no_panic_md";

@@ -358,7 +358,7 @@ pub struct Args {
 pub fn run(args: &Args) -> Result<(), String> {
     let dir = match &args.out {
         Some(dir) => dir.clone(),
-        None => crate::target::workspace_root().join("docs").join("paper"),
+        None => crate::qemu::workspace_root().join("docs").join("paper"),
     };
     std::fs::create_dir_all(&dir).map_err(|e| format!("creating {}: {e}", dir.display()))?;
     let mut out = Out {

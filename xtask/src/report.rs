@@ -11,7 +11,7 @@
 //! cases at least 1 deg from the limb, `max_rel_err_near_limb` over those within 1 deg.
 //!
 //! Run time: guest instructions on the Cortex-M4 under QEMU from `cargo xtask bench`
-//! (the same build, the same plugin, [`crate::target::bench_counts`]): per pixel, the
+//! (the same build, the same plugin, [`crate::qemu::bench_counts`]): per pixel, the
 //! count of `motion` over 32 pixels across the swath in a loop, divided by 32 (the
 //! marginal cost inside the loop the controller runs, without a one-pixel region's call
 //! and return); per update, `update` then `motion` at each of the default scene's
@@ -25,7 +25,7 @@ use core_math::{
     CLOSED_MICROMATH, FIXED,
 };
 
-use crate::target::{bench_counts, BenchCounts};
+use crate::qemu::{bench_counts, BenchCounts};
 use core_math::sample::SplitMix64 as Rng;
 
 const DEFAULT_CASES: usize = 200_000;
@@ -210,7 +210,7 @@ fn replace_table(doc: &str, rows: &[[String; 7]], trailer: &str) -> Option<Strin
 /// against log10 of its instructions per pixel. The reference is the golden source
 /// (error 0 by definition) and has no point on a log axis.
 fn write_artefacts(rows: &[[String; 7]], trailer: &str) -> Result<(), String> {
-    let root = crate::target::workspace_root();
+    let root = crate::qemu::workspace_root();
     let doc_path = root.join(DOC);
     let doc = std::fs::read_to_string(&doc_path).map_err(|e| format!("reading {DOC}: {e}"))?;
     let new_doc =

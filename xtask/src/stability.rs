@@ -78,7 +78,7 @@ pub fn run(args: &Args) -> Result<(), String> {
         values["G.samples"]
     );
     if !quick {
-        let root = crate::target::workspace_root();
+        let root = crate::qemu::workspace_root();
         let dir = root.join(PNG_DIR);
         std::fs::create_dir_all(&dir).map_err(|e| format!("creating {PNG_DIR}: {e}"))?;
         for (m, letter) in maps.iter().zip(LETTERS) {

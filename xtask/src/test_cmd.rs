@@ -2,7 +2,7 @@
 
 use std::process::Command;
 
-use crate::target::cargo;
+use crate::qemu::cargo;
 
 /// Runs a command with inherited output; an error names it and its status.
 pub fn run_step(program: &str, args: &[&str]) -> Result<(), String> {
@@ -22,13 +22,13 @@ pub fn run() -> Result<(), String> {
     let t0 = std::time::Instant::now();
     cargo(&["fmt", "--all", "--check"])?;
     // The default members are the host crates; the target crates are linted by
-    // `target::test_target` for thumbv7em.
+    // `qemu::test_target` for thumbv7em.
     cargo(&["clippy", "--all-targets", "--", "-D", "warnings"])?;
     // Host unit, property and golden tests; release, since the property tests evaluate
     // the reference chain tens of thousands of times.
     cargo(&["test", "--release"])?;
     derivation_check()?;
-    crate::target::test_target()?;
+    crate::qemu::test_target()?;
     crate::no_panic::check()?;
     eprintln!(
         "\nxtask test: all checks passed in {:.0} s",

@@ -36,7 +36,7 @@ use check::{Downlink, F32_REL_TOLERANCE};
 use scenario::Pass;
 
 use super::board::Board;
-use super::{build_board_bin, ensure_target_tools, qemu, workspace_root};
+use super::{build_board_bin, ensure_target_tools, runner, workspace_root};
 
 /// Segments shown in the table by default (first, one of the two central ones, last).
 pub const TABLE_SEGMENTS: [u8; 3] = [0, 5, 9];
@@ -404,7 +404,7 @@ fn run_qemu(elf: &Path, uplink: &[u8]) -> Result<(i32, Vec<u8>), String> {
     let listener = UnixListener::bind(&socket)
         .map_err(|e| format!("cannot listen on {}: {e}", socket.display()))?;
     let (link_ready, ready) = std::sync::mpsc::channel();
-    let options = qemu::Options {
+    let options = runner::Options {
         extra_args: vec![
             "-chardev".into(),
             format!("socket,id=telemetry,path={}", socket.display()),
@@ -415,7 +415,7 @@ fn run_qemu(elf: &Path, uplink: &[u8]) -> Result<(i32, Vec<u8>), String> {
         link_ready: Some(link_ready),
     };
     let elf_owned = elf.to_path_buf();
-    let emulator = std::thread::spawn(move || qemu::run_elf(&elf_owned, &options));
+    let emulator = std::thread::spawn(move || runner::run_elf(&elf_owned, &options));
 
     // QEMU connects as soon as it starts; give up if it ends first or takes too long.
     listener

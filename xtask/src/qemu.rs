@@ -1,5 +1,5 @@
-//! The on-target half of the xtask: the firmware under QEMU, the on-target tests, the
-//! instruction counts. See docs/target.md and docs/bench.md.
+//! The on-target half of the xtask (QEMU runs and boards): the firmware under QEMU, the
+//! on-target tests, the instruction counts. See docs/target.md and docs/bench.md.
 //!
 //! - `cargo xtask run [--board NAME]`: build the firmware (release) for a board
 //!   ([`board`]: `mps2-an386`, the default, or `stm32f405` on QEMU's netduinoplus2) and
@@ -19,7 +19,7 @@ mod board;
 mod flash;
 mod pass;
 mod profile;
-mod qemu;
+mod runner;
 mod tools;
 
 use std::path::{Path, PathBuf};
@@ -31,7 +31,7 @@ pub use board::{size, SizeArgs};
 use board::{Board, BoardArg};
 pub use flash::{flash, FlashArgs};
 pub use pass::e2e_test;
-pub use qemu::qemu;
+pub use runner::qemu;
 pub use tools::ensure_target_tools;
 
 /// The firmware's target: Cortex-M4F, hard-float ABI.
@@ -100,7 +100,7 @@ pub fn run(args: &RunArgs) -> Result<(), String> {
     if args.demo {
         ensure_target_tools()?;
         let elf = build_board_bin(board, "firmware", "demo", release, &[])?;
-        let outcome = qemu::run_elf(&elf, &qemu::Options::default())?;
+        let outcome = runner::run_elf(&elf, &runner::Options::default())?;
         return exit_like(outcome.status);
     }
     pass::run(&pass::RunOptions {

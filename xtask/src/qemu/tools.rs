@@ -106,13 +106,13 @@ pub(super) fn apt_install(packages: &[&str], why: &str) -> Result<(), String> {
 }
 
 fn ensure_qemu() -> Result<(), String> {
-    if !have(super::qemu::QEMU) {
+    if !have(super::runner::QEMU) {
         apt_install(&["qemu-system-arm"], "qemu-system-arm")?;
     }
-    let machines = Command::new(super::qemu::QEMU)
+    let machines = Command::new(super::runner::QEMU)
         .args(["-machine", "help"])
         .output()
-        .map_err(|e| format!("cannot run {}: {e}", super::qemu::QEMU))?;
+        .map_err(|e| format!("cannot run {}: {e}", super::runner::QEMU))?;
     let listed = String::from_utf8_lossy(&machines.stdout);
     let missing: Vec<&str> = Board::ALL
         .iter()
@@ -128,7 +128,7 @@ fn ensure_qemu() -> Result<(), String> {
     } else {
         Err(format!(
             "{} lacks the machine(s) {}: QEMU 6.0 or newer is needed",
-            super::qemu::QEMU,
+            super::runner::QEMU,
             missing.join(", ")
         ))
     }

@@ -13,7 +13,7 @@ use object::{Object, ObjectSymbol};
 
 use super::board::{Board, BoardArg};
 use super::profile;
-use super::{build_board_bin, ensure_target_tools, qemu, tools, workspace_root};
+use super::{build_board_bin, ensure_target_tools, runner, tools, workspace_root};
 
 const PLUGIN_SOURCE: &str = "tools/qemu-stopwatch/stopwatch.c";
 const LABEL_PREFIX: &str = "BENCH ";
@@ -123,14 +123,14 @@ fn measure_on(
         plugin_args += &format!(",profile={region},pcs={}", pcs_path.display());
     }
 
-    let options = qemu::Options {
+    let options = runner::Options {
         extra_args: vec!["-plugin".into(), plugin_args],
         capture: true,
         serial: None,
         log_to_stderr,
         link_ready: None,
     };
-    let outcome = qemu::run_elf(&elf, &options)?;
+    let outcome = runner::run_elf(&elf, &options)?;
     if outcome.status != 0 {
         return Err(format!(
             "the bench firmware exited with status {}",
@@ -209,7 +209,7 @@ fn marker_addresses(elf: &Path) -> Result<(u64, u64), String> {
 }
 
 fn qemu_version() -> String {
-    Command::new(qemu::QEMU)
+    Command::new(runner::QEMU)
         .arg("--version")
         .output()
         .ok()
