@@ -5,6 +5,7 @@
 
 mod earth;
 
+use anyhow::Result;
 use core_math::{Backend, Camera, Geometry, Reference, CLOSED_F32, CLOSED_F64};
 
 use crate::eval::Model;
@@ -53,7 +54,7 @@ pub struct Args {
     model: Model,
 }
 
-pub fn run(args: &Args) -> Result<(), String> {
+pub fn run(args: &Args) -> Result<()> {
     let quick = args.quick;
     if args.model == Model::Earth {
         return earth::run(quick);

@@ -9,6 +9,7 @@
 mod costs;
 mod motion;
 
+use anyhow::{anyhow, Context, Result};
 use std::time::Instant;
 
 use controller::Scene;
@@ -206,9 +207,9 @@ fn model_geometry(
     u_rad: f64,
     roll_rad: f64,
     radius_m: f64,
-) -> Result<Geometry<f64>, String> {
+) -> Result<Geometry<f64>> {
     let o = OrbitState::from_state(&orbit.state(u_rad), radius_m)
-        .map_err(|e| format!("ellipsoid: orbit state: {e:?}"))?;
+        .map_err(|e| anyhow!("ellipsoid: orbit state: {e:?}"))?;
     Ok(Geometry {
         roll_rad,
         inclination_rad: o.inclination_rad,
@@ -220,10 +221,10 @@ fn model_geometry(
     })
 }
 
-fn reference(camera: &Camera, g: &Geometry<f64>, n: f64) -> Result<ImageMotion<f64>, String> {
+fn reference(camera: &Camera, g: &Geometry<f64>, n: f64) -> Result<ImageMotion<f64>> {
     Reference
         .evaluate(camera, g, n)
-        .map_err(|e| format!("ellipsoid: reference at n {n}: {e:?}"))
+        .map_err(|e| anyhow!("ellipsoid: reference at n {n}: {e:?}"))
 }
 
 fn drift(m: &ImageMotion<f64>) -> f64 {
@@ -238,7 +239,7 @@ fn case(
     u_rad: f64,
     roll_rad: f64,
     n: f64,
-) -> Result<Errors, String> {
+) -> Result<Errors> {
     let scenario = |earth| Scenario {
         earth,
         earth_rate_rad_s: EARTH_RATE_RAD_S,
@@ -246,7 +247,7 @@ fn case(
         arg_latitude_rad: u_rad,
         roll_rad,
     };
-    let miss = || format!("ellipsoid: pixel {n} misses the Earth");
+    let miss = || anyhow!("ellipsoid: pixel {n} misses the Earth");
     let ell_full = scenario(Spheroid::WGS84)
         .image_motion(camera, n)
         .ok_or_else(miss)?;
@@ -273,9 +274,9 @@ fn case(
     // (the chain's frame G lifted by R, which is the orbit frame at t = 0).
     let px = Reference
         .pixel(camera, n)
-        .map_err(|e| format!("ellipsoid: pixel {n}: {e:?}"))?;
+        .map_err(|e| anyhow!("ellipsoid: pixel {n}: {e:?}"))?;
     let chain = Reference::chain(&g_local, &px)
-        .map_err(|e| format!("ellipsoid: reference at n {n}: {e:?}"))?;
+        .map_err(|e| anyhow!("ellipsoid: reference at n {n}: {e:?}"))?;
     let (_, e) = orbit.frame(u_rad);
     let up = g_local.earth_radius_m + chain.g_m[2];
     let ground: [f64; 3] = std::array::from_fn(|i| chain.g_m[1] * e[1][i] + up * e[2][i]);
@@ -289,7 +290,7 @@ fn case(
     let pixel = reference(camera, &g_pixel, n)?;
     let f32m = CLOSED_F32
         .evaluate(camera, &g_round.to::<f32>(), n)
-        .map_err(|e| format!("ellipsoid: f32 closed form at n {n}: {e:?}"))?;
+        .map_err(|e| anyhow!("ellipsoid: f32 closed form at n {n}: {e:?}"))?;
     let f32_speed = f64::from(f32m.speed_mps());
 
     let v_ell = ell.speed_mps();
@@ -310,7 +311,7 @@ fn case(
 
 /// The sweep: one orbit, rolls -25, 0, 25 deg, every active segment's first, middle and
 /// last pixel of the default scene.
-pub fn summary() -> Result<EllipsoidSummary, String> {
+pub fn summary() -> Result<EllipsoidSummary> {
     let scene = Scene::paper_default();
     let camera = scene.camera;
     // The round Earth of the paper's model (the controller's until issue 12).
@@ -383,7 +384,7 @@ pub fn summary() -> Result<EllipsoidSummary, String> {
     }
 
     let floor = f64::from(scene.mtf_floor);
-    let rule = StageRule::<f64>::new(floor).map_err(|e| format!("ellipsoid: {e:?}"))?;
+    let rule = StageRule::<f64>::new(floor).map_err(|e| anyhow!("ellipsoid: {e:?}"))?;
     let mtf = |e: f64| mtf_mismatch::<f64>(stages, e.abs()).unwrap_or(f64::NAN);
     Ok(EllipsoidSummary {
         worst_rel_err: all.round.worst,
@@ -421,10 +422,10 @@ fn signed(x: f64) -> String {
 }
 
 /// The markdown block between the doc's markers.
-fn render(s: &EllipsoidSummary) -> Result<String, String> {
+fn render(s: &EllipsoidSummary) -> Result<String> {
     let stages = s.stages;
     let mtf = |e: f64| mtf_mismatch::<f64>(stages, e.abs()).unwrap_or(f64::NAN);
-    let rule = StageRule::<f64>::new(s.mtf_floor).map_err(|e| format!("ellipsoid: {e:?}"))?;
+    let rule = StageRule::<f64>::new(s.mtf_floor).map_err(|e| anyhow!("ellipsoid: {e:?}"))?;
     let max_m = |e: f64| rule.max_stages(e.abs(), s.max_stages).unwrap_or(0);
     let (w, l, p, a) = (
         s.worst_rel_err,
@@ -543,7 +544,7 @@ pub struct Args {
     print: bool,
 }
 
-pub fn run(args: &Args) -> Result<(), String> {
+pub fn run(args: &Args) -> Result<()> {
     let print_only = args.print;
     let t0 = Instant::now();
     let s = summary()?;
@@ -555,12 +556,12 @@ pub fn run(args: &Args) -> Result<(), String> {
         println!("{costs_block}");
     } else {
         let path = crate::qemu::workspace_root().join(DOC);
-        let doc = std::fs::read_to_string(&path).map_err(|e| format!("reading {DOC}: {e}"))?;
-        let new =
-            replace_block(&doc, &block).ok_or(format!("{DOC} lacks the ellipsoid markers"))?;
+        let doc = std::fs::read_to_string(&path).with_context(|| format!("reading {DOC}"))?;
+        let new = replace_block(&doc, &block)
+            .with_context(|| format!("{DOC} lacks the ellipsoid markers"))?;
         let new = replace_between(&new, COSTS_BEGIN, COSTS_END, &costs_block)
-            .ok_or(format!("{DOC} lacks the ellipsoid-costs markers"))?;
-        std::fs::write(&path, new).map_err(|e| format!("writing {DOC}: {e}"))?;
+            .with_context(|| format!("{DOC} lacks the ellipsoid-costs markers"))?;
+        std::fs::write(&path, new).with_context(|| format!("writing {DOC}"))?;
         eprintln!("ellipsoid: wrote {DOC}");
     }
     println!("{}", s.line());

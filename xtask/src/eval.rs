@@ -5,6 +5,7 @@
 
 mod earth;
 
+use anyhow::{bail, Context, Result};
 use core_math::fixed_point::{geometry_from_f64, motion_to_f64};
 use core_math::{
     line_period_s, Backend, Camera, Geometry, ModelError, Real, Reference, CLOSED_F32, CLOSED_F64,
@@ -48,12 +49,12 @@ pub struct Args {
     input: String,
 }
 
-pub fn run(args: &Args) -> Result<(), String> {
+pub fn run(args: &Args) -> Result<()> {
     let (backend, input) = (&args.backend, &args.input);
     let text = if input == "-" {
-        std::io::read_to_string(std::io::stdin()).map_err(|e| format!("reading stdin: {e}"))?
+        std::io::read_to_string(std::io::stdin()).context("reading stdin")?
     } else {
-        std::fs::read_to_string(input).map_err(|e| format!("reading {input}: {e}"))?
+        std::fs::read_to_string(input).with_context(|| format!("reading {input}"))?
     };
     let out = match args.model {
         Model::Earth => earth::eval_csv(backend, &text)?,
@@ -64,7 +65,7 @@ pub fn run(args: &Args) -> Result<(), String> {
 }
 
 /// The whole command on a CSV text: one output row per input row, always.
-pub fn eval_csv(backend: &str, text: &str) -> Result<String, String> {
+pub fn eval_csv(backend: &str, text: &str) -> Result<String> {
     let table = Table::parse(text)?;
     let cols = table.columns(&INPUT_COLUMNS)?;
     write_rows(&table, &OUTPUT_COLUMNS, |row| {
@@ -87,7 +88,7 @@ fn write_rows<const N: usize>(
     table: &Table,
     outputs: &[&str],
     mut eval_row: impl FnMut(&[String]) -> Result<[String; N], EvalError>,
-) -> Result<String, String> {
+) -> Result<String> {
     let header: Vec<&str> = table
         .header
         .iter()
@@ -102,7 +103,7 @@ fn write_rows<const N: usize>(
             Err(EvalError::Unparsable) => {
                 (std::array::from_fn(|_| String::new()), "unparsable_input")
             }
-            Err(EvalError::Usage(msg)) => return Err(msg),
+            Err(EvalError::Usage(msg)) => bail!(msg),
         };
         let fields: Vec<&str> = row
             .iter()

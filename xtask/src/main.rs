@@ -12,9 +12,9 @@ mod footprint;
 mod no_panic;
 mod paper;
 mod plot;
+mod qemu;
 mod report;
 mod stability;
-mod qemu;
 mod test_cmd;
 
 use std::process::ExitCode;
@@ -86,7 +86,7 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("xtask: {e}");
+            eprintln!("xtask: {e:#}");
             ExitCode::FAILURE
         }
     }

@@ -22,6 +22,7 @@ mod profile;
 mod runner;
 mod tools;
 
+use anyhow::{anyhow, bail, Context, Result};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
@@ -78,7 +79,7 @@ pub struct RunArgs {
 #[derive(Clone, Debug)]
 pub struct Segments(Vec<u8>);
 
-fn parse_segments(v: &str) -> Result<Segments, String> {
+fn parse_segments(v: &str) -> Result<Segments> {
     if v == "all" {
         return Ok(Segments((0..16).collect()));
     }
@@ -86,12 +87,12 @@ fn parse_segments(v: &str) -> Result<Segments, String> {
         .map(|x| x.trim().parse::<u8>())
         .collect::<Result<_, _>>()
         .map(Segments)
-        .map_err(|_| format!("`{v}` is not a list of segment indices like 0,5,9"))
+        .map_err(|_| anyhow!("`{v}` is not a list of segment indices like 0,5,9"))
 }
 
 /// `cargo xtask run`: a pass through the firmware under QEMU (docs/telemetry.md), or the
 /// default-scene demo.
-pub fn run(args: &RunArgs) -> Result<(), String> {
+pub fn run(args: &RunArgs) -> Result<()> {
     let board = args.board.board;
     let release = !args.debug;
     if let Some(path) = &args.export_telemetry {
@@ -123,7 +124,7 @@ pub fn run(args: &RunArgs) -> Result<(), String> {
 /// too), and on thumbv7m (no FPU) for core-math's fixed-point backend; then, on each
 /// board's QEMU machine, the hil-tests in the test (dev) and release profiles and the
 /// end-to-end pass test ([`e2e_test`]).
-pub fn test_target() -> Result<(), String> {
+pub fn test_target() -> Result<()> {
     let started = Instant::now();
     ensure_target_tools()?;
     // core-math with its default backends and as the lean flight build links it (the
@@ -205,16 +206,16 @@ fn cargo_command() -> Command {
 }
 
 /// Runs cargo with `args` in the workspace root; an error if it fails.
-pub(crate) fn cargo(args: &[&str]) -> Result<(), String> {
+pub(crate) fn cargo(args: &[&str]) -> Result<()> {
     eprintln!("xtask: cargo {}", args.join(" "));
     let status = cargo_command()
         .args(args)
         .status()
-        .map_err(|e| format!("cannot start cargo: {e}"))?;
+        .context("cannot start cargo")?;
     if status.success() {
         Ok(())
     } else {
-        Err(format!("`cargo {}` failed ({status})", args.join(" ")))
+        Err(anyhow!("`cargo {}` failed ({status})", args.join(" ")))
     }
 }
 
@@ -222,10 +223,11 @@ pub(crate) fn cargo(args: &[&str]) -> Result<(), String> {
 /// cargo runs QEMU without building anything else (no nested cargo). Cargo splits a
 /// runner string at spaces (and cannot merge an array into the config's string), so a
 /// binary whose path has whitespace keeps the configured `tools/qemu-runner` instead.
-fn runner_config() -> Result<Vec<String>, String> {
-    let exe =
-        std::env::current_exe().map_err(|e| format!("cannot locate the xtask binary: {e}"))?;
-    let exe = exe.to_str().ok_or("the xtask binary's path is not UTF-8")?;
+fn runner_config() -> Result<Vec<String>> {
+    let exe = std::env::current_exe().context("cannot locate the xtask binary")?;
+    let exe = exe
+        .to_str()
+        .context("the xtask binary's path is not UTF-8")?;
     if exe.chars().any(char::is_whitespace) {
         return Ok(Vec::new());
     }
@@ -244,7 +246,7 @@ fn build_board_bin(
     bin: &str,
     release: bool,
     features: &[&str],
-) -> Result<PathBuf, String> {
+) -> Result<PathBuf> {
     build_elf(board, package, bin, release, features, &[])
 }
 
@@ -256,7 +258,7 @@ pub(crate) fn build_bin_with(
     release: bool,
     features: &[&str],
     rustc_args: &[&str],
-) -> Result<PathBuf, String> {
+) -> Result<PathBuf> {
     build_elf(Board::DEFAULT, package, bin, release, features, rustc_args)
 }
 
@@ -267,7 +269,7 @@ fn build_elf(
     release: bool,
     features: &[&str],
     rustc_args: &[&str],
-) -> Result<PathBuf, String> {
+) -> Result<PathBuf> {
     let subcommand = if rustc_args.is_empty() {
         "build"
     } else {
@@ -298,9 +300,9 @@ fn build_elf(
         .args(&args)
         .stderr(std::process::Stdio::inherit())
         .output()
-        .map_err(|e| format!("cannot start cargo: {e}"))?;
+        .context("cannot start cargo")?;
     if !out.status.success() {
-        return Err(format!("building `{bin}` failed ({})", out.status));
+        bail!("building `{bin}` failed ({})", out.status);
     }
     let stdout = String::from_utf8_lossy(&out.stdout);
     let mut elf = None;
@@ -314,11 +316,11 @@ fn build_elf(
             }
         }
     }
-    elf.ok_or_else(|| format!("cargo reported no executable for `{bin}`"))
+    elf.with_context(|| format!("cargo reported no executable for `{bin}`"))
 }
 
 /// Ends the process with the firmware's exit status (0 returns normally).
-fn exit_like(status: i32) -> Result<(), String> {
+fn exit_like(status: i32) -> Result<()> {
     if status == 0 {
         Ok(())
     } else {

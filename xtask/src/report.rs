@@ -19,6 +19,7 @@
 //!
 //! `flash_bytes`: [`crate::footprint`], one link per backend.
 
+use anyhow::{anyhow, Context, Result};
 use core_math::fixed_point::{geometry_from_f64, motion_to_f64};
 use core_math::{
     Backend, Camera, Geometry, MicroF32, NaiveF32, Reference, CLOSED_F32, CLOSED_F64,
@@ -148,7 +149,7 @@ pub struct Args {
     no_bench: bool,
 }
 
-pub fn run(args: &Args) -> Result<(), String> {
+pub fn run(args: &Args) -> Result<()> {
     let (csv, bench, cases) = (args.csv, !args.no_bench, args.cases);
     let seed = args.seed.unwrap_or(DEFAULT_SEED);
     let sample = sweep(seed, cases);
@@ -209,13 +210,13 @@ fn replace_table(doc: &str, rows: &[[String; 7]], trailer: &str) -> Option<Strin
 /// worst error at least 1 deg from the limb (a cross) and within 1 deg (a slash, dashed)
 /// against log10 of its instructions per pixel. The reference is the golden source
 /// (error 0 by definition) and has no point on a log axis.
-fn write_artefacts(rows: &[[String; 7]], trailer: &str) -> Result<(), String> {
+fn write_artefacts(rows: &[[String; 7]], trailer: &str) -> Result<()> {
     let root = crate::qemu::workspace_root();
     let doc_path = root.join(DOC);
-    let doc = std::fs::read_to_string(&doc_path).map_err(|e| format!("reading {DOC}: {e}"))?;
-    let new_doc =
-        replace_table(&doc, rows, trailer).ok_or(format!("{DOC} lacks the report markers"))?;
-    std::fs::write(&doc_path, new_doc).map_err(|e| format!("writing {DOC}: {e}"))?;
+    let doc = std::fs::read_to_string(&doc_path).with_context(|| format!("reading {DOC}"))?;
+    let new_doc = replace_table(&doc, rows, trailer)
+        .with_context(|| format!("{DOC} lacks the report markers"))?;
+    std::fs::write(&doc_path, new_doc).with_context(|| format!("writing {DOC}"))?;
     let mut plot = crate::plot::Plot::new(
         "Error against run time, per backend (Cortex-M4 under QEMU)",
         "log10 instructions per pixel",
@@ -250,19 +251,19 @@ fn write_artefacts(rows: &[[String; 7]], trailer: &str) -> Result<(), String> {
     Ok(())
 }
 
-fn parse_seed(v: &str) -> Result<u64, String> {
+fn parse_seed(v: &str) -> Result<u64> {
     match v.strip_prefix("0x") {
         Some(hex) => u64::from_str_radix(&hex.replace('_', ""), 16),
         None => v.parse(),
     }
-    .map_err(|e| format!("not a decimal or 0x hex integer: {e}"))
+    .map_err(|e| anyhow!("not a decimal or 0x hex integer: {e}"))
 }
 
-fn positive(v: &str) -> Result<usize, String> {
+fn positive(v: &str) -> Result<usize> {
     v.parse()
         .ok()
         .filter(|&n| n > 0)
-        .ok_or_else(|| "not a positive count".to_string())
+        .ok_or_else(|| anyhow!("not a positive count"))
 }
 
 /// One case whose line of sight meets the Earth (per the reference), geometry rounded to
@@ -421,7 +422,7 @@ fn print_table(
     flash: Option<&[u64]>,
     csv: bool,
     seed: u64,
-) -> Result<Vec<[String; 7]>, String> {
+) -> Result<Vec<[String; 7]>> {
     let notes = format!(
         "{} cases (seed {seed:#x}), {} within {NEAR_LIMB_DEG} deg of the limb; errors of |v_P| \
          relative to the f64 reference chain (reference: 0 by definition); earth rows: {} \
@@ -447,13 +448,13 @@ fn print_table(
             .get(((far.len().max(1) - 1) as f64 * 0.99).round() as usize)
             .copied()
             .unwrap_or(0.0);
-        let count = |label: &str| -> Result<Option<u64>, String> {
+        let count = |label: &str| -> Result<Option<u64>> {
             match counts {
                 None => Ok(None),
                 Some(c) => c
                     .net(label)
                     .map(Some)
-                    .ok_or_else(|| format!("report: no bench region `{label}`")),
+                    .with_context(|| format!("report: no bench region `{label}`")),
             }
         };
         let per_pixel = count(v.loop_label)?.map_or(String::new(), |n| {

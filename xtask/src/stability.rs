@@ -15,6 +15,7 @@ mod general;
 mod maps;
 mod point;
 
+use anyhow::{anyhow, Context, Result};
 use std::collections::BTreeMap;
 use std::time::Instant;
 
@@ -58,7 +59,7 @@ pub struct Args {
     quick: bool,
 }
 
-pub fn run(args: &Args) -> Result<(), String> {
+pub fn run(args: &Args) -> Result<()> {
     let quick = args.quick;
     let t0 = Instant::now();
     let maps = sweep_all(if quick { Some(QUICK) } else { None });
@@ -80,7 +81,7 @@ pub fn run(args: &Args) -> Result<(), String> {
     if !quick {
         let root = crate::qemu::workspace_root();
         let dir = root.join(PNG_DIR);
-        std::fs::create_dir_all(&dir).map_err(|e| format!("creating {PNG_DIR}: {e}"))?;
+        std::fs::create_dir_all(&dir).with_context(|| format!("creating {PNG_DIR}"))?;
         for (m, letter) in maps.iter().zip(LETTERS) {
             doc::write_pngs(m, letter, &dir)?;
         }
@@ -88,7 +89,7 @@ pub fn run(args: &Args) -> Result<(), String> {
             general::write_pngs(m, &dir)?;
         }
         let text = doc::fill(TEMPLATE, &values)?;
-        std::fs::write(root.join(DOC), text).map_err(|e| format!("writing {DOC}: {e}"))?;
+        std::fs::write(root.join(DOC), text).with_context(|| format!("writing {DOC}"))?;
         eprintln!("stability: wrote {DOC} and the maps under {PNG_DIR}/");
     }
     let bad = general::check_bounds(&gmaps);
@@ -96,7 +97,7 @@ pub fn run(args: &Args) -> Result<(), String> {
     if bad.is_empty() {
         Ok(())
     } else {
-        Err(format!(
+        Err(anyhow!(
             "general model: stability bound broken:\n{}",
             bad.join("\n")
         ))
@@ -105,7 +106,7 @@ pub fn run(args: &Args) -> Result<(), String> {
 
 /// Err if any sample of any map breaks the stated bounds, or a backend refused a case
 /// the reference accepts.
-pub fn check_bounds(maps: &[Map]) -> Result<(), String> {
+pub fn check_bounds(maps: &[Map]) -> Result<()> {
     let mut bad = Vec::new();
     for m in maps {
         let a = aggregate(m, |_, _, _| true);
@@ -138,7 +139,7 @@ pub fn check_bounds(maps: &[Map]) -> Result<(), String> {
     if bad.is_empty() {
         Ok(())
     } else {
-        Err(format!("stability bound broken:\n{}", bad.join("\n")))
+        Err(anyhow!("stability bound broken:\n{}", bad.join("\n")))
     }
 }
 

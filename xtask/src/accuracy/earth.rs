@@ -7,6 +7,7 @@
 //! condition number kappa (`core_math::accuracy::earth_kappa`). The real-Earth figures in
 //! docs/accuracy.md come from this command.
 
+use anyhow::{anyhow, Result};
 use core_math::accuracy::{earth_kappa, EARTH_F32_KAPPA_LIMIT};
 use core_math::earth::limb_margin_rad;
 use core_math::sample::SplitMix64;
@@ -35,7 +36,7 @@ fn rel(m: &ImageMotion<f64>, r: &ImageMotion<f64>) -> f64 {
     (m.v1_mps - r.v1_mps).hypot(m.v2_mps - r.v2_mps) / r.v1_mps.hypot(r.v2_mps)
 }
 
-pub fn run(quick: bool) -> Result<(), String> {
+pub fn run(quick: bool) -> Result<()> {
     let t0 = std::time::Instant::now();
     let draws = if quick { 20_000 } else { 200_000 };
     let mut rng = SplitMix64(SEED);
@@ -44,7 +45,7 @@ pub fn run(quick: bool) -> Result<(), String> {
     for _ in 0..draws {
         let Some(c) = rng.earth_case() else { continue };
         let margin_deg = limb_margin_rad(&c.geometry, &c.camera, c.n_px)
-            .map_err(|e| format!("accuracy: {e}"))?
+            .map_err(|e| anyhow!("accuracy: {e}"))?
             .to_degrees();
         let r = EarthReference.evaluate(&c.camera, &c.geometry, c.n_px);
         let f = GENERAL_F64.evaluate(&c.camera, &c.geometry, c.n_px);
@@ -72,7 +73,7 @@ pub fn run(quick: bool) -> Result<(), String> {
         st.f64_max = st.f64_max.max(rel(&f, &r));
         let e = rel(&s, &r);
         st.f32.push(e);
-        let kappa = earth_kappa(&c.camera, &c.geometry, c.n_px).map_err(|e| e.to_string())?;
+        let kappa = earth_kappa(&c.camera, &c.geometry, c.n_px).map_err(|e| anyhow!("{e}"))?;
         st.kappa_max = st.kappa_max.max(kappa);
         st.ratio_max = st.ratio_max.max(e / (kappa * U32));
         if kappa > EARTH_F32_KAPPA_LIMIT {

@@ -1,6 +1,7 @@
 //! `cargo xtask eval --model earth --backend <reference|f64|f32>`: the real-Earth model
 //! on user-supplied cases, exactly as `shared/EARTH-MODEL.md` ("Eval CSV") specifies.
 
+use anyhow::{anyhow, Result};
 use core_math::earth::{line_period_s, Attitude, EarthCamera, EarthGeometry};
 use core_math::{
     Backend, Earth, EarthReference, Ellipsoid, ModelError, Real, StateVector, EARTH_RATE_RAD_S,
@@ -56,14 +57,15 @@ pub struct Case {
 }
 
 /// The whole command on a CSV text: one output row per input row, always.
-pub fn eval_csv(backend: &str, text: &str) -> Result<String, String> {
+pub fn eval_csv(backend: &str, text: &str) -> Result<String> {
     if !["reference", "f64", "f32"].contains(&backend) {
         return Err(if backend == "fixed" {
-            "eval: the earth model has no fixed-point backend (use reference|f64|f32, or \
-             --model sphere for fixed)"
-                .to_string()
+            anyhow!(
+                "eval: the earth model has no fixed-point backend (use reference|f64|f32, or \
+                 --model sphere for fixed)"
+            )
         } else {
-            format!("eval: unknown backend `{backend}` for the earth model ({BACKENDS})")
+            anyhow!("eval: unknown backend `{backend}` for the earth model ({BACKENDS})")
         });
     }
     let table = Table::parse(text)?;
@@ -190,6 +192,7 @@ garbled,7016137,0,0,0,-1046.6,7464.5,x,0,0,0,0,0,0,0.555,13e-6,0,,
         }
         assert!(eval_csv("fixed", CASES)
             .unwrap_err()
+            .to_string()
             .contains("no fixed-point"));
         assert!(eval_csv("f16", CASES).is_err());
     }

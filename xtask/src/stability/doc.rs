@@ -1,5 +1,6 @@
 //! The figures: PNG maps, the tables, and the values the document's template quotes.
 
+use anyhow::{Context, Result};
 use std::collections::BTreeMap;
 use std::path::Path;
 
@@ -187,7 +188,7 @@ fn kappa_panel(map: &Map) -> Panel {
 }
 
 /// Writes the PNGs of `map` into `dir`; returns the file names in panel order.
-pub fn write_pngs(map: &Map, letter: &str, dir: &Path) -> Result<Vec<String>, String> {
+pub fn write_pngs(map: &Map, letter: &str, dir: &Path) -> Result<Vec<String>> {
     let mut names = Vec::new();
     let extra = if map.spec.key == "inclination-latitude" {
         Some(&V1_TERMS)
@@ -364,19 +365,19 @@ pub fn limb_slope(map: &Map, margin_deg: f64) -> Option<(f64, usize)> {
 }
 
 /// Fills `{{key}}` placeholders; an unknown key is an error.
-pub fn fill(template: &str, values: &BTreeMap<String, String>) -> Result<String, String> {
+pub fn fill(template: &str, values: &BTreeMap<String, String>) -> Result<String> {
     let mut out = String::with_capacity(template.len() * 2);
     let mut rest = template;
     while let Some(b) = rest.find("{{") {
         out.push_str(&rest[..b]);
         let e = rest[b..]
             .find("}}")
-            .ok_or("stability template: unclosed {{")?
+            .context("stability template: unclosed {{")?
             + b;
         let key = rest[b + 2..e].trim();
         let v = values
             .get(key)
-            .ok_or(format!("stability template: no value for `{key}`"))?;
+            .with_context(|| format!("stability template: no value for `{key}`"))?;
         out.push_str(v);
         rest = &rest[e + 2..];
     }

@@ -8,6 +8,7 @@
 //! motion). Error |dv|/|v|: hypot of the component differences over the reference's
 //! hypot(v1, v2), inputs as given in f64 (the f32 path rounds the attitude itself).
 
+use anyhow::Result;
 use core_math::accuracy::{earth_kappa, EARTH_F32_KAPPA_C, EARTH_F32_REL_TOLERANCE};
 use core_math::earth::{circular_state, limb_margin_rad, Attitude, EarthCamera, EarthGeometry};
 use core_math::sample::{roll_at_limb_margin, EarthCase};
@@ -499,7 +500,7 @@ fn lg(x: f64) -> f64 {
 }
 
 /// Writes the map's three PNGs (kappa, f32 error, err/(kappa u)) into `dir`.
-pub fn write_pngs(m: &GMap, dir: &Path) -> Result<(), String> {
+pub fn write_pngs(m: &GMap, dir: &Path) -> Result<()> {
     let s = m.spec;
     let kmax = m
         .cells

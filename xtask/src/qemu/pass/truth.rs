@@ -8,6 +8,7 @@
 //! paper's model: today's round Earth (R = 6 371 km), roll only, circular orbit from
 //! the state, period from |v_P|, the same pixels.
 
+use anyhow::{anyhow, Result};
 use controller::golden::{self, NavInput};
 use controller::Controller;
 use core_math::earth::{Attitude, EarthGeometry};
@@ -75,11 +76,7 @@ fn flown_and_unsteered(
 }
 
 /// Every update of the firmware's downlink with fresh periods against the truth.
-pub fn check(
-    truth: &AgileTruth,
-    firmware: &Downlink,
-    controller: &Controller,
-) -> Result<Report, String> {
+pub fn check(truth: &AgileTruth, firmware: &Downlink, controller: &Controller) -> Result<Report> {
     let scene = controller.scene();
     let plan = controller.plan();
     let mut r = Report {
@@ -106,7 +103,7 @@ pub fn check(
             .iter()
             .map(|s| Reference.pixel(&scene.camera, f64::from(s.px)))
             .collect::<Result<Vec<_>, _>>()
-            .map_err(|e| e.name().to_string())?;
+            .map_err(|e| anyhow!(e.name()))?;
         paper_pixels.insert(seg.index, pixels);
     }
     let boresight = core_math::EarthCamera {
@@ -140,9 +137,9 @@ pub fn check(
             },
             t_us,
         )
-        .map_err(|e| format!("truth at {t_s} s: {}", e.name()))?;
+        .map_err(|e| anyhow!("truth at {t_s} s: {}", e.name()))?;
         let orbit = OrbitState::from_state(&state, PAPER_EARTH_RADIUS_M)
-            .map_err(|e| format!("paper model at {t_s} s: {}", e.name()))?;
+            .map_err(|e| anyhow!("paper model at {t_s} s: {}", e.name()))?;
         let paper = Geometry {
             roll_rad: attitude.roll_rad,
             inclination_rad: orbit.inclination_rad,
