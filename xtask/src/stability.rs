@@ -12,6 +12,7 @@
 
 mod doc;
 mod general;
+mod grid;
 mod maps;
 mod point;
 
@@ -23,7 +24,7 @@ use std::time::Instant;
 // this document's split the margin the same way.
 use crate::accuracy::BUCKETS_DEG;
 use doc::{agg_table, aggregate, describe, e2, parts, sig, Agg};
-use maps::{sweep, Map, MAPS};
+use maps::{Map, MAPS};
 use point::{Outcome, Point, U_F32, U_FIXED};
 
 /// The stated bounds: f32 error (at the same or at the unrounded inputs) <= C_F32 kappa u,
@@ -35,16 +36,13 @@ const DOC: &str = "docs/stability.md";
 const PNG_DIR: &str = "docs/stability";
 const TEMPLATE: &str = include_str!("stability/template.md");
 
-/// Letters the document uses for the maps, in [`MAPS`] order.
-const LETTERS: [&str; 3] = ["A", "B", "C"];
-
 /// Sweeps every map: the full grid (`coarse` = None), or every dimension divided by
 /// `coarse` with `sub` sub-samples per cell.
 pub fn sweep_all(coarse: Option<(usize, usize)>) -> Vec<Map> {
     MAPS.iter()
         .map(|s| match coarse {
-            None => sweep(s, s.nx, s.ny, s.sub),
-            Some((c, sub)) => sweep(s, s.nx / c, s.ny / c, sub),
+            None => Map::sweep(s, s.nx, s.ny, s.sub),
+            Some((c, sub)) => Map::sweep(s, s.nx / c, s.ny / c, sub),
         })
         .collect()
 }
@@ -82,8 +80,8 @@ pub fn run(args: &Args) -> Result<()> {
         let root = crate::qemu::workspace_root();
         let dir = root.join(PNG_DIR);
         std::fs::create_dir_all(&dir).with_context(|| format!("creating {PNG_DIR}"))?;
-        for (m, letter) in maps.iter().zip(LETTERS) {
-            doc::write_pngs(m, letter, &dir)?;
+        for m in &maps {
+            doc::write_pngs(m, &dir)?;
         }
         for m in &gmaps {
             general::write_pngs(m, &dir)?;
@@ -186,7 +184,8 @@ fn figures(maps: &[Map], quick: bool, secs: f64) -> BTreeMap<String, String> {
     // Summary: one row per map, and the whole.
     let mut rows: Vec<(String, Agg)> = Vec::new();
     let mut all = Vec::new();
-    for (m, letter) in maps.iter().zip(LETTERS) {
+    for m in maps {
+        let letter = m.spec.letter;
         let a = aggregate(m, |_, _, _| true);
         put(
             &format!("{letter}.grid"),

@@ -4,8 +4,6 @@ use anyhow::{Context, Result};
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use crate::plot::heatmap::Heatmap;
-
 use super::maps::{Cell, Map};
 use super::point::{Outcome, Point, RelErrors, INPUTS};
 use super::{C_F32, C_FIXED};
@@ -134,33 +132,6 @@ const V1_TERMS: Panel = Panel {
     bound: None,
 };
 
-fn heatmap(map: &Map, panel: &Panel, map_letter: &str) -> Heatmap {
-    let s = map.spec;
-    let values = map.values(panel.value);
-    let mut h = Heatmap::new(
-        &format!("{map_letter}: {}", panel.title),
-        s.x_label,
-        s.y_label,
-        panel.z_label,
-        (map.nx, map.ny),
-        values,
-    )
-    .x_range(s.x_range.0, s.x_range.1)
-    .y_range(s.y_range.0, s.y_range.1)
-    .y_decades(s.y_decades)
-    .z_range(panel.z_range.0, panel.z_range.1)
-    .z_decades(!panel.linear)
-    .missing_label(s.missing);
-    if let Some(c) = panel.bound {
-        h = h.z_mark(c.log10());
-    }
-    if let Some((ix, iy)) = map.argmax(panel.value) {
-        let (x, y) = map.centre(ix, iy);
-        h = h.mark(x, y);
-    }
-    h
-}
-
 /// The kappa panel (each cell's largest kappa) with its colour scale fitted to the map:
 /// decades when it spans one or more, linear (whole numbers) otherwise, where a log
 /// scale would show one colour.
@@ -188,7 +159,7 @@ fn kappa_panel(map: &Map) -> Panel {
 }
 
 /// Writes the PNGs of `map` into `dir`; returns the file names in panel order.
-pub fn write_pngs(map: &Map, letter: &str, dir: &Path) -> Result<Vec<String>> {
+pub fn write_pngs(map: &Map, dir: &Path) -> Result<Vec<String>> {
     let mut names = Vec::new();
     let extra = if map.spec.key == "inclination-latitude" {
         Some(&V1_TERMS)
@@ -202,7 +173,13 @@ pub fn write_pngs(map: &Map, letter: &str, dir: &Path) -> Result<Vec<String>> {
         } else {
             panel
         };
-        heatmap(map, panel, letter).save(&dir.join(&name))?;
+        map.heatmap(
+            (panel.title, panel.z_label),
+            (panel.z_range, !panel.linear),
+            panel.value,
+            panel.bound.map(f64::log10),
+        )
+        .save(&dir.join(&name))?;
         names.push(name);
     }
     Ok(names)
