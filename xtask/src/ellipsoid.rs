@@ -13,6 +13,7 @@ use anyhow::{anyhow, Context, Result};
 use std::time::Instant;
 
 use controller::Scene;
+use core_math::vector::norm;
 use core_math::{
     mtf_mismatch, Backend, Camera, Geometry, ImageMotion, OrbitState, Reference, StageRule,
     CLOSED_F32, EARTH_RATE_RAD_S,
@@ -253,7 +254,7 @@ fn case(
         .ok_or_else(miss)?;
     let ell = ell_full.motion;
     let g = ell_full.ground_m;
-    let ground_lat_deg = (g[2] / motion::norm(g)).asin().to_degrees();
+    let ground_lat_deg = (g[2] / norm(g)).asin().to_degrees();
     let sph = scenario(Spheroid::sphere(r_model))
         .image_motion(camera, n)
         .ok_or_else(miss)?
@@ -262,7 +263,7 @@ fn case(
     let g_round = model_geometry(orbit, u_rad, roll_rad, r_model)?;
     let round = reference(camera, &g_round, n)?;
     let (pos, _) = orbit.frame(u_rad);
-    let lat = (pos[2] / motion::norm(pos)).asin();
+    let lat = (pos[2] / norm(pos)).asin();
     let g_local = model_geometry(
         orbit,
         u_rad,
@@ -280,7 +281,7 @@ fn case(
     let (_, e) = orbit.frame(u_rad);
     let up = g_local.earth_radius_m + chain.g_m[2];
     let ground: [f64; 3] = std::array::from_fn(|i| chain.g_m[1] * e[1][i] + up * e[2][i]);
-    let lat_ground = (ground[2] / motion::norm(ground)).asin();
+    let lat_ground = (ground[2] / norm(ground)).asin();
     let g_pixel = model_geometry(
         orbit,
         u_rad,

@@ -12,12 +12,13 @@
 
 use core_math::earth::{limb_margin_rad, Attitude};
 use core_math::sample::SplitMix64;
+use core_math::vector::norm;
 use core_math::{
     Backend, Camera, EarthCamera, EarthGeometry, EarthReference, Ellipsoid, Geometry, ImageMotion,
     OrbitState, Reference, StateVector, EARTH_RATE_RAD_S, GM_M3_S2,
 };
 
-use super::motion::{eccentric_state, envelope_draw, general_motion, norm, Orbit, Spheroid};
+use super::motion::{eccentric_state, envelope_draw, general_motion, Orbit, Spheroid};
 
 /// The paper's (and the controller's) Earth radius (m).
 const R_PAPER_M: f64 = 6_371e3;

@@ -36,24 +36,13 @@
 
 use core_math::earth::Attitude;
 use core_math::sample::SplitMix64;
+use core_math::vector::{add, cross, dot, norm, scale, sub, unit};
 use core_math::{Camera, EarthCamera, EarthGeometry, ImageMotion, StateVector, GM_M3_S2};
 use core_math::{Ellipsoid, EARTH_RATE_RAD_S};
 
 use core_math::earth::kepler::Kepler;
 
 pub type V3 = [f64; 3];
-
-pub fn dot(a: V3, b: V3) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-pub fn norm(a: V3) -> f64 {
-    dot(a, a).sqrt()
-}
-
-fn sub(a: V3, b: V3) -> V3 {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
 
 /// `x a + y b + z c`.
 fn comb(x: f64, a: V3, y: f64, b: V3, z: f64, c: V3) -> V3 {
@@ -99,7 +88,7 @@ impl Spheroid {
     /// Nearest point where the ray `s + rho d` (rho > 0) meets the surface, or None.
     pub fn intersect(&self, s: V3, d: V3) -> Option<V3> {
         let rho = self.intersect_range(s, d)?;
-        Some(std::array::from_fn(|i| s[i] + rho * d[i]))
+        Some(add(s, scale(rho, d)))
     }
 
     /// The smallest rho > 0 at which the ray `s + rho d` meets the surface, or None.
@@ -162,7 +151,7 @@ impl Orbit {
         let (su, cu) = u_rad.sin_cos();
         let up = comb(cu, p, su, q, 0.0, n);
         let fwd = comb(-su, p, cu, q, 0.0, n);
-        (up.map(|x| x * self.radius_m), [fwd, n, up])
+        (scale(self.radius_m, up), [fwd, n, up])
     }
 
     /// ECI state vector at argument of latitude `u_rad` (what NAV would send).
@@ -171,7 +160,7 @@ impl Orbit {
         let speed = self.rate_rad_s * self.radius_m;
         StateVector {
             position_m: pos,
-            velocity_mps: e[0].map(|x| x * speed),
+            velocity_mps: scale(speed, e[0]),
         }
     }
 }
@@ -281,19 +270,6 @@ fn rotate(k: usize, angle: f64, v: V3) -> V3 {
     w
 }
 
-fn cross(a: V3, b: V3) -> V3 {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-fn unit(a: V3) -> V3 {
-    let n = norm(a);
-    a.map(|x| x / n)
-}
-
 /// The general instant of `shared/EARTH-MODEL.md`, set up for the finite difference.
 struct General {
     orbit: Kepler,
@@ -327,7 +303,7 @@ impl General {
     /// Focal-plane position (P1, P2) at `t_s` of the Earth-fixed ground point.
     fn project(&self, t_s: f64) -> [f64; 2] {
         let (dr, v) = self.orbit.at(t_s);
-        let r: V3 = std::array::from_fn(|k| self.r0[k] + dr[k]);
+        let r = add(self.r0, dr);
         let e = Self::orbital_frame(r, v);
         // G(t) - r(t) = (G - r0) + (Rz(omega t) - I) G - (r(t) - r0): every term formed
         // as itself, none as a difference of two positions of Earth-radius size.
@@ -398,7 +374,7 @@ pub fn general_motion_step(
         attitude: *at,
         earth_rate_rad_s: g.earth_rate_rad_s,
         focal_m: camera.focal_m,
-        ground_m: std::array::from_fn(|i| r0[i] + to_ground_m[i]),
+        ground_m: add(r0, to_ground_m),
         to_ground_m,
     };
     let h = step_s;
