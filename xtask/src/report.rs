@@ -117,7 +117,8 @@ struct Sample {
 }
 
 /// `earth-f32`'s errors against the problem's condition number kappa
-/// (`core_math::accuracy::earth_kappa`): its 2e-6 and 2e-5 bounds hold up to kappa 50;
+/// (`core_math::accuracy::earth_kappa`): its 2e-6 and 2e-5 bounds hold up to
+/// `EARTH_F32_KAPPA_LIMIT`;
 /// everywhere at least 0.01 deg from the limb err / (kappa u32) is bounded.
 #[derive(Default)]
 struct EarthF32Split {

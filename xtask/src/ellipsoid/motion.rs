@@ -18,12 +18,9 @@
 //! ground point minus the satellite loses a factor |S| / |G - S| ~ 10 to cancellation,
 //! then the perspective division), so rounding contributes ~1.5e-15 / h m/s; the
 //! fifth derivative of P is about f (v_ground / range)^5 ~ 1e-10 m/s^5 at 645 km, so
-//! truncation is ~h^4 / 30 * 1e-10 m/s. h = 0.1 s balances them near 1e-14 m/s, about
-//! 3e-12 of the smallest |v_P| of the default scene (2.8 mm/s). Measured against
-//! `Reference` on a sphere over the grid of the test below (worst component / |v_P|):
-//! h = 0.01 s 7.6e-11, 0.03 s 2.3e-11, 0.1 s 8.6e-12, 0.3 s 1.1e-11 (truncation, at
-//! 300 km), 1 s over 1e-9: rounding falls as 1/h, truncation rises as h^4, as budgeted.
-//! Over the default scene's sweep (`cargo xtask ellipsoid`) it is 3.7e-12.
+//! truncation is ~h^4 / 30 * 1e-10 m/s. h = 0.1 s balances them near 1e-14 m/s, a few
+//! 1e-12 of the smallest |v_P| of the default scene. What the tests below and
+//! `cargo xtask ellipsoid` measure, and how it varies with h: docs/earth-model.md.
 //!
 //! The general model of `shared/EARTH-MODEL.md` ([`general_motion`]) extends this to an
 //! eccentric orbit (the exact two-body motion through the state vector, by Kepler's
@@ -504,7 +501,7 @@ mod tests {
     /// altitude the derivatives of P grow, hence the margin. Any modelling difference is
     /// far larger: the Earth-rotation terms are ~7 % of |v_P| (omega / Omega), the
     /// paper's doubled Eq. 14 cross term up to 1.5 %, a wrong orbit rate or radius at the
-    /// 1e-3 level. Measured: 8.6e-12 worst (printed with --nocapture).
+    /// 1e-3 level. The worst is printed with --nocapture (docs/earth-model.md).
     #[test]
     fn sphere_agrees_with_reference() {
         let mut worst: f64 = 0.0;
@@ -749,15 +746,8 @@ mod tests {
     /// miss (0.5 deg or more outside the limb, `core_math::earth::limb_margin_rad`) must
     /// be a miss for both routes, a clear hit a hit for both; within 0.5 deg of the limb
     /// the cases are counted and excluded from the bound. The ground point must project
-    /// back onto (p1, p2) within 1e-12 m.
-    ///
-    /// Measured (`cargo test -p xtask general_agrees -- --nocapture`): 16 308 hits
-    /// compared (532 at 0.5-2 deg from the limb, 2 160 at 2-10 deg), worst 6.29e-12 at
-    /// |r| 7991 km, e 0.026, over the equator, roll -27.2, pitch -38.9, yaw +155.8 deg,
-    /// field -37 deg, where the attitude rates cancel most of the ground's motion
-    /// (|v| = 2.1e-4 m/s, 1/50 of the typical): the absolute difference is 1.4e-15 m/s,
-    /// the rounding floor. 2 553 clear misses agreed; 1 139 within 0.5 deg of the limb
-    /// excluded, none of them split on hit or miss (worst 1.8e-12 where both hit).
+    /// back onto (p1, p2) within 1e-12 m. What it finds (`cargo test -p xtask
+    /// general_agrees -- --nocapture`): docs/earth-model.md.
     #[test]
     fn general_agrees_with_earth_reference() {
         let o = two_route(20_000, GENERAL_STEP_S);
@@ -832,9 +822,8 @@ mod tests {
 
     /// The budget's shape: the worst difference against the stencil unit h (rounding
     /// falls as 1/h, truncation rises as h^8). Run with
-    /// `cargo test -p xtask general_step_sweep -- --ignored --nocapture`. Measured:
-    /// h = 0.003 s 1.50e-10, 0.01 s 2.97e-11, 0.03 s 1.20e-11, 0.1 s 6.29e-12,
-    /// 0.3 s 3.96e-11, 1 s 7.16e-7.
+    /// `cargo test -p xtask general_step_sweep -- --ignored --nocapture`; the figures:
+    /// docs/earth-model.md.
     #[test]
     #[ignore]
     fn general_step_sweep() {
