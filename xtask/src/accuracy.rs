@@ -207,7 +207,8 @@ fn sweep_geometry(camera: &Camera, g: &Geometry<f64>, step: usize, stats: &mut [
     }
 }
 
-fn percentile(v: &mut [f64], p: f64) -> f64 {
+/// The `p` quantile of `v` (sorted in place; 0 when empty).
+pub(crate) fn percentile(v: &mut [f64], p: f64) -> f64 {
     if v.is_empty() {
         return 0.0;
     }

@@ -19,6 +19,7 @@ use core_math::{
     CLOSED_F32, EARTH_RATE_RAD_S,
 };
 
+use crate::markdown::{e2, replace_between, signed};
 use motion::{Orbit, Scenario, Spheroid};
 
 /// The orbit of the default pass (`cargo xtask run`): circular, 645 km over the
@@ -410,18 +411,6 @@ pub fn summary() -> Result<EllipsoidSummary> {
     })
 }
 
-fn sci(x: f64) -> String {
-    format!("{x:.2e}")
-}
-
-fn signed(x: f64) -> String {
-    if x >= 0.0 {
-        format!("+{x:.2e}")
-    } else {
-        format!("{x:.2e}")
-    }
-}
-
 /// The markdown block between the doc's markers.
 fn render(s: &EllipsoidSummary) -> Result<String> {
     let stages = s.stages;
@@ -461,9 +450,9 @@ fn render(s: &EllipsoidSummary) -> Result<String> {
             signed(st.round.max),
             st.round.at_lat_deg,
             st.round.at_u_deg,
-            sci(st.round.rms()),
+            e2(st.round.rms()),
             signed(st.local.worst),
-            sci(st.local.rms()),
+            e2(st.local.rms()),
             signed(st.pixel.worst),
             st.drift.worst * 1e6,
             signed(st.f32_arith.worst),
@@ -492,7 +481,7 @@ fn render(s: &EllipsoidSummary) -> Result<String> {
          radius {:.2} %, the f32 arithmetic {:.4} % ({CMD}).\n\
          - Largest stage count meeting the floor with that error alone (scene limit {}): \
          round Earth {}, sub-satellite radius {}, ground-point radius {} ({CMD}).\n\n{END}",
-        sci(s.validation_worst),
+        e2(s.validation_worst),
         s.cases,
         signed(w),
         s.worst_lat_deg,
@@ -502,7 +491,7 @@ fn render(s: &EllipsoidSummary) -> Result<String> {
         s.worst_ground_lat_deg,
         signed(s.range_rel_err.0),
         signed(s.range_rel_err.1),
-        sci(s.rms_rel_err),
+        e2(s.rms_rel_err),
         signed(-w / (1.0 + w)),
         signed(l),
         w.abs() / l.abs(),
@@ -514,7 +503,7 @@ fn render(s: &EllipsoidSummary) -> Result<String> {
         mtf(p),
         mtf(a),
         s.mtf_floor,
-        sci(s.budget_rel),
+        e2(s.budget_rel),
         100.0 * w.abs() / s.budget_rel,
         100.0 * l.abs() / s.budget_rel,
         100.0 * p.abs() / s.budget_rel,
@@ -529,13 +518,6 @@ fn render(s: &EllipsoidSummary) -> Result<String> {
 
 fn replace_block(doc: &str, block: &str) -> Option<String> {
     replace_between(doc, BEGIN, END, block)
-}
-
-/// `doc` with the text from `begin` to `end` (markers included) replaced by `block`.
-fn replace_between(doc: &str, begin: &str, end: &str, block: &str) -> Option<String> {
-    let b = doc.find(begin)?;
-    let e = doc[b..].find(end)? + b + end.len();
-    Some(format!("{}{block}{}", &doc[..b], &doc[e..]))
 }
 
 #[derive(clap::Args)]

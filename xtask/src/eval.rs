@@ -8,12 +8,12 @@
 use std::fmt::Display;
 
 use anyhow::{bail, Context, Result};
-use core_math::earth::{Attitude, EarthCamera, EarthGeometry};
+use core_math::earth::{self, Attitude, EarthCamera, EarthGeometry};
 use core_math::fixed_point::{geometry_from_f64, motion_to_f64};
 use core_math::{
-    Backend, Camera, Earth, EarthReference, Ellipsoid, Geometry, ImageMotion, ModelError, Real,
-    Reference, Sphere, StateVector, CLOSED_F32, CLOSED_F64, EARTH_RATE_RAD_S, FIXED, GENERAL_F32,
-    GENERAL_F64,
+    line_period_s, Backend, Camera, Earth, EarthReference, Ellipsoid, Geometry, ImageMotion,
+    Model as MathModel, ModelError, Real, Reference, Sphere, StateVector, CLOSED_F32, CLOSED_F64,
+    EARTH_RATE_RAD_S, FIXED, GENERAL_F32, GENERAL_F64,
 };
 
 use crate::csv::{Table, Writer};
@@ -73,7 +73,7 @@ pub fn eval_csv(model: Model, backend: &str, text: &str) -> Result<String> {
 }
 
 /// What `eval` needs of a model: its CSV columns and how a case is built from them.
-pub trait Columns: core_math::Model + Sized {
+pub trait Columns: MathModel + Sized {
     /// Required input columns, in the order [`Columns::case`] takes them.
     const INPUTS: &'static [&'static str];
     /// Optional input columns and their defaults (a missing column or an empty cell).
@@ -91,7 +91,7 @@ pub trait Columns: core_math::Model + Sized {
 }
 
 /// One case in SI units: optics, geometry (f64, to be rounded by the backend), pixel.
-pub struct Case<M: core_math::Model> {
+pub struct Case<M: MathModel> {
     pub camera: M::Camera,
     pub geometry: M::Geometry<f64>,
     pub n_px: f64,
@@ -133,7 +133,7 @@ impl Columns for Sphere {
         m: &ImageMotion<T>,
     ) -> Result<Vec<String>, ModelError> {
         let speed = m.speed_mps();
-        let period = core_math::line_period_s(T::from_f64(c.pixel_m), speed)?;
+        let period = line_period_s(T::from_f64(c.pixel_m), speed)?;
         Ok([m.v1_mps, m.v2_mps, speed, period]
             .map(|x| x.to_string())
             .to_vec())
@@ -213,7 +213,7 @@ impl Columns for Earth {
         c: &EarthCamera,
         m: &ImageMotion<T>,
     ) -> Result<Vec<String>, ModelError> {
-        let period = core_math::earth::line_period_s(T::from_f64(c.pixel_m), m);
+        let period = earth::line_period_s(T::from_f64(c.pixel_m), m);
         if !period.is_finite() {
             return Err(ModelError::NoAlongTrackMotion);
         }

@@ -9,6 +9,7 @@ mod csv;
 mod ellipsoid;
 mod eval;
 mod footprint;
+mod markdown;
 mod no_panic;
 mod paper;
 mod plot;

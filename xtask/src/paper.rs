@@ -20,6 +20,7 @@ use core_math::{
 };
 
 use crate::csv::Writer;
+use crate::markdown::f2;
 use crate::plot::{Legend, Plot, Series};
 
 /// Section 5's camera: f = 555 mm, A = 13 um.
@@ -579,14 +580,14 @@ fn summary(
     let rows: Vec<(&str, String, String, &str, &str)> = vec![
         (
             "near_min",
-            fmt2(published::NEAR_MIN),
+            f2(published::NEAR_MIN),
             format!("{:.3}", near.min),
             "mm/s",
             "min |v|, pixel 0, phi 0..25, gamma0 0..90",
         ),
         (
             "near_max",
-            fmt2(published::NEAR_MAX),
+            f2(published::NEAR_MAX),
             format!("{:.3}", near.max),
             "mm/s",
             "max |v|, pixel 0, phi 0..25, gamma0 0..90",
@@ -607,14 +608,14 @@ fn summary(
         ),
         (
             "far_min",
-            fmt2(published::FAR_MIN),
+            f2(published::FAR_MIN),
             format!("{:.3}", far.min),
             "mm/s",
             "min |v|, pixel 60000, phi 0..25, gamma0 0..90",
         ),
         (
             "far_max",
-            fmt2(published::FAR_MAX),
+            f2(published::FAR_MAX),
             format!("{:.3}", far.max),
             "mm/s",
             "max |v|, pixel 60000, phi 0..25, gamma0 0..90",
@@ -673,10 +674,6 @@ fn summary(
     Ok(())
 }
 
-fn fmt2(x: f64) -> String {
-    format!("{x:.2}")
-}
-
 /// The relative mismatch dv/v with sinc(pi M dv/v / 2) = `mtf` on the first lobe.
 fn implied_rel(mtf: f64, stages: u32) -> f64 {
     let (mut lo, mut hi) = (0.0_f64, core::f64::consts::PI);
@@ -710,11 +707,11 @@ fn hypotheses(out: &mut Out) -> Result<()> {
     )?;
     csv.row(&[
         "paper".to_string(),
-        fmt2(published::NEAR_MIN),
-        fmt2(published::NEAR_MAX),
+        f2(published::NEAR_MIN),
+        f2(published::NEAR_MAX),
         format!("{:.1}", published::NEAR_CHANGE_PCT),
-        fmt2(published::FAR_MIN),
-        fmt2(published::FAR_MAX),
+        f2(published::FAR_MIN),
+        f2(published::FAR_MAX),
         format!("{:.1}", published::FAR_CHANGE_PCT),
         format!("{:.3}", 100.0 * implied_rel(published::MTF_M48, 48)),
         format!("{:.3}", published::MTF_M48),

@@ -20,14 +20,18 @@
 //! `flash_bytes`: [`crate::footprint`], one link per backend.
 
 use anyhow::{anyhow, Context, Result};
+use core_math::accuracy::{earth_kappa, limb_margin_rad, EARTH_F32_KAPPA_LIMIT};
+use core_math::earth;
 use core_math::fixed_point::{geometry_from_f64, motion_to_f64};
+use core_math::sample::SplitMix64 as Rng;
 use core_math::{
-    Backend, Camera, Geometry, MicroF32, NaiveF32, Reference, CLOSED_F32, CLOSED_F64,
-    CLOSED_MICROMATH, FIXED,
+    Backend, Camera, EarthReference, Geometry, ImageMotion, MicroF32, NaiveF32, Reference,
+    CLOSED_F32, CLOSED_F64, CLOSED_MICROMATH, FIXED, GENERAL_F32, GENERAL_F64,
 };
 
+use crate::accuracy::percentile;
+use crate::markdown;
 use crate::qemu::{bench_counts, BenchCounts};
-use core_math::sample::SplitMix64 as Rng;
 
 const DEFAULT_CASES: usize = 200_000;
 const DEFAULT_SEED: u64 = 0x5EED_2013_0605_0750;
@@ -189,22 +193,13 @@ const END: &str = "<!-- report:end -->";
 /// `doc` with the markdown table of `rows`, then the paragraph `trailer`, between its
 /// markers.
 fn replace_table(doc: &str, rows: &[[String; 7]], trailer: &str) -> Option<String> {
-    let b = doc.find(BEGIN)?;
-    let e = doc[b..].find(END)? + b;
-    let mut table = format!(
-        "{BEGIN}\n\n| {} |\n|{}\n",
-        HEADER.join(" | "),
-        "---|".repeat(HEADER.len())
-    );
-    for r in rows {
-        table.push_str(&format!("| {} |\n", r.join(" | ")));
-    }
-    table.push('\n');
+    let mut block = format!("{BEGIN}\n\n{}\n", markdown::table(&HEADER, rows));
     if !trailer.is_empty() {
-        table.push_str(trailer);
-        table.push_str("\n\n");
+        block.push_str(trailer);
+        block.push_str("\n\n");
     }
-    Some(format!("{}{table}{}", &doc[..b], &doc[e..]))
+    block.push_str(END);
+    markdown::replace_between(doc, BEGIN, END, &block)
 }
 
 /// Replaces the table between the doc's markers and draws the plot: each variant's
@@ -272,7 +267,7 @@ fn positive(v: &str) -> Result<usize> {
 fn case(rng: &mut Rng) -> Option<(Geometry<f64>, f64, f64)> {
     let g = rng.envelope_geometry();
     let n_px = rng.envelope_pixel(&g, &CAMERA)?;
-    let margin = core_math::accuracy::limb_margin_rad(&CAMERA, &g, n_px).ok()?;
+    let margin = limb_margin_rad(&CAMERA, &g, n_px).ok()?;
     (margin > 0.0).then_some((g, n_px, margin.to_degrees()))
 }
 
@@ -344,8 +339,6 @@ fn sweep(seed: u64, cases: usize) -> Sample {
 /// difference) against `EarthReference` at the inputs as given. Returns how many lie
 /// within `NEAR_LIMB_DEG` of the limb, and the f32 errors split by condition number.
 fn earth_sweep(seed: u64, cases: usize, errors: &mut [Errors]) -> (usize, EarthF32Split) {
-    use core_math::accuracy::{earth_kappa, EARTH_F32_KAPPA_LIMIT};
-    use core_math::{EarthReference, GENERAL_F32, GENERAL_F64};
     let mut split = EarthF32Split::default();
     let mut rng = Rng(seed ^ 0xEA27_0000_0000_0000);
     let (mut done, mut near) = (0, 0);
@@ -354,13 +347,13 @@ fn earth_sweep(seed: u64, cases: usize, errors: &mut [Errors]) -> (usize, EarthF
         let Ok(r) = EarthReference.evaluate(&c.camera, &c.geometry, c.n_px) else {
             continue;
         };
-        let Ok(margin) = core_math::earth::limb_margin_rad(&c.geometry, &c.camera, c.n_px) else {
+        let Ok(margin) = earth::limb_margin_rad(&c.geometry, &c.camera, c.n_px) else {
             continue;
         };
         done += 1;
         let is_near = margin.to_degrees() < NEAR_LIMB_DEG;
         near += usize::from(is_near);
-        let widen = |m: core_math::ImageMotion<f32>| core_math::ImageMotion {
+        let widen = |m: ImageMotion<f32>| ImageMotion {
             v1_mps: f64::from(m.v1_mps),
             v2_mps: f64::from(m.v2_mps),
         };
@@ -443,12 +436,8 @@ fn print_table(
     for (i, (v, e)) in VARIANTS.iter().zip(&sample.errors).enumerate() {
         let name = v.name;
         let mut far = e.far.clone();
-        far.sort_by(f64::total_cmp);
+        let p99 = percentile(&mut far, 0.99);
         let max = far.last().copied().unwrap_or(0.0);
-        let p99 = far
-            .get(((far.len().max(1) - 1) as f64 * 0.99).round() as usize)
-            .copied()
-            .unwrap_or(0.0);
         let count = |label: &str| -> Result<Option<u64>> {
             match counts {
                 None => Ok(None),

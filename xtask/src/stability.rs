@@ -23,7 +23,8 @@ use std::time::Instant;
 // Map A's limb-margin bands are the accuracy report's buckets, so that its table and
 // this document's split the margin the same way.
 use crate::accuracy::BUCKETS_DEG;
-use doc::{agg_table, aggregate, describe, e2, parts, sig, Agg};
+use crate::markdown::{e2, sig};
+use doc::{agg_table, aggregate, describe, parts, Agg};
 use maps::{Map, MAPS};
 use point::{Outcome, Point, U_F32, U_FIXED};
 
@@ -467,6 +468,7 @@ fn merge(all: &[Agg]) -> Agg {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use core_math::accuracy::{EARTH_F32_KAPPA_C, EARTH_F32_REL_TOLERANCE};
 
     /// A coarse version of the three maps (every dimension / 6, two sub-samples per
     /// cell) meets the document's bounds err <= C kappa u at every sample, and the
@@ -513,7 +515,6 @@ mod tests {
     /// hundreds, errors past the 2e-6 bound, and a ratio that is a fair part of C.
     #[test]
     fn general_coarse_maps_stay_within_c_kappa_u() {
-        use core_math::accuracy::{EARTH_F32_KAPPA_C, EARTH_F32_REL_TOLERANCE};
         let maps = general::sweep_all(Some(4));
         let bad = general::check_bounds(&maps);
         assert!(bad.is_empty(), "{}", bad.join("\n"));

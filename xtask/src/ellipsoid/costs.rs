@@ -10,6 +10,7 @@
 //! contract's period) for both, except for Eq. 16, where T_model = pixel / |v_P| of the
 //! truth's own motion: > 0 when the simplified model clocks too slowly.
 
+use core_math::earth::kepler::Kepler;
 use core_math::earth::{limb_margin_rad, Attitude};
 use core_math::sample::SplitMix64;
 use core_math::vector::norm;
@@ -17,6 +18,8 @@ use core_math::{
     Backend, Camera, EarthCamera, EarthGeometry, EarthReference, Ellipsoid, Geometry, ImageMotion,
     OrbitState, Reference, StateVector, EARTH_RATE_RAD_S, GM_M3_S2,
 };
+
+use crate::markdown::signed;
 
 use super::motion::{eccentric_state, envelope_draw, general_motion, Orbit, Spheroid};
 
@@ -290,8 +293,8 @@ fn envelope_at(g: &EarthGeometry<f64>, cam: &EarthCamera, n: f64) -> String {
     let s = &g.state;
     let lat = lat_deg(s);
     let alt = norm(s.position_m) - Spheroid::WGS84.geocentric_radius_m(lat.to_radians());
-    let e = core_math::earth::kepler::Kepler::new(s.position_m, s.velocity_mps, GM_M3_S2)
-        .map_or(f64::NAN, |k| k.eccentricity());
+    let e =
+        Kepler::new(s.position_m, s.velocity_mps, GM_M3_S2).map_or(f64::NAN, |k| k.eccentricity());
     let a = &g.attitude;
     let d = f64::to_degrees;
     let mut o = format!(
@@ -607,14 +610,6 @@ pub fn costs(grid: Grid) -> Costs {
         default_cases: cases.len(),
         validation_worst,
         validation_cases,
-    }
-}
-
-fn signed(x: f64) -> String {
-    if x >= 0.0 {
-        format!("+{x:.2e}")
-    } else {
-        format!("{x:.2e}")
     }
 }
 

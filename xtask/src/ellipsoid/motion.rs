@@ -478,6 +478,7 @@ pub fn envelope_draw(rng: &mut SplitMix64) -> (EarthGeometry<f64>, EarthCamera, 
 mod tests {
     use super::*;
     use core_math::earth::limb_margin_rad;
+    use core_math::sample::{roll_at_limb_margin, EarthCase};
     use core_math::{Backend, EarthReference, Geometry, ModelError, Reference};
 
     const CAMERA: Camera = Camera {
@@ -660,12 +661,12 @@ mod tests {
                 } else {
                     -1.0
                 };
-                let case = core_math::sample::EarthCase {
+                let case = EarthCase {
                     camera: cam,
                     geometry: g,
                     n_px: n,
                 };
-                if let Some(roll) = core_math::sample::roll_at_limb_margin(&case, m, side) {
+                if let Some(roll) = roll_at_limb_margin(&case, m, side) {
                     g.attitude.roll_rad = roll;
                 }
             }

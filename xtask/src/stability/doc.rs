@@ -4,21 +4,15 @@ use anyhow::{Context, Result};
 use std::collections::BTreeMap;
 use std::path::Path;
 
+use crate::markdown::{e2, f2, sig, table};
+
 use super::maps::{Cell, Map};
 use super::point::{Outcome, Point, RelErrors, INPUTS};
 use super::{C_F32, C_FIXED};
 
 /// log10 with a floor, so that an exact 0 lands at the bottom of the colour scale.
-fn lg(x: f64) -> f64 {
+pub fn lg(x: f64) -> f64 {
     x.max(1e-30).log10()
-}
-
-pub fn e2(x: f64) -> String {
-    format!("{x:.2e}")
-}
-
-fn f2(x: f64) -> String {
-    format!("{x:.2}")
 }
 
 /// A short description of where a point is.
@@ -33,19 +27,6 @@ pub fn describe(pt: &Point, o: &Outcome) -> String {
         g.arg_latitude_rad.to_degrees(),
         sig(o.margin_rad.to_degrees()),
     )
-}
-
-/// Three significant digits, plain or scientific.
-pub fn sig(x: f64) -> String {
-    if x != 0.0 && (x.abs() < 0.01 || x.abs() >= 1e4) {
-        format!("{x:.2e}")
-    } else if x.abs() >= 100.0 {
-        format!("{x:.0}")
-    } else if x.abs() >= 10.0 {
-        format!("{x:.1}")
-    } else {
-        format!("{x:.3}")
-    }
 }
 
 /// One panel of a map: file suffix, title, colour-bar label, z range (log10 unless
@@ -253,19 +234,6 @@ pub fn aggregate(map: &Map, keep: impl Fn(usize, usize, &Cell) -> bool) -> Agg {
         }
     }
     a
-}
-
-/// A markdown table.
-pub fn table(header: &[&str], rows: &[Vec<String>]) -> String {
-    let mut s = format!(
-        "| {} |\n|{}\n",
-        header.join(" | "),
-        "---|".repeat(header.len())
-    );
-    for r in rows {
-        s.push_str(&format!("| {} |\n", r.join(" | ")));
-    }
-    s
 }
 
 const AGG_HEADER: [&str; 12] = [

@@ -9,14 +9,18 @@
 //! hypot(v1, v2), inputs as given in f64 (the f32 path rounds the attitude itself).
 
 use anyhow::Result;
-use core_math::accuracy::{earth_kappa, EARTH_F32_KAPPA_C, EARTH_F32_REL_TOLERANCE};
+use core_math::accuracy::{
+    earth_kappa, EARTH_F32_KAPPA_C, EARTH_F32_KAPPA_LIMIT, EARTH_F32_REL_TOLERANCE,
+};
 use core_math::earth::{circular_state, limb_margin_rad, Attitude, EarthCamera, EarthGeometry};
 use core_math::sample::{roll_at_limb_margin, EarthCase};
 use core_math::{Backend, EarthReference, Ellipsoid, EARTH_RATE_RAD_S, GENERAL_F32};
 
 use std::path::Path;
 
-use super::doc::{e2, sig};
+use crate::markdown::{e2, sig, table};
+
+use super::doc::lg;
 use super::grid::{self, Spec};
 use super::maps::I0_SSO_DEG;
 use super::point::U_F32;
@@ -306,7 +310,7 @@ impl GCell {
             self.over_tol += 1;
             self.over_tol_kappa_min = self.over_tol_kappa_min.min(o.kappa);
         }
-        if o.kappa <= core_math::accuracy::EARTH_F32_KAPPA_LIMIT
+        if o.kappa <= EARTH_F32_KAPPA_LIMIT
             && o.margin_rad.to_degrees() >= 1.0
             && o.err > self.err_tame
         {
@@ -450,10 +454,6 @@ pub fn describe(c: &EarthCase, o: &GOutcome) -> String {
     s
 }
 
-fn lg(x: f64) -> f64 {
-    x.max(1e-30).log10()
-}
-
 /// Writes the map's three PNGs (kappa, f32 error, err/(kappa u)) into `dir`.
 pub fn write_pngs(m: &GMap, dir: &Path) -> Result<()> {
     let s = m.spec;
@@ -479,7 +479,7 @@ pub fn write_pngs(m: &GMap, dir: &Path) -> Result<()> {
             "kappa",
             (0.0, lg(kmax).ceil().max(2.0)),
             |c| lg(c.kappa),
-            Some(lg(core_math::accuracy::EARTH_F32_KAPPA_LIMIT)),
+            Some(lg(EARTH_F32_KAPPA_LIMIT)),
         ),
         (
             "err-f32",
@@ -627,7 +627,7 @@ pub fn figures(maps: &[GMap], secs: f64) -> std::collections::BTreeMap<String, S
             );
         }
     }
-    put("G.table", super::doc::table(&TABLE_HEADER, &rows));
+    put("G.table", table(&TABLE_HEADER, &rows));
     put(
         "G.bound_line",
         format!(
@@ -670,7 +670,7 @@ pub fn figures(maps: &[GMap], secs: f64) -> std::collections::BTreeMap<String, S
             .collect();
         let mut header = TABLE_HEADER;
         header[0] = "limb margin";
-        put("E.band_table", super::doc::table(&header, &rows));
+        put("E.band_table", table(&header, &rows));
         put(
             "E.mid_kappa_min",
             sig(e.aggregate(|_, y| y < 0.0).kappa_min),
@@ -726,10 +726,7 @@ pub fn figures(maps: &[GMap], secs: f64) -> std::collections::BTreeMap<String, S
                 100.0 * f.cells.iter().filter(|c| c.n > 0 && p(c)).count() as f64 / n
             )
         };
-        put(
-            "F.pct_stiff",
-            frac(&|c| c.kappa > core_math::accuracy::EARTH_F32_KAPPA_LIMIT),
-        );
+        put("F.pct_stiff", frac(&|c| c.kappa > EARTH_F32_KAPPA_LIMIT));
         put("F.pct_over", frac(&|c| c.over_tol > 0));
         if let Some((c, o)) = &f.aggregate(|_, _| true).max_kappa {
             let a = &c.geometry.attitude;

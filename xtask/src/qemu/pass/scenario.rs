@@ -7,6 +7,7 @@
 use anyhow::{anyhow, bail, Context, Result};
 use controller::nav::{Attitude, Nav};
 use controller::EARTH;
+use core_math::earth::kepler::Kepler;
 use core_math::{StateVector, GM_M3_S2};
 
 use crate::csv::Table;
@@ -115,8 +116,7 @@ impl J2Orbit {
     /// Eccentricity of the osculating two-body orbit at `t_s` (for the pass line).
     pub fn eccentricity(&self, t_s: f64) -> f64 {
         let s = self.state(t_s);
-        core_math::earth::kepler::Kepler::new(s.position_m, s.velocity_mps, GM_M3_S2)
-            .map_or(f64::NAN, |k| k.eccentricity())
+        Kepler::new(s.position_m, s.velocity_mps, GM_M3_S2).map_or(f64::NAN, |k| k.eccentricity())
     }
 }
 

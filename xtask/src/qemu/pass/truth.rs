@@ -12,7 +12,10 @@ use anyhow::{anyhow, Result};
 use controller::golden::{self, NavInput};
 use controller::Controller;
 use core_math::earth::{Attitude, EarthGeometry};
-use core_math::{Backend, Geometry, OrbitState, Reference, EARTH_RATE_RAD_S};
+use core_math::{
+    Backend, EarthCamera, EarthReference, Geometry, OrbitState, Reference, StateVector,
+    EARTH_RATE_RAD_S,
+};
 
 use super::check::Downlink;
 use super::scenario::AgileTruth;
@@ -44,8 +47,8 @@ pub struct Report {
     holds: usize,
 }
 
-fn drift(g: &EarthGeometry<f64>, camera: &core_math::EarthCamera, n: f64) -> Option<f64> {
-    core_math::EarthReference
+fn drift(g: &EarthGeometry<f64>, camera: &EarthCamera, n: f64) -> Option<f64> {
+    EarthReference
         .evaluate(camera, g, n)
         .ok()
         .map(|m| (m.v2_mps / m.v1_mps).atan())
@@ -53,7 +56,7 @@ fn drift(g: &EarthGeometry<f64>, camera: &core_math::EarthCamera, n: f64) -> Opt
 
 /// The geometry flown over ground `h_m`, and the same with the yaw left at zero.
 fn flown_and_unsteered(
-    state: core_math::StateVector,
+    state: StateVector,
     attitude: Attitude<f64>,
     h_m: f32,
 ) -> (EarthGeometry<f64>, EarthGeometry<f64>) {
@@ -106,7 +109,7 @@ pub fn check(truth: &AgileTruth, firmware: &Downlink, controller: &Controller) -
             .map_err(|e| anyhow!(e.name()))?;
         paper_pixels.insert(seg.index, pixels);
     }
-    let boresight = core_math::EarthCamera {
+    let boresight = EarthCamera {
         p1_m: 0.0,
         ..scene.earth_camera(&scene.segments[0])
     };
