@@ -28,10 +28,10 @@ use std::process::Command;
 use std::time::Instant;
 
 pub use bench::{bench, measure as bench_counts, BenchArgs, BenchCounts};
+use board::Board;
 pub use board::{size, SizeArgs};
-use board::{Board, BoardArg};
 pub use flash::{flash, FlashArgs};
-pub use pass::e2e_test;
+pub use pass::{e2e_test, run, RunArgs};
 pub use runner::qemu;
 pub use tools::ensure_target_tools;
 
@@ -39,84 +39,6 @@ pub use tools::ensure_target_tools;
 pub const TARGET: &str = "thumbv7em-none-eabihf";
 /// A core without an FPU (Cortex-M3), for the fixed-point backend's build check.
 pub const NO_FPU_TARGET: &str = "thumbv7m-none-eabi";
-
-/// `cargo xtask run`'s options.
-#[derive(clap::Args)]
-pub struct RunArgs {
-    #[command(flatten)]
-    board: BoardArg,
-    /// The default-scene demo (one synthetic NAV frame, no UART) instead of a pass
-    #[arg(long)]
-    demo: bool,
-    /// The firmware's dev profile instead of release
-    #[arg(long)]
-    debug: bool,
-    /// The release profile (the default)
-    #[arg(long, hide = true, conflicts_with = "debug")]
-    release: bool,
-    /// The end-to-end test's 1-minute pass instead of the 10-minute default
-    #[arg(long)]
-    short: bool,
-    /// Play this NAV telemetry (docs/telemetry.md) instead of the default pass
-    #[arg(long, value_name = "FILE.csv")]
-    telemetry: Option<PathBuf>,
-    /// Write the line-period plot here [default: target/pass/line-periods.png]
-    #[arg(long, value_name = "FILE.png")]
-    plot: Option<PathBuf>,
-    /// Seconds between the table's rows
-    #[arg(long, value_name = "SECONDS", default_value_t = pass::TABLE_EVERY_S,
-          value_parser = clap::value_parser!(u64).range(1..))]
-    every: u64,
-    /// The table's segments: indices, or all [default: 0,5,9]
-    #[arg(long, value_name = "0,5,9|all", value_parser = parse_segments)]
-    segments: Option<Segments>,
-    /// Only write the default pass's NAV samples as telemetry CSV
-    #[arg(long, value_name = "FILE.csv")]
-    export_telemetry: Option<PathBuf>,
-}
-
-/// Segment indices given on the command line (one value, not a list of arguments).
-#[derive(Clone, Debug)]
-pub struct Segments(Vec<u8>);
-
-fn parse_segments(v: &str) -> Result<Segments> {
-    if v == "all" {
-        return Ok(Segments((0..16).collect()));
-    }
-    v.split(',')
-        .map(|x| x.trim().parse::<u8>())
-        .collect::<Result<_, _>>()
-        .map(Segments)
-        .map_err(|_| anyhow!("`{v}` is not a list of segment indices like 0,5,9"))
-}
-
-/// `cargo xtask run`: a pass through the firmware under QEMU (docs/telemetry.md), or the
-/// default-scene demo.
-pub fn run(args: &RunArgs) -> Result<()> {
-    let board = args.board.board;
-    let release = !args.debug;
-    if let Some(path) = &args.export_telemetry {
-        return pass::export(path);
-    }
-    if args.demo {
-        ensure_target_tools()?;
-        let elf = build_board_bin(board, "firmware", "demo", release, &[])?;
-        let outcome = runner::run_elf(&elf, &runner::Options::default())?;
-        return exit_like(outcome.status);
-    }
-    pass::run(&pass::RunOptions {
-        board,
-        release,
-        short: args.short,
-        telemetry: args.telemetry.clone(),
-        plot: args.plot.clone(),
-        every_s: args.every,
-        segments: args
-            .segments
-            .clone()
-            .map_or(pass::TABLE_SEGMENTS.to_vec(), |s| s.0),
-    })
-}
 
 /// Every check of the target crates, for `cargo xtask test`: toolchain and QEMU present,
 /// clippy with `-D warnings` on thumbv7em for core-math, controller, firmware and
@@ -320,7 +242,7 @@ fn build_elf(
 }
 
 /// Ends the process with the firmware's exit status (0 returns normally).
-fn exit_like(status: i32) -> Result<()> {
+pub(super) fn exit_like(status: i32) -> Result<()> {
     if status == 0 {
         Ok(())
     } else {

@@ -36,42 +36,91 @@ use crate::plot::{Legend, Plot, Series};
 use check::{Downlink, F32_REL_TOLERANCE};
 use scenario::Pass;
 
-use super::board::Board;
-use super::{build_board_bin, ensure_target_tools, runner, workspace_root};
+use super::board::{Board, BoardArg};
+use super::{build_board_bin, ensure_target_tools, exit_like, runner, workspace_root};
 
 /// Segments shown in the table by default (first, one of the two central ones, last).
 pub const TABLE_SEGMENTS: [u8; 3] = [0, 5, 9];
 /// Table row spacing by default (simulated seconds).
 pub const TABLE_EVERY_S: u64 = 10;
 
-/// What `run` was asked to do.
-pub struct RunOptions {
-    pub board: Board,
-    pub release: bool,
-    /// The end-to-end test's one-minute pass instead of the default one.
-    pub short: bool,
-    pub telemetry: Option<PathBuf>,
-    pub plot: Option<PathBuf>,
-    /// Table: seconds between rows, segments shown.
-    pub every_s: u64,
-    pub segments: Vec<u8>,
+/// `cargo xtask run`'s options.
+#[derive(clap::Args)]
+pub struct RunArgs {
+    #[command(flatten)]
+    board: BoardArg,
+    /// The default-scene demo (one synthetic NAV frame, no UART) instead of a pass
+    #[arg(long)]
+    demo: bool,
+    /// The firmware's dev profile instead of release
+    #[arg(long)]
+    debug: bool,
+    /// The release profile (the default)
+    #[arg(long, hide = true, conflicts_with = "debug")]
+    release: bool,
+    /// The end-to-end test's 1-minute pass instead of the 10-minute default
+    #[arg(long)]
+    short: bool,
+    /// Play this NAV telemetry (docs/telemetry.md) instead of the default pass
+    #[arg(long, value_name = "FILE.csv")]
+    telemetry: Option<PathBuf>,
+    /// Write the line-period plot here [default: target/pass/line-periods.png]
+    #[arg(long, value_name = "FILE.png")]
+    plot: Option<PathBuf>,
+    /// Seconds between the table's rows
+    #[arg(long, value_name = "SECONDS", default_value_t = TABLE_EVERY_S,
+          value_parser = clap::value_parser!(u64).range(1..))]
+    every: u64,
+    /// The table's segments: indices, or all [default: 0,5,9]
+    #[arg(long, value_name = "0,5,9|all", value_parser = parse_segments)]
+    segments: Option<Segments>,
+    /// Only write the default pass's NAV samples as telemetry CSV
+    #[arg(long, value_name = "FILE.csv")]
+    export_telemetry: Option<PathBuf>,
+}
+
+/// Segment indices given on the command line (one value, not a list of arguments).
+#[derive(Clone, Debug)]
+pub struct Segments(Vec<u8>);
+
+fn parse_segments(v: &str) -> Result<Segments> {
+    if v == "all" {
+        return Ok(Segments((0..16).collect()));
+    }
+    v.split(',')
+        .map(|x| x.trim().parse::<u8>())
+        .collect::<Result<_, _>>()
+        .map(Segments)
+        .map_err(|_| anyhow!("`{v}` is not a list of segment indices like 0,5,9"))
 }
 
 /// `cargo xtask run [--telemetry FILE]`: the default pass (or the file) through the
-/// firmware, table, plot, checks.
-pub fn run(options: &RunOptions) -> Result<()> {
+/// firmware, table, plot, checks; or the default-scene demo, or the export of the
+/// default pass's telemetry.
+pub fn run(args: &RunArgs) -> Result<()> {
+    let (board, release) = (args.board.board, !args.debug);
+    if let Some(path) = &args.export_telemetry {
+        return export(path);
+    }
+    if args.demo {
+        ensure_target_tools()?;
+        let elf = build_board_bin(board, "firmware", "demo", release, &[])?;
+        let outcome = runner::run_elf(&elf, &runner::Options::default())?;
+        return exit_like(outcome.status);
+    }
     let started = Instant::now();
     let tick_us = Config::default().update_period_us;
-    let pass = match &options.telemetry {
+    let pass = match &args.telemetry {
         Some(path) => scenario::from_csv(path, tick_us)?,
-        None if options.short => scenario::short_pass(tick_us)?,
+        None if args.short => scenario::short_pass(tick_us)?,
         None => scenario::default_pass(tick_us)?,
     };
     ensure_target_tools()?;
-    let elf = build_board_bin(options.board, "firmware", "firmware", options.release, &[])?;
+    let elf = build_board_bin(board, "firmware", "firmware", release, &[])?;
     let result = play(&elf, &pass)?;
-    print_table(&pass, &result, options.every_s.max(1), &options.segments);
-    let plot = options
+    let segments = args.segments.as_ref().map_or(&TABLE_SEGMENTS[..], |s| &s.0);
+    print_table(&pass, &result, args.every, segments);
+    let plot = args
         .plot
         .clone()
         .unwrap_or_else(|| workspace_root().join("target/pass/line-periods.png"));
