@@ -13,7 +13,7 @@
 use core_math::earth::kepler::Kepler;
 use core_math::earth::{limb_margin_rad, Attitude};
 use core_math::sample::SplitMix64;
-use core_math::vector::norm;
+use core_math::vector::{dot, norm, scale};
 use core_math::{
     Backend, Camera, EarthCamera, EarthGeometry, EarthReference, Ellipsoid, Geometry, ImageMotion,
     OrbitState, Reference, StateVector, EARTH_RATE_RAD_S, GM_M3_S2,
@@ -201,12 +201,12 @@ fn steering_yaw(g: &EarthGeometry<f64>, cam: &EarthCamera) -> Option<f64> {
 fn circularise(s: &StateVector) -> StateVector {
     let (r, v) = (s.position_m, s.velocity_mps);
     let rn = norm(r);
-    let vr = (r[0] * v[0] + r[1] * v[1] + r[2] * v[2]) / rn;
+    let vr = dot(r, v) / rn;
     let t: [f64; 3] = std::array::from_fn(|k| v[k] - vr * r[k] / rn);
     let k = (GM_M3_S2 / rn).sqrt() / norm(t);
     StateVector {
         position_m: r,
-        velocity_mps: t.map(|x| x * k),
+        velocity_mps: scale(k, t),
     }
 }
 

@@ -14,6 +14,7 @@ use core_math::accuracy::{
 };
 use core_math::earth::{circular_state, limb_margin_rad, Attitude, EarthCamera, EarthGeometry};
 use core_math::sample::{roll_at_limb_margin, EarthCase};
+use core_math::vector::norm;
 use core_math::{Backend, EarthReference, Ellipsoid, EARTH_RATE_RAD_S, GENERAL_F32};
 
 use std::path::Path;
@@ -429,8 +430,7 @@ pub fn check_bounds(maps: &[GMap]) -> Vec<String> {
 pub fn describe(c: &EarthCase, o: &GOutcome) -> String {
     let a = &c.geometry.attitude;
     let r = c.geometry.state.position_m;
-    let h_km =
-        (libm::sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]) - c.geometry.ellipsoid.a_m) / 1e3;
+    let h_km = (norm(r) - c.geometry.ellipsoid.a_m) / 1e3;
     let mut s = format!(
         "H {h_km:.0} km, roll {:.2} deg, pitch {:.2} deg, yaw {:.0} deg",
         a.roll_rad.to_degrees(),

@@ -8,6 +8,7 @@ use anyhow::{anyhow, bail, Context, Result};
 use controller::nav::{Attitude, Nav};
 use controller::EARTH;
 use core_math::earth::kepler::Kepler;
+use core_math::vector::{add, dot, scale};
 use core_math::{StateVector, GM_M3_S2};
 
 use crate::csv::Table;
@@ -34,7 +35,7 @@ pub struct J2Orbit {
 }
 
 fn accel(r: [f64; 3]) -> [f64; 3] {
-    let r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+    let r2 = dot(r, r);
     let rn = r2.sqrt();
     let mu_r3 = GM_M3_S2 / (r2 * rn);
     let re = EARTH.a_m;
@@ -48,12 +49,13 @@ fn accel(r: [f64; 3]) -> [f64; 3] {
 }
 
 fn rk4(s: &StateVector, h: f64) -> StateVector {
-    let add = |a: [f64; 3], b: [f64; 3], k: f64| std::array::from_fn(|i| a[i] + k * b[i]);
+    // a + k b
+    let step = |a, b, k| add(a, scale(k, b));
     let (r, v) = (s.position_m, s.velocity_mps);
     let (k1r, k1v) = (v, accel(r));
-    let (k2r, k2v) = (add(v, k1v, h / 2.0), accel(add(r, k1r, h / 2.0)));
-    let (k3r, k3v) = (add(v, k2v, h / 2.0), accel(add(r, k2r, h / 2.0)));
-    let (k4r, k4v) = (add(v, k3v, h), accel(add(r, k3r, h)));
+    let (k2r, k2v) = (step(v, k1v, h / 2.0), accel(step(r, k1r, h / 2.0)));
+    let (k3r, k3v) = (step(v, k2v, h / 2.0), accel(step(r, k2r, h / 2.0)));
+    let (k4r, k4v) = (step(v, k3v, h), accel(step(r, k3r, h)));
     StateVector {
         position_m: std::array::from_fn(|i| {
             r[i] + h / 6.0 * (k1r[i] + 2.0 * k2r[i] + 2.0 * k3r[i] + k4r[i])

@@ -11,6 +11,7 @@ use controller::nav::Nav;
 use controller::Fault;
 
 use controller::EARTH;
+use core_math::vector::{norm, scale};
 
 use super::scenario::{schedule, terrain_payload, us, FaultSpec, Pass, SlotKind};
 
@@ -165,9 +166,7 @@ pub fn build(pass: &Pass) -> Result<Stream> {
             FaultSpec::Altitude { t_s, altitude_m } => {
                 let mut nav = truth_nav(t_s)?;
                 let r = nav.state.position_m;
-                let norm = (r[0] * r[0] + r[1] * r[1] + r[2] * r[2]).sqrt();
-                let scale = (EARTH.a_m + altitude_m) / norm;
-                nav.state.position_m = r.map(|x| x * scale);
+                nav.state.position_m = scale((EARTH.a_m + altitude_m) / norm(r), r);
                 let bytes = frames.nav(us(t_s), &nav);
                 extra.push(injected_item(after(us(t_s)), bytes, k));
                 Some(Fault::OutOfRange)
