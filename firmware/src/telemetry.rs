@@ -22,7 +22,7 @@ use crate::board::Monotonic;
 use crate::link::{flush_bounded, send_bounded, Link};
 
 /// The words of the firmware's first log line that say the link is up: the host's pass
-/// player waits for them before it sends a byte (xtask/src/target/pass.rs).
+/// player waits for them before it sends a byte (xtask/src/qemu/pass.rs).
 pub const READY: &str = "telemetry link ready";
 
 /// How a pass ended.

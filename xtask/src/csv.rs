@@ -5,6 +5,8 @@
 //! reads back to the same value, or a fixed number of decimals), and quoting is the
 //! crate's (only where a field needs it).
 
+use anyhow::{anyhow, bail, Context, Result};
+
 /// A parsed table: the header and the rows, each as the trimmed field texts.
 pub struct Table {
     pub header: Vec<String>,
@@ -13,31 +15,31 @@ pub struct Table {
 
 impl Table {
     /// A header line, then rows of any length; blank lines and `#` lines are skipped.
-    pub fn parse(text: &str) -> Result<Table, String> {
+    pub fn parse(text: &str) -> Result<Table> {
         let mut reader = ::csv::ReaderBuilder::new()
             .trim(::csv::Trim::All)
             .flexible(true)
             .comment(Some(b'#'))
             .from_reader(text.as_bytes());
         let record = |r: &::csv::StringRecord| r.iter().map(str::to_string).collect::<Vec<_>>();
-        let header = record(reader.headers().map_err(|e| format!("csv: {e}"))?);
+        let header = record(reader.headers().context("csv")?);
         if header.is_empty() {
-            return Err("empty input: expected a header line".into());
+            bail!("empty input: expected a header line");
         }
         let rows = reader
             .records()
-            .map(|r| r.map(|r| record(&r)).map_err(|e| format!("csv: {e}")))
+            .map(|r| r.map(|r| record(&r)).context("csv"))
             .collect::<Result<_, _>>()?;
         Ok(Table { header, rows })
     }
 
     /// Index of each wanted column, by name, in any order.
-    pub fn columns(&self, wanted: &[&str]) -> Result<Vec<usize>, String> {
+    pub fn columns(&self, wanted: &[&str]) -> Result<Vec<usize>> {
         wanted
             .iter()
             .map(|w| {
                 self.header.iter().position(|h| h == w).ok_or_else(|| {
-                    format!("missing column `{w}` (header: {})", self.header.join(","))
+                    anyhow!("missing column `{w}` (header: {})", self.header.join(","))
                 })
             })
             .collect()
@@ -48,24 +50,24 @@ impl Table {
 pub struct Writer(::csv::Writer<Vec<u8>>);
 
 impl Writer {
-    pub fn new<H: AsRef<str>>(preamble: &str, header: &[H]) -> Result<Writer, String> {
+    pub fn new<H: AsRef<str>>(preamble: &str, header: &[H]) -> Result<Writer> {
         let mut w = Writer(::csv::Writer::from_writer(preamble.as_bytes().to_vec()));
         w.row(header)?;
         Ok(w)
     }
 
-    pub fn row<F: AsRef<str>>(&mut self, fields: &[F]) -> Result<(), String> {
+    pub fn row<F: AsRef<str>>(&mut self, fields: &[F]) -> Result<()> {
         self.0
             .write_record(fields.iter().map(|f| f.as_ref()))
-            .map_err(|e| format!("csv: {e}"))
+            .context("csv")
     }
 
-    pub fn into_bytes(self) -> Result<Vec<u8>, String> {
-        self.0.into_inner().map_err(|e| format!("csv: {e}"))
+    pub fn into_bytes(self) -> Result<Vec<u8>> {
+        self.0.into_inner().context("csv")
     }
 
-    pub fn into_string(self) -> Result<String, String> {
-        String::from_utf8(self.into_bytes()?).map_err(|e| format!("csv: {e}"))
+    pub fn into_string(self) -> Result<String> {
+        String::from_utf8(self.into_bytes()?).context("csv")
     }
 }
 
@@ -82,6 +84,7 @@ mod tests {
         assert!(t
             .columns(&["c"])
             .unwrap_err()
+            .to_string()
             .contains("missing column `c`"));
         assert!(Table::parse("\n").is_err());
     }

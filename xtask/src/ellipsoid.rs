@@ -9,12 +9,15 @@
 mod costs;
 mod motion;
 
+use anyhow::{anyhow, Context, Result};
 use std::time::Instant;
 
 use controller::Scene;
 use core_math::sphere::{Geometry, OrbitState, Reference, CLOSED_F32};
+use core_math::vector::norm;
 use core_math::{mtf_mismatch, Backend, Camera, ImageMotion, StageRule, EARTH_RATE_RAD_S};
 
+use crate::markdown::{e2, replace_between, signed};
 use motion::{Orbit, Scenario, Spheroid};
 
 /// The orbit of the default pass (`cargo xtask run`): circular, 645 km over the
@@ -204,9 +207,9 @@ fn model_geometry(
     u_rad: f64,
     roll_rad: f64,
     radius_m: f64,
-) -> Result<Geometry<f64>, String> {
+) -> Result<Geometry<f64>> {
     let o = OrbitState::from_state(&orbit.state(u_rad), radius_m)
-        .map_err(|e| format!("ellipsoid: orbit state: {e:?}"))?;
+        .map_err(|e| anyhow!("ellipsoid: orbit state: {e:?}"))?;
     Ok(Geometry {
         roll_rad,
         inclination_rad: o.inclination_rad,
@@ -218,10 +221,10 @@ fn model_geometry(
     })
 }
 
-fn reference(camera: &Camera, g: &Geometry<f64>, n: f64) -> Result<ImageMotion<f64>, String> {
+fn reference(camera: &Camera, g: &Geometry<f64>, n: f64) -> Result<ImageMotion<f64>> {
     Reference
         .evaluate(camera, g, n)
-        .map_err(|e| format!("ellipsoid: reference at n {n}: {e:?}"))
+        .map_err(|e| anyhow!("ellipsoid: reference at n {n}: {e:?}"))
 }
 
 fn drift(m: &ImageMotion<f64>) -> f64 {
@@ -236,7 +239,7 @@ fn case(
     u_rad: f64,
     roll_rad: f64,
     n: f64,
-) -> Result<Errors, String> {
+) -> Result<Errors> {
     let scenario = |earth| Scenario {
         earth,
         earth_rate_rad_s: EARTH_RATE_RAD_S,
@@ -244,13 +247,13 @@ fn case(
         arg_latitude_rad: u_rad,
         roll_rad,
     };
-    let miss = || format!("ellipsoid: pixel {n} misses the Earth");
+    let miss = || anyhow!("ellipsoid: pixel {n} misses the Earth");
     let ell_full = scenario(Spheroid::WGS84)
         .image_motion(camera, n)
         .ok_or_else(miss)?;
     let ell = ell_full.motion;
     let g = ell_full.ground_m;
-    let ground_lat_deg = (g[2] / motion::norm(g)).asin().to_degrees();
+    let ground_lat_deg = (g[2] / norm(g)).asin().to_degrees();
     let sph = scenario(Spheroid::sphere(r_model))
         .image_motion(camera, n)
         .ok_or_else(miss)?
@@ -259,7 +262,7 @@ fn case(
     let g_round = model_geometry(orbit, u_rad, roll_rad, r_model)?;
     let round = reference(camera, &g_round, n)?;
     let (pos, _) = orbit.frame(u_rad);
-    let lat = (pos[2] / motion::norm(pos)).asin();
+    let lat = (pos[2] / norm(pos)).asin();
     let g_local = model_geometry(
         orbit,
         u_rad,
@@ -271,13 +274,13 @@ fn case(
     // (the chain's frame G lifted by R, which is the orbit frame at t = 0).
     let px = Reference
         .pixel(camera, n)
-        .map_err(|e| format!("ellipsoid: pixel {n}: {e:?}"))?;
+        .map_err(|e| anyhow!("ellipsoid: pixel {n}: {e:?}"))?;
     let chain = Reference::chain(&g_local, &px)
-        .map_err(|e| format!("ellipsoid: reference at n {n}: {e:?}"))?;
+        .map_err(|e| anyhow!("ellipsoid: reference at n {n}: {e:?}"))?;
     let (_, e) = orbit.frame(u_rad);
     let up = g_local.earth_radius_m + chain.g_m[2];
     let ground: [f64; 3] = std::array::from_fn(|i| chain.g_m[1] * e[1][i] + up * e[2][i]);
-    let lat_ground = (ground[2] / motion::norm(ground)).asin();
+    let lat_ground = (ground[2] / norm(ground)).asin();
     let g_pixel = model_geometry(
         orbit,
         u_rad,
@@ -287,7 +290,7 @@ fn case(
     let pixel = reference(camera, &g_pixel, n)?;
     let f32m = CLOSED_F32
         .evaluate(camera, &g_round.to::<f32>(), n)
-        .map_err(|e| format!("ellipsoid: f32 closed form at n {n}: {e:?}"))?;
+        .map_err(|e| anyhow!("ellipsoid: f32 closed form at n {n}: {e:?}"))?;
     let f32_speed = f64::from(f32m.speed_mps());
 
     let v_ell = ell.speed_mps();
@@ -308,7 +311,7 @@ fn case(
 
 /// The sweep: one orbit, rolls -25, 0, 25 deg, every active segment's first, middle and
 /// last pixel of the default scene.
-pub fn summary() -> Result<EllipsoidSummary, String> {
+pub fn summary() -> Result<EllipsoidSummary> {
     let scene = Scene::paper_default();
     let camera = scene.camera;
     // The round Earth of the paper's model (the controller's until issue 12).
@@ -381,7 +384,7 @@ pub fn summary() -> Result<EllipsoidSummary, String> {
     }
 
     let floor = f64::from(scene.mtf_floor);
-    let rule = StageRule::<f64>::new(floor).map_err(|e| format!("ellipsoid: {e:?}"))?;
+    let rule = StageRule::<f64>::new(floor).map_err(|e| anyhow!("ellipsoid: {e:?}"))?;
     let mtf = |e: f64| mtf_mismatch::<f64>(stages, e.abs()).unwrap_or(f64::NAN);
     Ok(EllipsoidSummary {
         worst_rel_err: all.round.worst,
@@ -406,23 +409,11 @@ pub fn summary() -> Result<EllipsoidSummary, String> {
     })
 }
 
-fn sci(x: f64) -> String {
-    format!("{x:.2e}")
-}
-
-fn signed(x: f64) -> String {
-    if x >= 0.0 {
-        format!("+{x:.2e}")
-    } else {
-        format!("{x:.2e}")
-    }
-}
-
 /// The markdown block between the doc's markers.
-fn render(s: &EllipsoidSummary) -> Result<String, String> {
+fn render(s: &EllipsoidSummary) -> Result<String> {
     let stages = s.stages;
     let mtf = |e: f64| mtf_mismatch::<f64>(stages, e.abs()).unwrap_or(f64::NAN);
-    let rule = StageRule::<f64>::new(s.mtf_floor).map_err(|e| format!("ellipsoid: {e:?}"))?;
+    let rule = StageRule::<f64>::new(s.mtf_floor).map_err(|e| anyhow!("ellipsoid: {e:?}"))?;
     let max_m = |e: f64| rule.max_stages(e.abs(), s.max_stages).unwrap_or(0);
     let (w, l, p, a) = (
         s.worst_rel_err,
@@ -457,9 +448,9 @@ fn render(s: &EllipsoidSummary) -> Result<String, String> {
             signed(st.round.max),
             st.round.at_lat_deg,
             st.round.at_u_deg,
-            sci(st.round.rms()),
+            e2(st.round.rms()),
             signed(st.local.worst),
-            sci(st.local.rms()),
+            e2(st.local.rms()),
             signed(st.pixel.worst),
             st.drift.worst * 1e6,
             signed(st.f32_arith.worst),
@@ -488,7 +479,7 @@ fn render(s: &EllipsoidSummary) -> Result<String, String> {
          radius {:.2} %, the f32 arithmetic {:.4} % ({CMD}).\n\
          - Largest stage count meeting the floor with that error alone (scene limit {}): \
          round Earth {}, sub-satellite radius {}, ground-point radius {} ({CMD}).\n\n{END}",
-        sci(s.validation_worst),
+        e2(s.validation_worst),
         s.cases,
         signed(w),
         s.worst_lat_deg,
@@ -498,7 +489,7 @@ fn render(s: &EllipsoidSummary) -> Result<String, String> {
         s.worst_ground_lat_deg,
         signed(s.range_rel_err.0),
         signed(s.range_rel_err.1),
-        sci(s.rms_rel_err),
+        e2(s.rms_rel_err),
         signed(-w / (1.0 + w)),
         signed(l),
         w.abs() / l.abs(),
@@ -510,7 +501,7 @@ fn render(s: &EllipsoidSummary) -> Result<String, String> {
         mtf(p),
         mtf(a),
         s.mtf_floor,
-        sci(s.budget_rel),
+        e2(s.budget_rel),
         100.0 * w.abs() / s.budget_rel,
         100.0 * l.abs() / s.budget_rel,
         100.0 * p.abs() / s.budget_rel,
@@ -527,13 +518,6 @@ fn replace_block(doc: &str, block: &str) -> Option<String> {
     replace_between(doc, BEGIN, END, block)
 }
 
-/// `doc` with the text from `begin` to `end` (markers included) replaced by `block`.
-fn replace_between(doc: &str, begin: &str, end: &str, block: &str) -> Option<String> {
-    let b = doc.find(begin)?;
-    let e = doc[b..].find(end)? + b + end.len();
-    Some(format!("{}{block}{}", &doc[..b], &doc[e..]))
-}
-
 #[derive(clap::Args)]
 pub struct Args {
     /// The markdown blocks to stdout, docs/earth-model.md untouched
@@ -541,7 +525,7 @@ pub struct Args {
     print: bool,
 }
 
-pub fn run(args: &Args) -> Result<(), String> {
+pub fn run(args: &Args) -> Result<()> {
     let print_only = args.print;
     let t0 = Instant::now();
     let s = summary()?;
@@ -552,13 +536,13 @@ pub fn run(args: &Args) -> Result<(), String> {
         println!("{block}");
         println!("{costs_block}");
     } else {
-        let path = crate::target::workspace_root().join(DOC);
-        let doc = std::fs::read_to_string(&path).map_err(|e| format!("reading {DOC}: {e}"))?;
-        let new =
-            replace_block(&doc, &block).ok_or(format!("{DOC} lacks the ellipsoid markers"))?;
+        let path = crate::qemu::workspace_root().join(DOC);
+        let doc = std::fs::read_to_string(&path).with_context(|| format!("reading {DOC}"))?;
+        let new = replace_block(&doc, &block)
+            .with_context(|| format!("{DOC} lacks the ellipsoid markers"))?;
         let new = replace_between(&new, COSTS_BEGIN, COSTS_END, &costs_block)
-            .ok_or(format!("{DOC} lacks the ellipsoid-costs markers"))?;
-        std::fs::write(&path, new).map_err(|e| format!("writing {DOC}: {e}"))?;
+            .with_context(|| format!("{DOC} lacks the ellipsoid-costs markers"))?;
+        std::fs::write(&path, new).with_context(|| format!("writing {DOC}"))?;
         eprintln!("ellipsoid: wrote {DOC}");
     }
     println!("{}", s.line());

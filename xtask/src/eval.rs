@@ -1,29 +1,24 @@
 //! `cargo xtask eval [--model <sphere|earth>] --backend <...> --input CASES.csv`: a model
 //! on user-supplied cases, CSV out, so the firmware's numbers can be checked on the
 //! ground. `sphere` (the default) is the paper's round Earth; `earth` the real-Earth
-//! model of `shared/EARTH-MODEL.md` (`eval/earth.rs`).
+//! model, with the columns `shared/EARTH-MODEL.md` ("Eval CSV") specifies. One generic
+//! path serves both: a model names its columns ([`Columns`]) and any [`Backend`] of it
+//! is evaluated the same way.
 
-mod earth;
+use std::fmt::Display;
 
+use anyhow::{bail, Context, Result};
+use core_math::earth::{Attitude, EarthCamera, EarthGeometry};
 use core_math::sphere::fixed_point::{geometry_from_f64, motion_to_f64};
-use core_math::sphere::{speed_line_period_s, Sphere};
-use core_math::sphere::{Geometry, Reference, CLOSED_F32, CLOSED_F64, FIXED};
-use core_math::{Backend, Camera, ModelError, Real};
+use core_math::sphere::{
+    speed_line_period_s, Geometry, Reference, Sphere, CLOSED_F32, CLOSED_F64, FIXED,
+};
+use core_math::{
+    line_period_s, Backend, Camera, Earth, EarthReference, Ellipsoid, ImageMotion,
+    Model as MathModel, ModelError, Real, StateVector, EARTH_RATE_RAD_S, GENERAL_F32, GENERAL_F64,
+};
 
 use crate::csv::{Table, Writer};
-
-/// Input columns, in the order the model takes them.
-pub const INPUT_COLUMNS: [&str; 8] = [
-    "n_px",
-    "phi_deg",
-    "i0_deg",
-    "gamma0_deg",
-    "h_m",
-    "f_m",
-    "pixel_m",
-    "r_m",
-];
-pub const OUTPUT_COLUMNS: [&str; 5] = ["v1_mps", "v2_mps", "v_mps", "line_period_s", "error"];
 
 /// The Earth of a model.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -47,61 +42,228 @@ pub struct Args {
     input: String,
 }
 
-pub fn run(args: &Args) -> Result<(), String> {
-    let (backend, input) = (&args.backend, &args.input);
+pub fn run(args: &Args) -> Result<()> {
+    let input = &args.input;
     let text = if input == "-" {
-        std::io::read_to_string(std::io::stdin()).map_err(|e| format!("reading stdin: {e}"))?
+        std::io::read_to_string(std::io::stdin()).context("reading stdin")?
     } else {
-        std::fs::read_to_string(input).map_err(|e| format!("reading {input}: {e}"))?
+        std::fs::read_to_string(input).with_context(|| format!("reading {input}"))?
     };
-    let out = match args.model {
-        Model::Earth => earth::eval_csv(backend, &text)?,
-        Model::Sphere => eval_csv(backend, &text)?,
-    };
-    print!("{out}");
+    print!("{}", eval_csv(args.model, &args.backend, &text)?);
     Ok(())
 }
 
 /// The whole command on a CSV text: one output row per input row, always.
-pub fn eval_csv(backend: &str, text: &str) -> Result<String, String> {
-    let table = Table::parse(text)?;
-    let cols = table.columns(&INPUT_COLUMNS)?;
-    write_rows(&table, &OUTPUT_COLUMNS, |row| {
-        parse_case(row, &cols).and_then(|case| match backend {
-            "reference" => evaluate(&Reference, &case, |g| g),
-            "f64" => evaluate(&CLOSED_F64, &case, |g| g),
-            "f32" => evaluate(&CLOSED_F32, &case, |g| g.to::<f32>()),
-            "fixed" => evaluate_fixed(&case),
-            other => Err(EvalError::Usage(format!(
-                "unknown backend `{other}` (reference|f64|f32|fixed)"
-            ))),
-        })
-    })
+pub fn eval_csv(model: Model, backend: &str, text: &str) -> Result<String> {
+    match (model, backend) {
+        (Model::Sphere, "reference") => eval_rows(text, |c| evaluate(&Reference, c, |g| g)),
+        (Model::Sphere, "f64") => eval_rows(text, |c| evaluate(&CLOSED_F64, c, |g| g)),
+        (Model::Sphere, "f32") => eval_rows(text, |c| evaluate(&CLOSED_F32, c, |g| g.to())),
+        (Model::Sphere, "fixed") => eval_rows(text, evaluate_fixed),
+        (Model::Sphere, other) => bail!("unknown backend `{other}` (reference|f64|f32|fixed)"),
+        (Model::Earth, "reference") => eval_rows(text, |c| evaluate(&EarthReference, c, |g| g)),
+        (Model::Earth, "f64") => eval_rows(text, |c| evaluate(&GENERAL_F64, c, |g| g)),
+        (Model::Earth, "f32") => eval_rows(text, |c| evaluate(&GENERAL_F32, c, |g| g.to())),
+        (Model::Earth, "fixed") => bail!(
+            "eval: the earth model has no fixed-point backend (use reference|f64|f32, or \
+             --model sphere for fixed)"
+        ),
+        (Model::Earth, other) => {
+            bail!("eval: unknown backend `{other}` for the earth model (reference|f64|f32)")
+        }
+    }
 }
 
-/// The output text: the input header and `outputs` (the last of which is `error`), then
-/// each input row as given followed by its numbers and an empty error, or by empty
-/// numbers and the error's name. Stops at the first usage error.
-fn write_rows<const N: usize>(
-    table: &Table,
-    outputs: &[&str],
-    mut eval_row: impl FnMut(&[String]) -> Result<[String; N], EvalError>,
-) -> Result<String, String> {
+/// What `eval` needs of a model: its CSV columns and how a case is built from them.
+pub trait Columns: MathModel + Sized {
+    /// Required input columns, in the order [`Columns::case`] takes them.
+    const INPUTS: &'static [&'static str];
+    /// Optional input columns and their defaults (a missing column or an empty cell).
+    const OPTIONAL: &'static [(&'static str, f64)];
+    /// Output columns, the last of which is `error`.
+    const OUTPUTS: &'static [&'static str];
+    /// The case of the inputs, then the optional values, in column order (SI units but
+    /// for the angles, in deg as the CSV gives them).
+    fn case(v: &[f64]) -> Case<Self>;
+    /// The output numbers from a motion, in the backend's own precision.
+    fn numbers<T: Real + Display>(
+        camera: &Self::Camera,
+        m: &ImageMotion<T>,
+    ) -> Result<Vec<String>, ModelError>;
+}
+
+/// One case in SI units: optics, geometry (f64, to be rounded by the backend), pixel.
+pub struct Case<M: MathModel> {
+    pub camera: M::Camera,
+    pub geometry: M::Geometry<f64>,
+    pub n_px: f64,
+}
+
+impl Columns for Sphere {
+    const INPUTS: &'static [&'static str] = &[
+        "n_px",
+        "phi_deg",
+        "i0_deg",
+        "gamma0_deg",
+        "h_m",
+        "f_m",
+        "pixel_m",
+        "r_m",
+    ];
+    const OPTIONAL: &'static [(&'static str, f64)] = &[];
+    const OUTPUTS: &'static [&'static str] =
+        &["v1_mps", "v2_mps", "v_mps", "line_period_s", "error"];
+
+    fn case(v: &[f64]) -> Case<Sphere> {
+        let &[n_px, phi_deg, i0_deg, gamma0_deg, h_m, f_m, pixel_m, r_m] = v else {
+            unreachable!("eight input columns")
+        };
+        let rad = f64::to_radians;
+        Case {
+            camera: Camera {
+                focal_m: f_m,
+                pixel_m,
+            },
+            geometry: Geometry::circular(rad(phi_deg), rad(i0_deg), rad(gamma0_deg), h_m, r_m),
+            n_px,
+        }
+    }
+
+    /// v1, v2, |v| and the line period pixel/|v|.
+    fn numbers<T: Real + Display>(
+        c: &Camera,
+        m: &ImageMotion<T>,
+    ) -> Result<Vec<String>, ModelError> {
+        let speed = m.speed_mps();
+        let period = speed_line_period_s(T::from_f64(c.pixel_m), speed)?;
+        Ok([m.v1_mps, m.v2_mps, speed, period]
+            .map(|x| x.to_string())
+            .to_vec())
+    }
+}
+
+impl Columns for Earth {
+    const INPUTS: &'static [&'static str] = &[
+        "x_m",
+        "y_m",
+        "z_m",
+        "vx_mps",
+        "vy_mps",
+        "vz_mps",
+        "roll_deg",
+        "pitch_deg",
+        "yaw_deg",
+        "roll_rate_dps",
+        "pitch_rate_dps",
+        "yaw_rate_dps",
+        "ground_h_m",
+        "f_m",
+        "pixel_m",
+        "n_px",
+    ];
+    const OPTIONAL: &'static [(&'static str, f64)] = &[
+        ("p1_m", 0.0),
+        ("a_m", Ellipsoid::WGS84.a_m),
+        ("flattening", Ellipsoid::WGS84.flattening),
+        ("earth_rate_rad_s", EARTH_RATE_RAD_S),
+    ];
+    const OUTPUTS: &'static [&'static str] = &[
+        "v1_mps",
+        "v2_mps",
+        "v_mps",
+        "line_period_s",
+        "drift_rad",
+        "error",
+    ];
+
+    fn case(v: &[f64]) -> Case<Earth> {
+        let &[x, y, z, vx, vy, vz, roll, pitch, yaw, roll_rate, pitch_rate, yaw_rate, ground_h_m, f_m, pixel_m, n_px, p1_m, a_m, flattening, earth_rate_rad_s] =
+            v
+        else {
+            unreachable!("sixteen input and four optional columns")
+        };
+        let rad = f64::to_radians;
+        Case {
+            camera: EarthCamera {
+                focal_m: f_m,
+                pixel_m,
+                p1_m,
+            },
+            geometry: EarthGeometry {
+                state: StateVector {
+                    position_m: [x, y, z],
+                    velocity_mps: [vx, vy, vz],
+                },
+                attitude: Attitude {
+                    roll_rad: rad(roll),
+                    pitch_rad: rad(pitch),
+                    yaw_rad: rad(yaw),
+                    roll_rate_rad_s: rad(roll_rate),
+                    pitch_rate_rad_s: rad(pitch_rate),
+                    yaw_rate_rad_s: rad(yaw_rate),
+                },
+                ground_h_m,
+                ellipsoid: Ellipsoid { a_m, flattening },
+                earth_rate_rad_s,
+            },
+            n_px,
+        }
+    }
+
+    /// v1, v2, |v|, the line period pixel/|v1| and the drift atan(v2/v1).
+    fn numbers<T: Real + Display>(
+        c: &EarthCamera,
+        m: &ImageMotion<T>,
+    ) -> Result<Vec<String>, ModelError> {
+        let period = line_period_s(T::from_f64(c.pixel_m), m);
+        if !period.is_finite() {
+            return Err(ModelError::NoAlongTrackMotion);
+        }
+        let numbers = [m.v1_mps, m.v2_mps, m.speed_mps(), period, m.drift_rad()];
+        Ok(numbers.map(|x| x.to_string()).to_vec())
+    }
+}
+
+/// Why a row has no numbers.
+enum RowError {
+    Model(ModelError),
+    Unparsable,
+}
+
+impl From<ModelError> for RowError {
+    fn from(e: ModelError) -> Self {
+        RowError::Model(e)
+    }
+}
+
+/// The output text: the input header and the model's outputs, then each input row as
+/// given followed by its numbers and an empty error, or by empty numbers and the
+/// error's name.
+fn eval_rows<M: Columns>(
+    text: &str,
+    eval: impl Fn(&Case<M>) -> Result<Vec<String>, RowError>,
+) -> Result<String> {
+    let table = Table::parse(text)?;
+    let required = table.columns(M::INPUTS)?;
+    let optional: Vec<Option<usize>> = M::OPTIONAL
+        .iter()
+        .map(|(name, _)| table.header.iter().position(|h| h == name))
+        .collect();
     let header: Vec<&str> = table
         .header
         .iter()
         .map(String::as_str)
-        .chain(outputs.iter().copied())
+        .chain(M::OUTPUTS.iter().copied())
         .collect();
     let mut out = Writer::new("", &header)?;
+    let blank = vec![String::new(); M::OUTPUTS.len() - 1];
     for row in &table.rows {
-        let (nums, error) = match eval_row(row) {
+        let (nums, error) = match parse_row(row, &required, &optional, M::OPTIONAL)
+            .and_then(|v| eval(&M::case(&v)))
+        {
             Ok(nums) => (nums, ""),
-            Err(EvalError::Model(e)) => (std::array::from_fn(|_| String::new()), e.name()),
-            Err(EvalError::Unparsable) => {
-                (std::array::from_fn(|_| String::new()), "unparsable_input")
-            }
-            Err(EvalError::Usage(msg)) => return Err(msg),
+            Err(RowError::Model(e)) => (blank.clone(), e.name()),
+            Err(RowError::Unparsable) => (blank.clone(), "unparsable_input"),
         };
         let fields: Vec<&str> = row
             .iter()
@@ -114,84 +276,50 @@ fn write_rows<const N: usize>(
     out.into_string()
 }
 
-enum EvalError {
-    Model(ModelError),
-    Unparsable,
-    Usage(String),
-}
-
-impl From<ModelError> for EvalError {
-    fn from(e: ModelError) -> Self {
-        EvalError::Model(e)
+/// The required values, then the optional ones (their default where the column or the
+/// cell is missing).
+fn parse_row(
+    row: &[String],
+    required: &[usize],
+    optional: &[Option<usize>],
+    defaults: &[(&str, f64)],
+) -> Result<Vec<f64>, RowError> {
+    let cell = |c: usize| row.get(c).map(String::as_str).unwrap_or("");
+    let number = |text: &str| text.parse::<f64>().map_err(|_| RowError::Unparsable);
+    let mut v = required
+        .iter()
+        .map(|&c| number(cell(c)))
+        .collect::<Result<Vec<f64>, _>>()?;
+    for (col, (_, default)) in optional.iter().zip(defaults) {
+        v.push(match col.map(cell) {
+            None | Some("") => *default,
+            Some(text) => number(text)?,
+        });
     }
+    Ok(v)
 }
 
-/// One case in SI units: optics, geometry (f64, to be rounded by the backend), pixel.
-pub struct Case {
-    pub camera: Camera,
-    pub geometry: Geometry<f64>,
-    pub n_px: f64,
-}
-
-fn parse_case(row: &[String], cols: &[usize]) -> Result<Case, EvalError> {
-    let mut v = [0.0f64; 8];
-    for (slot, &c) in v.iter_mut().zip(cols) {
-        *slot = row
-            .get(c)
-            .and_then(|s| s.parse::<f64>().ok())
-            .ok_or(EvalError::Unparsable)?;
-    }
-    let [n_px, phi_deg, i0_deg, gamma0_deg, h_m, f_m, pixel_m, r_m] = v;
-    Ok(Case {
-        camera: Camera {
-            focal_m: f_m,
-            pixel_m,
-        },
-        geometry: Geometry::circular(
-            phi_deg.to_radians(),
-            i0_deg.to_radians(),
-            gamma0_deg.to_radians(),
-            h_m,
-            r_m,
-        ),
-        n_px,
-    })
-}
-
-/// v1, v2, |v| and the line period, formatted in the backend's own precision
-/// (shortest text that reads back to the same value).
-fn evaluate<B: Backend<Sphere>>(
+/// A backend's numbers, in its own precision (shortest text that reads back to the
+/// same value).
+fn evaluate<M: Columns, B: Backend<M>>(
     backend: &B,
-    case: &Case,
-    to_real: impl Fn(Geometry<f64>) -> Geometry<B::Real>,
-) -> Result<[String; 4], EvalError>
+    case: &Case<M>,
+    to_real: impl Fn(M::Geometry<f64>) -> M::Geometry<B::Real>,
+) -> Result<Vec<String>, RowError>
 where
-    B::Real: Real + std::fmt::Display,
+    B::Real: Real + Display,
+    M::Geometry<f64>: Copy,
 {
     let m = backend.evaluate(&case.camera, &to_real(case.geometry), case.n_px)?;
-    let speed = m.speed_mps();
-    let period = speed_line_period_s(B::Real::from_f64(case.camera.pixel_m), speed)?;
-    Ok([
-        m.v1_mps.to_string(),
-        m.v2_mps.to_string(),
-        speed.to_string(),
-        period.to_string(),
-    ])
+    Ok(M::numbers(&case.camera, &m)?)
 }
 
 /// The fixed-point backend: the geometry rounded to I24F40, the results widened to f64
 /// (exact) and printed as f64; |v| and the line period in f64 from them.
-fn evaluate_fixed(case: &Case) -> Result<[String; 4], EvalError> {
+fn evaluate_fixed(case: &Case<Sphere>) -> Result<Vec<String>, RowError> {
     let g = geometry_from_f64(&case.geometry)?;
     let m = motion_to_f64(&FIXED.evaluate(&case.camera, &g, case.n_px)?);
-    let speed = m.speed_mps();
-    let period = speed_line_period_s(case.camera.pixel_m, speed)?;
-    Ok([
-        m.v1_mps.to_string(),
-        m.v2_mps.to_string(),
-        speed.to_string(),
-        period.to_string(),
-    ])
+    Ok(Sphere::numbers(&case.camera, &m)?)
 }
 
 #[cfg(test)]
@@ -206,28 +334,41 @@ bad_focal,0,0,97.98,0,645000,0,13e-6,6370000
 garbled,x,0,97.98,0,645000,0.555,13e-6,6370000
 ";
 
+    /// A 645 km sun-synchronous state (circular: 7 016 137 m, 7 537.5 m/s), then the same
+    /// agile, eccentric and mountainous; a case with the optional columns given, one
+    /// beyond the limb, one with a bad focal length, one garbled.
+    const EARTH_CASES: &str = "case,x_m,y_m,z_m,vx_mps,vy_mps,vz_mps,roll_deg,pitch_deg,yaw_deg,\
+roll_rate_dps,pitch_rate_dps,yaw_rate_dps,ground_h_m,f_m,pixel_m,n_px,p1_m,a_m
+nadir,7016137,0,0,0,-1046.6,7464.5,0,0,0,0,0,0,0,0.555,13e-6,0,,
+agile,7016137,0,0,150,-1046.6,7464.5,20,-25,7,0.3,-1,0.5,4000,0.555,13e-6,20000,0.01,
+sphere,7016137,0,0,0,-1046.6,7464.5,0,0,0,0,0,0,0,0.555,13e-6,0,,6371000
+beyond_limb,7016137,0,0,0,-1046.6,7464.5,70,0,0,0,0,0,0,0.555,13e-6,0,,
+bad_focal,7016137,0,0,0,-1046.6,7464.5,0,0,0,0,0,0,0,0,13e-6,0,,
+garbled,7016137,0,0,0,-1046.6,7464.5,x,0,0,0,0,0,0,0.555,13e-6,0,,
+";
+
     /// An output (header and rows), read back by column name.
-    pub(super) struct Out(Table);
+    struct Out(Table);
 
     impl Out {
-        pub(super) fn of(text: &str) -> Out {
-            Out(Table::parse(text).unwrap())
+        fn of(model: Model, backend: &str, cases: &str) -> Out {
+            Out(Table::parse(&eval_csv(model, backend, cases).unwrap()).unwrap())
         }
 
-        pub(super) fn rows(&self) -> usize {
+        fn rows(&self) -> usize {
             self.0.rows.len()
         }
 
         /// Field `name` of row `row` (0: the first after the header).
-        pub(super) fn field(&self, row: usize, name: &str) -> &str {
+        fn field(&self, row: usize, name: &str) -> &str {
             &self.0.rows[row][self.0.columns(&[name]).unwrap()[0]]
         }
 
-        pub(super) fn num(&self, row: usize, name: &str) -> f64 {
+        fn num(&self, row: usize, name: &str) -> f64 {
             self.field(row, name).parse().unwrap()
         }
 
-        pub(super) fn header(&self) -> String {
+        fn header(&self) -> String {
             self.0.header.join(",")
         }
     }
@@ -235,7 +376,7 @@ garbled,x,0,97.98,0,645000,0.555,13e-6,6370000
     #[test]
     fn one_row_per_input_row_with_typed_errors() {
         for backend in ["reference", "f64", "f32", "fixed"] {
-            let out = Out::of(&eval_csv(backend, CASES).unwrap());
+            let out = Out::of(Model::Sphere, backend, CASES);
             assert_eq!(out.rows(), 5);
             assert!(out
                 .header()
@@ -247,14 +388,14 @@ garbled,x,0,97.98,0,645000,0.555,13e-6,6370000
             assert_eq!(out.field(3, "error"), "non_positive_focal_length");
             assert_eq!(out.field(4, "error"), "unparsable_input");
         }
-        assert!(eval_csv("f16", CASES).is_err());
+        assert!(eval_csv(Model::Sphere, "f16", CASES).is_err());
     }
 
     #[test]
     fn backends_agree_and_period_is_pixel_over_speed() {
-        let r = Out::of(&eval_csv("reference", CASES).unwrap());
-        let f = Out::of(&eval_csv("f32", CASES).unwrap());
-        let x = Out::of(&eval_csv("fixed", CASES).unwrap());
+        let r = Out::of(Model::Sphere, "reference", CASES);
+        let f = Out::of(Model::Sphere, "f32", CASES);
+        let x = Out::of(Model::Sphere, "fixed", CASES);
         for row in 0..2 {
             let (vr, vf, vx) = (
                 r.num(row, "v_mps"),
@@ -265,6 +406,46 @@ garbled,x,0,97.98,0,645000,0.555,13e-6,6370000
             assert!((vx - vr).abs() / vr < 2e-6, "fixed {vx} vs {vr}");
             let t = r.num(row, "line_period_s");
             assert!((t - 13e-6 / vr).abs() < 1e-15 * t);
+        }
+    }
+
+    #[test]
+    fn earth_one_row_per_input_row_with_typed_errors() {
+        for backend in ["reference", "f64", "f32"] {
+            let out = Out::of(Model::Earth, backend, EARTH_CASES);
+            assert_eq!(out.rows(), 6);
+            assert!(out
+                .header()
+                .ends_with("v1_mps,v2_mps,v_mps,line_period_s,drift_rad,error"));
+            assert_eq!(out.field(0, "case"), "nadir", "extra columns are kept");
+            for row in 0..3 {
+                assert_eq!(out.field(row, "error"), "", "row {row}");
+            }
+            assert_eq!(out.field(3, "error"), "line_of_sight_misses_earth");
+            assert_eq!(out.field(3, "v1_mps"), "");
+            assert_eq!(out.field(4, "error"), "invalid_input");
+            assert_eq!(out.field(5, "error"), "unparsable_input");
+        }
+        assert!(eval_csv(Model::Earth, "fixed", EARTH_CASES)
+            .unwrap_err()
+            .to_string()
+            .contains("no fixed-point"));
+        assert!(eval_csv(Model::Earth, "f16", EARTH_CASES).is_err());
+    }
+
+    /// The derived outputs follow the definition from v1 and v2, and the backends agree.
+    #[test]
+    fn earth_derived_outputs_and_agreement() {
+        let r = Out::of(Model::Earth, "reference", EARTH_CASES);
+        let f = Out::of(Model::Earth, "f32", EARTH_CASES);
+        for row in 0..3 {
+            let (v1, v2) = (r.num(row, "v1_mps"), r.num(row, "v2_mps"));
+            assert!((r.num(row, "v_mps") - v1.hypot(v2)).abs() <= 1e-16);
+            let t = r.num(row, "line_period_s");
+            assert!((t - 13e-6 / v1.abs()).abs() <= 1e-15 * t);
+            assert!((r.num(row, "drift_rad") - (v2 / v1).atan()).abs() <= 1e-15);
+            let d = (f.num(row, "v1_mps") - v1).hypot(f.num(row, "v2_mps") - v2);
+            assert!(d / v1.hypot(v2) < 2e-6, "row {row}");
         }
     }
 }

@@ -6,28 +6,29 @@
 //! constants its `pixel`, `update` and `motion` bring into a binary, shared support
 //! (soft-float routines, libm) included, the runtime and logger excluded.
 
+use anyhow::{anyhow, Context, Result};
 use std::path::Path;
 
 use object::{Object, ObjectSection, SectionFlags};
 
-use crate::target::build_bin_with;
+use crate::qemu::build_bin_with;
 
 /// Loadable bytes of the footprint binary built for `variant`.
-fn image_bytes(variant: &str) -> Result<u64, String> {
+fn image_bytes(variant: &str) -> Result<u64> {
     let cfg = format!("footprint=\"{variant}\"");
     let elf = build_bin_with("firmware", "footprint", true, &["bench"], &["--cfg", &cfg])?;
     flash_bytes(&elf)
 }
 
 /// Flash bytes of each of `variants` beyond the empty ("none") build.
-pub fn variant_bytes(variants: &[&str]) -> Result<Vec<u64>, String> {
+pub fn variant_bytes(variants: &[&str]) -> Result<Vec<u64>> {
     let base = image_bytes("none")?;
     variants
         .iter()
         .map(|v| {
             let with = image_bytes(v)?;
             with.checked_sub(base).ok_or_else(|| {
-                format!("footprint: `{v}` ({with} B) is smaller than none ({base} B)")
+                anyhow!("footprint: `{v}` ({with} B) is smaller than none ({base} B)")
             })
         })
         .collect()
@@ -36,9 +37,9 @@ pub fn variant_bytes(variants: &[&str]) -> Result<Vec<u64>, String> {
 /// Bytes of every section an ELF image loads from flash: allocated (`SHF_ALLOC`) and
 /// with contents in the file (not `SHT_NOBITS`): vector table, code, constants and the
 /// initial image of `.data`.
-pub fn flash_bytes(elf: &Path) -> Result<u64, String> {
-    let bytes = std::fs::read(elf).map_err(|e| format!("reading {}: {e}", elf.display()))?;
-    loadable_bytes(&bytes).map_err(|e| format!("{}: {e}", elf.display()))
+pub fn flash_bytes(elf: &Path) -> Result<u64> {
+    let bytes = std::fs::read(elf).with_context(|| format!("reading {}", elf.display()))?;
+    loadable_bytes(&bytes).with_context(|| format!("{}", elf.display()))
 }
 
 fn loadable_bytes(elf: &[u8]) -> Result<u64, object::Error> {

@@ -9,12 +9,13 @@ mod csv;
 mod ellipsoid;
 mod eval;
 mod footprint;
+mod markdown;
 mod no_panic;
 mod paper;
 mod plot;
+mod qemu;
 mod report;
 mod stability;
-mod target;
 mod test_cmd;
 
 use std::process::ExitCode;
@@ -41,13 +42,13 @@ enum Command {
     /// Every check CI runs
     Test,
     /// A pass through the firmware under QEMU (docs/telemetry.md), or the demo
-    Run(target::RunArgs),
+    Run(qemu::RunArgs),
     /// Guest instructions per evaluation, from a QEMU plugin (docs/bench.md)
-    Bench(target::BenchArgs),
+    Bench(qemu::BenchArgs),
     /// Flash and static RAM of the release flight binary, per board (docs/target.md)
-    Size(target::SizeArgs),
+    Size(qemu::SizeArgs),
     /// The firmware on a real board through probe-rs (docs/target.md)
-    Flash(target::FlashArgs),
+    Flash(qemu::FlashArgs),
     /// Error against run time per backend; runs the bench (docs/error-vs-runtime.md)
     Report(report::Args),
     /// Regenerate docs/stability.md and its maps
@@ -74,19 +75,19 @@ fn main() -> ExitCode {
         Command::Accuracy(args) => accuracy::run(&args),
         Command::Paper(args) => paper::run(&args),
         Command::Test => test_cmd::run(),
-        Command::Run(args) => target::run(&args),
-        Command::Bench(args) => target::bench(&args),
-        Command::Size(args) => target::size(&args),
-        Command::Flash(args) => target::flash(&args),
+        Command::Run(args) => qemu::run(&args),
+        Command::Bench(args) => qemu::bench(&args),
+        Command::Size(args) => qemu::size(&args),
+        Command::Flash(args) => qemu::flash(&args),
         Command::Report(args) => report::run(&args),
         Command::Stability(args) => stability::run(&args),
         Command::Ellipsoid(args) => ellipsoid::run(&args),
-        Command::Qemu { args } => target::qemu(&args),
+        Command::Qemu { args } => qemu::qemu(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("xtask: {e}");
+            eprintln!("xtask: {e:#}");
             ExitCode::FAILURE
         }
     }

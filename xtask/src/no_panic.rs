@@ -9,6 +9,7 @@
 //! ELF: the `core::panic::Location` records still in it (file:line:col of each panic
 //! that survived optimisation) and the functions that branch into the panic machinery.
 
+use anyhow::{anyhow, bail, Context, Result};
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::PathBuf;
 use std::process::{Command, Stdio};
@@ -16,7 +17,7 @@ use std::time::Instant;
 
 use object::{Object, ObjectSection, ObjectSymbol, SectionKind, SymbolKind};
 
-use crate::target::{workspace_root, TARGET};
+use crate::qemu::{workspace_root, TARGET};
 
 /// The undefined function the check build's panic handlers call (firmware/src/platform.rs).
 const SYMBOL: &str = "NO_PANIC_CHECK__a_panic_path_is_reachable__see_docs_no_panic_md";
@@ -80,14 +81,14 @@ fn cargo() -> Command {
 
 /// The proof: an error (naming the panic sites when it can) if a covered build still has
 /// a path to the panic handler.
-pub fn check() -> Result<(), String> {
+pub fn check() -> Result<()> {
     for build in &BUILDS {
         check_one(build)?;
     }
     Ok(())
 }
 
-fn check_one(build: &Build) -> Result<(), String> {
+fn check_one(build: &Build) -> Result<()> {
     let t0 = Instant::now();
     let args = build.cargo_args();
     eprintln!(
@@ -102,7 +103,7 @@ fn check_one(build: &Build) -> Result<(), String> {
         .args(build.rustc_args)
         .stdout(Stdio::null())
         .output()
-        .map_err(|e| format!("cannot start cargo: {e}"))?;
+        .context("cannot start cargo")?;
     let stderr = String::from_utf8_lossy(&out.stderr);
     if out.status.success() {
         restore_flight_binary();
@@ -115,13 +116,13 @@ fn check_one(build: &Build) -> Result<(), String> {
     }
     if !stderr.contains(SYMBOL) {
         eprint!("{stderr}");
-        return Err(format!("the no-panic check build failed ({})", out.status));
+        bail!("the no-panic check build failed ({})", out.status);
     }
     let report = match diagnose(build) {
         Ok(report) => report,
-        Err(e) => format!("(could not name the panic sites: {e})\n"),
+        Err(e) => format!("(could not name the panic sites: {e:#})\n"),
     };
-    Err(format!(
+    Err(anyhow!(
         "no-panic proof failed: {} can reach the panic handler \
          (link error: undefined symbol {SYMBOL}).\n{report}\
          Remove each path (docs/no-panic.md) and rerun `cargo xtask test`.",
@@ -131,7 +132,7 @@ fn check_one(build: &Build) -> Result<(), String> {
 
 /// Links the check build with the symbol unresolved, lists its panic sites, and puts the
 /// normal flight binary back in its place.
-fn diagnose(build: &Build) -> Result<String, String> {
+fn diagnose(build: &Build) -> Result<String> {
     let out = cargo()
         .arg("rustc")
         .args(build.cargo_args())
@@ -141,7 +142,7 @@ fn diagnose(build: &Build) -> Result<String, String> {
         .args(["-C", "link-arg=--unresolved-symbols=ignore-all"])
         .stderr(Stdio::null())
         .output()
-        .map_err(|e| format!("cannot start cargo: {e}"))?;
+        .context("cannot start cargo")?;
     let mut elf = None;
     for line in String::from_utf8_lossy(&out.stdout).lines() {
         let Ok(msg) = serde_json::from_str::<serde_json::Value>(line) else {
@@ -155,9 +156,9 @@ fn diagnose(build: &Build) -> Result<String, String> {
     }
     let report = match (out.status.success(), elf) {
         (true, Some(elf)) => std::fs::read(&elf)
-            .map_err(|e| format!("cannot read {}: {e}", elf.display()))
+            .with_context(|| format!("cannot read {}", elf.display()))
             .and_then(|bytes| report(&bytes)),
-        _ => Err(format!("the diagnostic link failed ({})", out.status)),
+        _ => Err(anyhow!("the diagnostic link failed ({})", out.status)),
     };
     restore_flight_binary();
     report
@@ -177,8 +178,8 @@ fn restore_flight_binary() {
 }
 
 /// What the diagnostic ELF says about its panic paths.
-fn report(elf: &[u8]) -> Result<String, String> {
-    let file = object::File::parse(elf).map_err(|e| format!("cannot parse the ELF: {e}"))?;
+fn report(elf: &[u8]) -> Result<String> {
+    let file = object::File::parse(elf).context("cannot parse the ELF")?;
     let mut text = String::new();
     let locations = panic_locations(&file);
     if !locations.is_empty() {
@@ -197,7 +198,7 @@ fn report(elf: &[u8]) -> Result<String, String> {
         }
     }
     if text.is_empty() {
-        return Err("found neither Location records nor branches to the handler".into());
+        bail!("found neither Location records nor branches to the handler");
     }
     Ok(text)
 }

@@ -12,12 +12,14 @@
 //! Conventions: paper pixel p (0 = near point, 60 000 = far point, rolling left) is
 //! array offset n = p - 30 000; velocities are reported as magnitudes in mm/s.
 
+use anyhow::{anyhow, bail, Context, Result};
 use std::path::PathBuf;
 
 use core_math::sphere::{Geometry, Reference};
 use core_math::{mtf_mismatch, Backend, Camera, ImageMotion, StageRule, EARTH_RATE_RAD_S};
 
 use crate::csv::Writer;
+use crate::markdown::f2;
 use crate::plot::{Legend, Plot, Series};
 
 /// Section 5's camera: f = 555 mm, A = 13 um.
@@ -73,16 +75,11 @@ fn geometry(roll_deg: f64, g0_deg: f64, i0_deg: f64) -> Geometry<f64> {
 }
 
 /// The reference image motion of paper pixel `paper_px` (m/s).
-fn motion(paper_px: f64, roll_deg: f64, g0_deg: f64) -> Result<ImageMotion<f64>, String> {
+fn motion(paper_px: f64, roll_deg: f64, g0_deg: f64) -> Result<ImageMotion<f64>> {
     motion_i0(paper_px, roll_deg, g0_deg, INCLINATION_DEG)
 }
 
-fn motion_i0(
-    paper_px: f64,
-    roll_deg: f64,
-    g0_deg: f64,
-    i0_deg: f64,
-) -> Result<ImageMotion<f64>, String> {
+fn motion_i0(paper_px: f64, roll_deg: f64, g0_deg: f64, i0_deg: f64) -> Result<ImageMotion<f64>> {
     Reference
         .evaluate(
             &CAMERA,
@@ -90,7 +87,7 @@ fn motion_i0(
             paper_px - CENTRE_PX,
         )
         .map_err(|e| {
-            format!(
+            anyhow!(
                 "reference at pixel {paper_px}, roll {roll_deg} deg, gamma0 {g0_deg} deg: {e:?}"
             )
         })
@@ -284,21 +281,21 @@ impl MismatchSweep {
     }
 
     /// The lowest MTF over the sweep for `stages`.
-    fn min_mtf(&self, stages: u32) -> Result<f64, String> {
+    fn min_mtf(&self, stages: u32) -> Result<f64> {
         let mut m = f64::INFINITY;
         for &r in &self.rel {
-            m = m.min(mtf_mismatch(stages, r).map_err(|e| format!("{e:?}"))?);
+            m = m.min(mtf_mismatch(stages, r).map_err(|e| anyhow!("{e:?}"))?);
         }
         Ok(m)
     }
 
     /// Largest M with MTF >= floor everywhere on the sweep, from `StageRule`,
     /// cross-checked by trying every M.
-    fn max_stages(&self) -> Result<u32, String> {
-        let rule = StageRule::<f64>::new(MTF_FLOOR).map_err(|e| format!("{e:?}"))?;
+    fn max_stages(&self) -> Result<u32> {
+        let rule = StageRule::<f64>::new(MTF_FLOOR).map_err(|e| anyhow!("{e:?}"))?;
         let m = rule
             .max_stages(self.worst_rel(), STAGE_LIMIT)
-            .map_err(|e| format!("{e:?}"))?;
+            .map_err(|e| anyhow!("{e:?}"))?;
         let mut brute = 0;
         for k in 1..=STAGE_LIMIT {
             if self.min_mtf(k)? >= MTF_FLOOR {
@@ -308,16 +305,14 @@ impl MismatchSweep {
             }
         }
         if brute != m {
-            return Err(format!(
-                "StageRule gives {m} stages, trying every M gives {brute}"
-            ));
+            bail!("StageRule gives {m} stages, trying every M gives {brute}");
         }
         Ok(m)
     }
 }
 
 /// The Figs. 6-7 grid at one paper pixel: rows of (roll, gamma0, motion).
-fn grid(paper_px: f64) -> Result<Vec<(f64, f64, ImageMotion<f64>)>, String> {
+fn grid(paper_px: f64) -> Result<Vec<(f64, f64, ImageMotion<f64>)>> {
     let mut rows = Vec::new();
     for &phi in &deg_steps(ROLL_MAX_DEG, ROLL_STEPS) {
         for &g0 in &deg_steps(G0_MAX_DEG, G0_STEPS) {
@@ -333,13 +328,13 @@ struct Out {
 }
 
 impl Out {
-    fn write(&mut self, name: &str, bytes: &[u8]) -> Result<(), String> {
+    fn write(&mut self, name: &str, bytes: &[u8]) -> Result<()> {
         let path = self.dir.join(name);
-        std::fs::write(&path, bytes).map_err(|e| format!("writing {}: {e}", path.display()))?;
+        std::fs::write(&path, bytes).with_context(|| format!("writing {}", path.display()))?;
         self.written.push(path);
         Ok(())
     }
-    fn plot(&mut self, name: &str, plot: &Plot) -> Result<(), String> {
+    fn plot(&mut self, name: &str, plot: &Plot) -> Result<()> {
         let bytes = plot.to_png()?;
         self.write(name, &bytes)
     }
@@ -354,12 +349,12 @@ pub struct Args {
     out: Option<PathBuf>,
 }
 
-pub fn run(args: &Args) -> Result<(), String> {
+pub fn run(args: &Args) -> Result<()> {
     let dir = match &args.out {
         Some(dir) => dir.clone(),
-        None => crate::target::workspace_root().join("docs").join("paper"),
+        None => crate::qemu::workspace_root().join("docs").join("paper"),
     };
-    std::fs::create_dir_all(&dir).map_err(|e| format!("creating {}: {e}", dir.display()))?;
+    std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
     let mut out = Out {
         dir,
         written: Vec::new(),
@@ -390,17 +385,17 @@ pub fn run(args: &Args) -> Result<(), String> {
 }
 
 /// The Eq. 14 route with every switch off must be the chain's v_P1.
-fn self_check() -> Result<(), String> {
+fn self_check() -> Result<()> {
     for &px in &[NEAR_PX, 15_000.0, CENTRE_PX + 1.0, 45_000.0, FAR_PX] {
         for &phi in &[0.0, 15.0, 25.0] {
             for &g0 in &[0.0, 37.0, 90.0] {
                 let want = motion(px, phi, g0)?.v1_mps;
-                let got = CHAIN.v1(px, phi, g0).ok_or("Eq. 14 route failed")?;
+                let got = CHAIN.v1(px, phi, g0).context("Eq. 14 route failed")?;
                 if (got - want).abs() > 1e-9 * want.abs() {
-                    return Err(format!(
+                    bail!(
                         "Eq. 14 route disagrees with the chain at pixel {px}, roll {phi}, \
                          gamma0 {g0}: {got} vs {want}"
-                    ));
+                    );
                 }
             }
         }
@@ -408,7 +403,7 @@ fn self_check() -> Result<(), String> {
     Ok(())
 }
 
-fn fig5(out: &mut Out) -> Result<(), String> {
+fn fig5(out: &mut Out) -> Result<()> {
     let rolls = [0.0, 15.0, 25.0];
     let g0s = deg_steps(G0_MAX_DEG, 90);
     let mut header = ["paper_pixel", "n_px", "field_angle_deg"]
@@ -432,7 +427,7 @@ fn fig5(out: &mut Out) -> Result<(), String> {
                 .iter()
                 .map(|&g| motion(px, phi, g).map(|m| mm_s(m.speed_mps())))
                 .collect::<Result<_, _>>()?;
-            let r = Range::of(speeds.iter().copied()).ok_or("non-finite speed")?;
+            let r = Range::of(speeds.iter().copied()).context("non-finite speed")?;
             let (s0, s90) = (speeds[0], speeds[speeds.len() - 1]);
             row.extend([s0, s90, r.min, r.max].map(|v| format!("{v:.6}")));
             lines[2 * j].push((px, s0));
@@ -469,7 +464,7 @@ fn fig5(out: &mut Out) -> Result<(), String> {
     out.plot("fig5_velocity_across_array.png", &plot)
 }
 
-fn fig67(out: &mut Out, stem: &str, paper_px: f64, title: &str) -> Result<Range, String> {
+fn fig67(out: &mut Out, stem: &str, paper_px: f64, title: &str) -> Result<Range> {
     let rows = grid(paper_px)?;
     let mut csv = Writer::new(
         &format!(
@@ -489,7 +484,8 @@ fn fig67(out: &mut Out, stem: &str, paper_px: f64, title: &str) -> Result<Range,
         )?;
     }
     out.write(&format!("{stem}.csv"), &csv.into_bytes()?)?;
-    let range = Range::of(rows.iter().map(|r| mm_s(r.2.speed_mps()))).ok_or("non-finite speed")?;
+    let range =
+        Range::of(rows.iter().map(|r| mm_s(r.2.speed_mps()))).context("non-finite speed")?;
 
     let mut plot = Plot::new(title, "roll angle phi (deg)", "speed v_P (mm/s)")
         .x_range(0.0, ROLL_MAX_DEG)
@@ -511,9 +507,9 @@ fn fig67(out: &mut Out, stem: &str, paper_px: f64, title: &str) -> Result<Range,
 }
 
 /// Returns (min MTF at M = 48, largest M for the floor, worst relative mismatch).
-fn fig8(out: &mut Out) -> Result<(f64, u32, f64), String> {
+fn fig8(out: &mut Out) -> Result<(f64, u32, f64)> {
     let sweep = MismatchSweep::new(|g| motion(FAR_PX, 25.0, g).ok().map(|m| mm_s(m.speed_mps())))
-        .ok_or("far point at 25 deg misses the Earth")?;
+        .context("far point at 25 deg misses the Earth")?;
     let mut header = ["gamma0_deg", "speed_mm_s", "rel_mismatch"]
         .map(String::from)
         .to_vec();
@@ -534,7 +530,7 @@ fn fig8(out: &mut Out) -> Result<(f64, u32, f64), String> {
             format!("{rel:.8}"),
         ];
         for (j, &m) in FIG8_STAGES.iter().enumerate() {
-            let mtf = mtf_mismatch(m, rel).map_err(|e| format!("{e:?}"))?;
+            let mtf = mtf_mismatch(m, rel).map_err(|e| anyhow!("{e:?}"))?;
             row.push(format!("{mtf:.6}"));
             curves[j].push((g, mtf));
         }
@@ -573,7 +569,7 @@ fn summary(
     mtf48: f64,
     max_m: u32,
     worst: f64,
-) -> Result<(), String> {
+) -> Result<()> {
     let mut csv = Writer::new(
         &format!(
             "{GENERATED}# H = 645 km, f = 555 mm, A = 13 um, R = 6370 km, i0 = {INCLINATION_DEG} deg, GM = 3.986004418e14, omega = {EARTH_RATE_RAD_S}; reference chain\n"
@@ -583,14 +579,14 @@ fn summary(
     let rows: Vec<(&str, String, String, &str, &str)> = vec![
         (
             "near_min",
-            fmt2(published::NEAR_MIN),
+            f2(published::NEAR_MIN),
             format!("{:.3}", near.min),
             "mm/s",
             "min |v|, pixel 0, phi 0..25, gamma0 0..90",
         ),
         (
             "near_max",
-            fmt2(published::NEAR_MAX),
+            f2(published::NEAR_MAX),
             format!("{:.3}", near.max),
             "mm/s",
             "max |v|, pixel 0, phi 0..25, gamma0 0..90",
@@ -611,14 +607,14 @@ fn summary(
         ),
         (
             "far_min",
-            fmt2(published::FAR_MIN),
+            f2(published::FAR_MIN),
             format!("{:.3}", far.min),
             "mm/s",
             "min |v|, pixel 60000, phi 0..25, gamma0 0..90",
         ),
         (
             "far_max",
-            fmt2(published::FAR_MAX),
+            f2(published::FAR_MAX),
             format!("{:.3}", far.max),
             "mm/s",
             "max |v|, pixel 60000, phi 0..25, gamma0 0..90",
@@ -677,10 +673,6 @@ fn summary(
     Ok(())
 }
 
-fn fmt2(x: f64) -> String {
-    format!("{x:.2}")
-}
-
 /// The relative mismatch dv/v with sinc(pi M dv/v / 2) = `mtf` on the first lobe.
 fn implied_rel(mtf: f64, stages: u32) -> f64 {
     let (mut lo, mut hi) = (0.0_f64, core::f64::consts::PI);
@@ -696,7 +688,7 @@ fn implied_rel(mtf: f64, stages: u32) -> f64 {
 }
 
 /// Each candidate explanation on the Figs. 6-8 quantities.
-fn hypotheses(out: &mut Out) -> Result<(), String> {
+fn hypotheses(out: &mut Out) -> Result<()> {
     let mut csv = Writer::new(
         &format!("{GENERATED}# what the paper's numbers would be under each suspected mistake (Eq. 14 route, v2 from the chain); empty = the line of sight misses the Earth somewhere\n"),
         &[
@@ -714,11 +706,11 @@ fn hypotheses(out: &mut Out) -> Result<(), String> {
     )?;
     csv.row(&[
         "paper".to_string(),
-        fmt2(published::NEAR_MIN),
-        fmt2(published::NEAR_MAX),
+        f2(published::NEAR_MIN),
+        f2(published::NEAR_MAX),
         format!("{:.1}", published::NEAR_CHANGE_PCT),
-        fmt2(published::FAR_MIN),
-        fmt2(published::FAR_MAX),
+        f2(published::FAR_MIN),
+        f2(published::FAR_MAX),
         format!("{:.1}", published::FAR_CHANGE_PCT),
         format!("{:.3}", 100.0 * implied_rel(published::MTF_M48, 48)),
         format!("{:.3}", published::MTF_M48),

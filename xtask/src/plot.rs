@@ -15,6 +15,7 @@
 // A helper for several commands: not every option is used by every build of them.
 #![allow(dead_code)]
 
+use anyhow::{anyhow, bail, Context, Result};
 use std::ops::Range;
 use std::path::Path;
 use std::sync::OnceLock;
@@ -61,15 +62,15 @@ const MARGIN: u32 = 14;
 const MAX_TICKS: usize = 10;
 
 /// The bundled font, registered with plotters as its default family once per process.
-fn font_ready() -> Result<(), String> {
-    static READY: OnceLock<Result<(), String>> = OnceLock::new();
-    READY
-        .get_or_init(|| {
-            const TTF: &[u8] = include_bytes!("../fonts/DejaVuSans.ttf");
-            plotters::style::register_font("sans-serif", FontStyle::Normal, TTF)
-                .map_err(|_| "the bundled font xtask/fonts/DejaVuSans.ttf is unreadable".into())
-        })
-        .clone()
+fn font_ready() -> Result<()> {
+    static READY: OnceLock<bool> = OnceLock::new();
+    const TTF: &[u8] = include_bytes!("../fonts/DejaVuSans.ttf");
+    if !*READY.get_or_init(|| {
+        plotters::style::register_font("sans-serif", FontStyle::Normal, TTF).is_ok()
+    }) {
+        bail!("the bundled font xtask/fonts/DejaVuSans.ttf is unreadable");
+    }
+    Ok(())
 }
 
 fn text(px: f64) -> TextStyle<'static> {
@@ -81,8 +82,8 @@ fn rgb(c: Rgb) -> RGBColor {
 }
 
 /// Any plotters error as our error text.
-fn drawing<E: std::fmt::Debug>(e: E) -> String {
-    format!("plotting: {e:?}")
+fn drawing<E: std::fmt::Debug>(e: E) -> anyhow::Error {
+    anyhow!("plotting: {e:?}")
 }
 
 /// One labelled curve.
@@ -210,12 +211,12 @@ impl Plot {
     }
 
     /// Renders and encodes as an 8-bit RGB PNG.
-    pub fn to_png(&self) -> Result<Vec<u8>, String> {
+    pub fn to_png(&self) -> Result<Vec<u8>> {
         encode_png(self.width, self.height, &self.render()?)
     }
 
     /// Renders and writes a PNG file.
-    pub fn save(&self, path: &Path) -> Result<(), String> {
+    pub fn save(&self, path: &Path) -> Result<()> {
         write_png(path, &self.to_png()?)
     }
 
@@ -228,7 +229,7 @@ impl Plot {
         }
     }
 
-    fn axes(&self) -> Result<(Axis, Axis), String> {
+    fn axes(&self) -> Result<(Axis, Axis)> {
         let points = || self.series.iter().flat_map(|s| &s.points);
         let drawable = || {
             points().filter_map(|&(x, y)| Some((x, self.plotted_y(y)?)).filter(|p| p.0.is_finite()))
@@ -236,7 +237,7 @@ impl Plot {
         let x = match self.x_range {
             Some((lo, hi)) => Axis::linear(lo, hi)?,
             None => {
-                let (lo, hi) = extent(drawable().map(|p| p.0)).ok_or("no finite data to plot")?;
+                let (lo, hi) = extent(drawable().map(|p| p.0)).context("no finite data to plot")?;
                 Axis::linear(lo, hi)?
             }
         };
@@ -244,12 +245,12 @@ impl Plot {
             (Some((lo, hi)), false) => Axis::linear(lo, hi)?,
             (Some((lo, hi)), true) => {
                 if !(lo > 0.0 && hi > lo) {
-                    return Err("log y range must be positive".into());
+                    bail!("log y range must be positive");
                 }
                 Axis::decades(lo.log10(), hi.log10())?
             }
             (None, log) => {
-                let (lo, hi) = extent(drawable().map(|p| p.1)).ok_or(if log {
+                let (lo, hi) = extent(drawable().map(|p| p.1)).context(if log {
                     "no positive data for a log axis"
                 } else {
                     "no finite data to plot"
@@ -266,7 +267,7 @@ impl Plot {
     }
 
     /// The RGB pixels, row by row.
-    fn render(&self) -> Result<Vec<u8>, String> {
+    fn render(&self) -> Result<Vec<u8>> {
         check_size(self.width, self.height, (200, 150))?;
         let (x_axis, y_axis) = self.axes()?;
         render_rgb((self.width, self.height), &self.title, |_, body| {
@@ -344,9 +345,9 @@ fn extent(values: impl Iterator<Item = f64>) -> Option<(f64, f64)> {
     })
 }
 
-fn check_size(width: u32, height: u32, (min_w, min_h): (u32, u32)) -> Result<(), String> {
+fn check_size(width: u32, height: u32, (min_w, min_h): (u32, u32)) -> Result<()> {
     if width < min_w || height < min_h || width > 8000 || height > 8000 {
-        return Err(format!("plot size {width}x{height} out of range"));
+        bail!("plot size {width}x{height} out of range");
     }
     Ok(())
 }
@@ -358,7 +359,7 @@ const X_LABEL_AREA: u32 = (LABEL_PX + DESC_PX + 24.0) as u32;
 fn y_label_area<DB: DrawingBackend>(
     area: &DrawingArea<DB, plotters::coord::Shift>,
     axis: &Axis,
-) -> Result<u32, String> {
+) -> Result<u32> {
     let mut widest = 0;
     for v in axis.key_points(BoldPoints(MAX_TICKS)) {
         let (w, _) = area
@@ -377,8 +378,8 @@ type Area<'a> = DrawingArea<BitMapBackend<'a>, Shift>;
 fn render_rgb(
     (width, height): (u32, u32),
     title: &str,
-    draw: impl FnOnce(&Area<'_>, &Area<'_>) -> Result<(), String>,
-) -> Result<Vec<u8>, String> {
+    draw: impl FnOnce(&Area<'_>, &Area<'_>) -> Result<()>,
+) -> Result<Vec<u8>> {
     font_ready()?;
     let mut pixels = vec![255u8; width as usize * height as usize * 3];
     {
@@ -397,7 +398,7 @@ fn labelled_chart<'a, 'b>(
     (x, y): (&Axis, &Axis),
     (x_name, y_name): (&str, &str),
     grid: bool,
-) -> Result<ChartContext<'a, BitMapBackend<'b>, Cartesian2d<Axis, Axis>>, String> {
+) -> Result<ChartContext<'a, BitMapBackend<'b>, Cartesian2d<Axis, Axis>>> {
     let mut chart = ChartBuilder::on(area)
         .margin(MARGIN)
         .margin_right(right_margin(area, x)?)
@@ -431,7 +432,7 @@ fn labelled_chart<'a, 'b>(
 fn right_margin<DB: DrawingBackend>(
     area: &DrawingArea<DB, plotters::coord::Shift>,
     x_axis: &Axis,
-) -> Result<u32, String> {
+) -> Result<u32> {
     let last = x_axis.key_points(BoldPoints(MAX_TICKS)).pop();
     let (w, _) = area
         .estimate_text_size(
@@ -443,9 +444,7 @@ fn right_margin<DB: DrawingBackend>(
 }
 
 /// A black frame around the plot area (the mesh draws only the left and bottom axes).
-fn frame<DB: DrawingBackend>(
-    chart: &ChartContext<'_, DB, Cartesian2d<Axis, Axis>>,
-) -> Result<(), String> {
+fn frame<DB: DrawingBackend>(chart: &ChartContext<'_, DB, Cartesian2d<Axis, Axis>>) -> Result<()> {
     let (x, y) = (chart.x_range(), chart.y_range());
     chart
         .plotting_area()
@@ -464,17 +463,17 @@ pub struct Axis {
 }
 
 impl Axis {
-    pub fn linear(lo: f64, hi: f64) -> Result<Axis, String> {
+    pub fn linear(lo: f64, hi: f64) -> Result<Axis> {
         Axis::new(lo, hi, false)
     }
 
-    pub fn decades(lo: f64, hi: f64) -> Result<Axis, String> {
+    pub fn decades(lo: f64, hi: f64) -> Result<Axis> {
         Axis::new(lo, hi, true)
     }
 
-    fn new(lo: f64, hi: f64, decades: bool) -> Result<Axis, String> {
+    fn new(lo: f64, hi: f64, decades: bool) -> Result<Axis> {
         if !(lo.is_finite() && hi.is_finite()) {
-            return Err(format!("bad axis range [{lo}, {hi}]"));
+            bail!("bad axis range [{lo}, {hi}]");
         }
         // A flat extent (one value) still gets an axis around it.
         let (lo, hi) = if hi - lo > 1e-12 * (1.0 + lo.abs()) {
@@ -482,7 +481,7 @@ impl Axis {
         } else if hi >= lo {
             (lo - 0.5 * (1.0 + lo.abs()), hi + 0.5 * (1.0 + hi.abs()))
         } else {
-            return Err(format!("bad axis range [{lo}, {hi}]"));
+            bail!("bad axis range [{lo}, {hi}]");
         };
         Ok(Axis { lo, hi, decades })
     }
@@ -573,20 +572,20 @@ impl ValueFormatter<f64> for Axis {
 
 /// Encodes RGB pixels as an 8-bit RGB PNG (no time stamp: the bytes depend only on the
 /// pixels).
-fn encode_png(width: u32, height: u32, rgb: &[u8]) -> Result<Vec<u8>, String> {
+fn encode_png(width: u32, height: u32, rgb: &[u8]) -> Result<Vec<u8>> {
     let mut out = Vec::new();
     let mut enc = png::Encoder::new(&mut out, width, height);
     enc.set_color(png::ColorType::Rgb);
     enc.set_depth(png::BitDepth::Eight);
     enc.set_compression(png::Compression::High);
-    let mut w = enc.write_header().map_err(|e| format!("png: {e}"))?;
-    w.write_image_data(rgb).map_err(|e| format!("png: {e}"))?;
-    w.finish().map_err(|e| format!("png: {e}"))?;
+    let mut w = enc.write_header().context("png")?;
+    w.write_image_data(rgb).context("png")?;
+    w.finish().context("png")?;
     Ok(out)
 }
 
-fn write_png(path: &Path, bytes: &[u8]) -> Result<(), String> {
-    std::fs::write(path, bytes).map_err(|e| format!("writing {}: {e}", path.display()))
+fn write_png(path: &Path, bytes: &[u8]) -> Result<()> {
+    std::fs::write(path, bytes).with_context(|| format!("writing {}", path.display()))
 }
 
 #[cfg(test)]

@@ -11,7 +11,7 @@
 //! cases at least 1 deg from the limb, `max_rel_err_near_limb` over those within 1 deg.
 //!
 //! Run time: guest instructions on the Cortex-M4 under QEMU from `cargo xtask bench`
-//! (the same build, the same plugin, [`crate::target::bench_counts`]): per pixel, the
+//! (the same build, the same plugin, [`crate::qemu::bench_counts`]): per pixel, the
 //! count of `motion` over 32 pixels across the swath in a loop, divided by 32 (the
 //! marginal cost inside the loop the controller runs, without a one-pixel region's call
 //! and return); per update, `update` then `motion` at each of the default scene's
@@ -19,14 +19,20 @@
 //!
 //! `flash_bytes`: [`crate::footprint`], one link per backend.
 
+use anyhow::{anyhow, Context, Result};
+use core_math::accuracy::{earth_kappa, EARTH_F32_KAPPA_LIMIT};
+use core_math::earth;
+use core_math::sample::SplitMix64 as Rng;
+use core_math::sphere::accuracy::limb_margin_rad;
 use core_math::sphere::fixed_point::{geometry_from_f64, motion_to_f64};
 use core_math::sphere::{
     Geometry, MicroF32, NaiveF32, Reference, CLOSED_F32, CLOSED_F64, CLOSED_MICROMATH, FIXED,
 };
-use core_math::{Backend, Camera};
+use core_math::{Backend, Camera, EarthReference, ImageMotion, GENERAL_F32, GENERAL_F64};
 
-use crate::target::{bench_counts, BenchCounts};
-use core_math::sample::SplitMix64 as Rng;
+use crate::accuracy::percentile;
+use crate::markdown;
+use crate::qemu::{bench_counts, BenchCounts};
 
 const DEFAULT_CASES: usize = 200_000;
 const DEFAULT_SEED: u64 = 0x5EED_2013_0605_0750;
@@ -116,7 +122,8 @@ struct Sample {
 }
 
 /// `earth-f32`'s errors against the problem's condition number kappa
-/// (`core_math::accuracy::earth_kappa`): its 2e-6 and 2e-5 bounds hold up to kappa 50;
+/// (`core_math::accuracy::earth_kappa`): its 2e-6 and 2e-5 bounds hold up to
+/// `EARTH_F32_KAPPA_LIMIT`;
 /// everywhere at least 0.01 deg from the limb err / (kappa u32) is bounded.
 #[derive(Default)]
 struct EarthF32Split {
@@ -148,7 +155,7 @@ pub struct Args {
     no_bench: bool,
 }
 
-pub fn run(args: &Args) -> Result<(), String> {
+pub fn run(args: &Args) -> Result<()> {
     let (csv, bench, cases) = (args.csv, !args.no_bench, args.cases);
     let seed = args.seed.unwrap_or(DEFAULT_SEED);
     let sample = sweep(seed, cases);
@@ -187,35 +194,26 @@ const END: &str = "<!-- report:end -->";
 /// `doc` with the markdown table of `rows`, then the paragraph `trailer`, between its
 /// markers.
 fn replace_table(doc: &str, rows: &[[String; 7]], trailer: &str) -> Option<String> {
-    let b = doc.find(BEGIN)?;
-    let e = doc[b..].find(END)? + b;
-    let mut table = format!(
-        "{BEGIN}\n\n| {} |\n|{}\n",
-        HEADER.join(" | "),
-        "---|".repeat(HEADER.len())
-    );
-    for r in rows {
-        table.push_str(&format!("| {} |\n", r.join(" | ")));
-    }
-    table.push('\n');
+    let mut block = format!("{BEGIN}\n\n{}\n", markdown::table(&HEADER, rows));
     if !trailer.is_empty() {
-        table.push_str(trailer);
-        table.push_str("\n\n");
+        block.push_str(trailer);
+        block.push_str("\n\n");
     }
-    Some(format!("{}{table}{}", &doc[..b], &doc[e..]))
+    block.push_str(END);
+    markdown::replace_between(doc, BEGIN, END, &block)
 }
 
 /// Replaces the table between the doc's markers and draws the plot: each variant's
 /// worst error at least 1 deg from the limb (a cross) and within 1 deg (a slash, dashed)
 /// against log10 of its instructions per pixel. The reference is the golden source
 /// (error 0 by definition) and has no point on a log axis.
-fn write_artefacts(rows: &[[String; 7]], trailer: &str) -> Result<(), String> {
-    let root = crate::target::workspace_root();
+fn write_artefacts(rows: &[[String; 7]], trailer: &str) -> Result<()> {
+    let root = crate::qemu::workspace_root();
     let doc_path = root.join(DOC);
-    let doc = std::fs::read_to_string(&doc_path).map_err(|e| format!("reading {DOC}: {e}"))?;
-    let new_doc =
-        replace_table(&doc, rows, trailer).ok_or(format!("{DOC} lacks the report markers"))?;
-    std::fs::write(&doc_path, new_doc).map_err(|e| format!("writing {DOC}: {e}"))?;
+    let doc = std::fs::read_to_string(&doc_path).with_context(|| format!("reading {DOC}"))?;
+    let new_doc = replace_table(&doc, rows, trailer)
+        .with_context(|| format!("{DOC} lacks the report markers"))?;
+    std::fs::write(&doc_path, new_doc).with_context(|| format!("writing {DOC}"))?;
     let mut plot = crate::plot::Plot::new(
         "Error against run time, per backend (Cortex-M4 under QEMU)",
         "log10 instructions per pixel",
@@ -250,19 +248,19 @@ fn write_artefacts(rows: &[[String; 7]], trailer: &str) -> Result<(), String> {
     Ok(())
 }
 
-fn parse_seed(v: &str) -> Result<u64, String> {
+fn parse_seed(v: &str) -> Result<u64> {
     match v.strip_prefix("0x") {
         Some(hex) => u64::from_str_radix(&hex.replace('_', ""), 16),
         None => v.parse(),
     }
-    .map_err(|e| format!("not a decimal or 0x hex integer: {e}"))
+    .map_err(|e| anyhow!("not a decimal or 0x hex integer: {e}"))
 }
 
-fn positive(v: &str) -> Result<usize, String> {
+fn positive(v: &str) -> Result<usize> {
     v.parse()
         .ok()
         .filter(|&n| n > 0)
-        .ok_or_else(|| "not a positive count".to_string())
+        .ok_or_else(|| anyhow!("not a positive count"))
 }
 
 /// One case whose line of sight meets the Earth (per the reference), geometry rounded to
@@ -270,7 +268,7 @@ fn positive(v: &str) -> Result<usize, String> {
 fn case(rng: &mut Rng) -> Option<(Geometry<f64>, f64, f64)> {
     let g = rng.envelope_geometry();
     let n_px = rng.envelope_pixel(&g, &CAMERA)?;
-    let margin = core_math::sphere::accuracy::limb_margin_rad(&CAMERA, &g, n_px).ok()?;
+    let margin = limb_margin_rad(&CAMERA, &g, n_px).ok()?;
     (margin > 0.0).then_some((g, n_px, margin.to_degrees()))
 }
 
@@ -342,8 +340,6 @@ fn sweep(seed: u64, cases: usize) -> Sample {
 /// difference) against `EarthReference` at the inputs as given. Returns how many lie
 /// within `NEAR_LIMB_DEG` of the limb, and the f32 errors split by condition number.
 fn earth_sweep(seed: u64, cases: usize, errors: &mut [Errors]) -> (usize, EarthF32Split) {
-    use core_math::accuracy::{earth_kappa, EARTH_F32_KAPPA_LIMIT};
-    use core_math::{EarthReference, GENERAL_F32, GENERAL_F64};
     let mut split = EarthF32Split::default();
     let mut rng = Rng(seed ^ 0xEA27_0000_0000_0000);
     let (mut done, mut near) = (0, 0);
@@ -352,13 +348,13 @@ fn earth_sweep(seed: u64, cases: usize, errors: &mut [Errors]) -> (usize, EarthF
         let Ok(r) = EarthReference.evaluate(&c.camera, &c.geometry, c.n_px) else {
             continue;
         };
-        let Ok(margin) = core_math::earth::limb_margin_rad(&c.geometry, &c.camera, c.n_px) else {
+        let Ok(margin) = earth::limb_margin_rad(&c.geometry, &c.camera, c.n_px) else {
             continue;
         };
         done += 1;
         let is_near = margin.to_degrees() < NEAR_LIMB_DEG;
         near += usize::from(is_near);
-        let widen = |m: core_math::ImageMotion<f32>| core_math::ImageMotion {
+        let widen = |m: ImageMotion<f32>| ImageMotion {
             v1_mps: f64::from(m.v1_mps),
             v2_mps: f64::from(m.v2_mps),
         };
@@ -421,7 +417,7 @@ fn print_table(
     flash: Option<&[u64]>,
     csv: bool,
     seed: u64,
-) -> Result<Vec<[String; 7]>, String> {
+) -> Result<Vec<[String; 7]>> {
     let notes = format!(
         "{} cases (seed {seed:#x}), {} within {NEAR_LIMB_DEG} deg of the limb; errors of |v_P| \
          relative to the f64 reference chain (reference: 0 by definition); earth rows: {} \
@@ -441,19 +437,15 @@ fn print_table(
     for (i, (v, e)) in VARIANTS.iter().zip(&sample.errors).enumerate() {
         let name = v.name;
         let mut far = e.far.clone();
-        far.sort_by(f64::total_cmp);
+        let p99 = percentile(&mut far, 0.99);
         let max = far.last().copied().unwrap_or(0.0);
-        let p99 = far
-            .get(((far.len().max(1) - 1) as f64 * 0.99).round() as usize)
-            .copied()
-            .unwrap_or(0.0);
-        let count = |label: &str| -> Result<Option<u64>, String> {
+        let count = |label: &str| -> Result<Option<u64>> {
             match counts {
                 None => Ok(None),
                 Some(c) => c
                     .net(label)
                     .map(Some)
-                    .ok_or_else(|| format!("report: no bench region `{label}`")),
+                    .with_context(|| format!("report: no bench region `{label}`")),
             }
         };
         let per_pixel = count(v.loop_label)?.map_or(String::new(), |n| {

@@ -12,17 +12,20 @@
 
 mod doc;
 mod general;
+mod grid;
 mod maps;
 mod point;
 
+use anyhow::{anyhow, Context, Result};
 use std::collections::BTreeMap;
 use std::time::Instant;
 
 // Map A's limb-margin bands are the accuracy report's buckets, so that its table and
 // this document's split the margin the same way.
 use crate::accuracy::BUCKETS_DEG;
-use doc::{agg_table, aggregate, describe, e2, parts, sig, Agg};
-use maps::{sweep, Map, MAPS};
+use crate::markdown::{e2, sig};
+use doc::{agg_table, aggregate, describe, parts, Agg};
+use maps::{Map, MAPS};
 use point::{Outcome, Point, U_F32, U_FIXED};
 
 /// The stated bounds: f32 error (at the same or at the unrounded inputs) <= C_F32 kappa u,
@@ -34,16 +37,13 @@ const DOC: &str = "docs/stability.md";
 const PNG_DIR: &str = "docs/stability";
 const TEMPLATE: &str = include_str!("stability/template.md");
 
-/// Letters the document uses for the maps, in [`MAPS`] order.
-const LETTERS: [&str; 3] = ["A", "B", "C"];
-
 /// Sweeps every map: the full grid (`coarse` = None), or every dimension divided by
 /// `coarse` with `sub` sub-samples per cell.
 pub fn sweep_all(coarse: Option<(usize, usize)>) -> Vec<Map> {
     MAPS.iter()
         .map(|s| match coarse {
-            None => sweep(s, s.nx, s.ny, s.sub),
-            Some((c, sub)) => sweep(s, s.nx / c, s.ny / c, sub),
+            None => Map::sweep(s, s.nx, s.ny, s.sub),
+            Some((c, sub)) => Map::sweep(s, s.nx / c, s.ny / c, sub),
         })
         .collect()
 }
@@ -58,7 +58,7 @@ pub struct Args {
     quick: bool,
 }
 
-pub fn run(args: &Args) -> Result<(), String> {
+pub fn run(args: &Args) -> Result<()> {
     let quick = args.quick;
     let t0 = Instant::now();
     let maps = sweep_all(if quick { Some(QUICK) } else { None });
@@ -78,17 +78,17 @@ pub fn run(args: &Args) -> Result<(), String> {
         values["G.samples"]
     );
     if !quick {
-        let root = crate::target::workspace_root();
+        let root = crate::qemu::workspace_root();
         let dir = root.join(PNG_DIR);
-        std::fs::create_dir_all(&dir).map_err(|e| format!("creating {PNG_DIR}: {e}"))?;
-        for (m, letter) in maps.iter().zip(LETTERS) {
-            doc::write_pngs(m, letter, &dir)?;
+        std::fs::create_dir_all(&dir).with_context(|| format!("creating {PNG_DIR}"))?;
+        for m in &maps {
+            doc::write_pngs(m, &dir)?;
         }
         for m in &gmaps {
             general::write_pngs(m, &dir)?;
         }
         let text = doc::fill(TEMPLATE, &values)?;
-        std::fs::write(root.join(DOC), text).map_err(|e| format!("writing {DOC}: {e}"))?;
+        std::fs::write(root.join(DOC), text).with_context(|| format!("writing {DOC}"))?;
         eprintln!("stability: wrote {DOC} and the maps under {PNG_DIR}/");
     }
     let bad = general::check_bounds(&gmaps);
@@ -96,7 +96,7 @@ pub fn run(args: &Args) -> Result<(), String> {
     if bad.is_empty() {
         Ok(())
     } else {
-        Err(format!(
+        Err(anyhow!(
             "general model: stability bound broken:\n{}",
             bad.join("\n")
         ))
@@ -105,7 +105,7 @@ pub fn run(args: &Args) -> Result<(), String> {
 
 /// Err if any sample of any map breaks the stated bounds, or a backend refused a case
 /// the reference accepts.
-pub fn check_bounds(maps: &[Map]) -> Result<(), String> {
+pub fn check_bounds(maps: &[Map]) -> Result<()> {
     let mut bad = Vec::new();
     for m in maps {
         let a = aggregate(m, |_, _, _| true);
@@ -138,7 +138,7 @@ pub fn check_bounds(maps: &[Map]) -> Result<(), String> {
     if bad.is_empty() {
         Ok(())
     } else {
-        Err(format!("stability bound broken:\n{}", bad.join("\n")))
+        Err(anyhow!("stability bound broken:\n{}", bad.join("\n")))
     }
 }
 
@@ -185,7 +185,8 @@ fn figures(maps: &[Map], quick: bool, secs: f64) -> BTreeMap<String, String> {
     // Summary: one row per map, and the whole.
     let mut rows: Vec<(String, Agg)> = Vec::new();
     let mut all = Vec::new();
-    for (m, letter) in maps.iter().zip(LETTERS) {
+    for m in maps {
+        let letter = m.spec.letter;
         let a = aggregate(m, |_, _, _| true);
         put(
             &format!("{letter}.grid"),
@@ -467,6 +468,7 @@ fn merge(all: &[Agg]) -> Agg {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use core_math::accuracy::{EARTH_F32_KAPPA_C, EARTH_F32_REL_TOLERANCE};
 
     /// A coarse version of the three maps (every dimension / 6, two sub-samples per
     /// cell) meets the document's bounds err <= C kappa u at every sample, and the
@@ -513,7 +515,6 @@ mod tests {
     /// hundreds, errors past the 2e-6 bound, and a ratio that is a fair part of C.
     #[test]
     fn general_coarse_maps_stay_within_c_kappa_u() {
-        use core_math::accuracy::{EARTH_F32_KAPPA_C, EARTH_F32_REL_TOLERANCE};
         let maps = general::sweep_all(Some(4));
         let bad = general::check_bounds(&maps);
         assert!(bad.is_empty(), "{}", bad.join("\n"));

@@ -1,34 +1,35 @@
 //! `cargo xtask test`: every check CI runs, in the order a failure is cheapest to see.
 
+use anyhow::{anyhow, Context, Result};
 use std::process::Command;
 
-use crate::target::cargo;
+use crate::qemu::cargo;
 
 /// Runs a command with inherited output; an error names it and its status.
-pub fn run_step(program: &str, args: &[&str]) -> Result<(), String> {
+pub fn run_step(program: &str, args: &[&str]) -> Result<()> {
     eprintln!("\n==> {program} {}", args.join(" "));
     let status = Command::new(program)
         .args(args)
         .status()
-        .map_err(|e| format!("cannot start `{program}`: {e}"))?;
+        .with_context(|| format!("cannot start `{program}`"))?;
     if status.success() {
         Ok(())
     } else {
-        Err(format!("`{program} {}` failed ({status})", args.join(" ")))
+        Err(anyhow!("`{program} {}` failed ({status})", args.join(" ")))
     }
 }
 
-pub fn run() -> Result<(), String> {
+pub fn run() -> Result<()> {
     let t0 = std::time::Instant::now();
     cargo(&["fmt", "--all", "--check"])?;
     // The default members are the host crates; the target crates are linted by
-    // `target::test_target` for thumbv7em.
+    // `qemu::test_target` for thumbv7em.
     cargo(&["clippy", "--all-targets", "--", "-D", "warnings"])?;
     // Host unit, property and golden tests; release, since the property tests evaluate
     // the reference chain tens of thousands of times.
     cargo(&["test", "--release"])?;
     derivation_check()?;
-    crate::target::test_target()?;
+    crate::qemu::test_target()?;
     crate::no_panic::check()?;
     eprintln!(
         "\nxtask test: all checks passed in {:.0} s",
@@ -38,12 +39,12 @@ pub fn run() -> Result<(), String> {
 }
 
 /// The computer-algebra proof of the derivation (tools/derivation/derive.py).
-fn derivation_check() -> Result<(), String> {
+fn derivation_check() -> Result<()> {
     let has_sympy = Command::new("python3")
         .args(["-c", "import sympy, mpmath"])
         .output()
         .map(|o| o.status.success())
-        .map_err(|e| format!("python3 is needed for the derivation check: {e}"))?;
+        .context("python3 is needed for the derivation check")?;
     if !has_sympy {
         run_step(
             "python3",

@@ -10,15 +10,19 @@
 //! contract's period) for both, except for Eq. 16, where T_model = pixel / |v_P| of the
 //! truth's own motion: > 0 when the simplified model clocks too slowly.
 
+use core_math::earth::kepler::Kepler;
 use core_math::earth::{limb_margin_rad, Attitude};
 use core_math::sample::SplitMix64;
 use core_math::sphere::{Geometry, OrbitState, Reference};
+use core_math::vector::{dot, norm, scale};
 use core_math::{
     Backend, Camera, EarthCamera, EarthGeometry, EarthReference, Ellipsoid, ImageMotion,
     StateVector, EARTH_RATE_RAD_S, GM_M3_S2,
 };
 
-use super::motion::{eccentric_state, envelope_draw, general_motion, norm, Orbit, Spheroid};
+use crate::markdown::signed;
+
+use super::motion::{eccentric_state, envelope_draw, general_motion, Orbit, Spheroid};
 
 /// The paper's (and the controller's) Earth radius (m).
 const R_PAPER_M: f64 = 6_371e3;
@@ -198,12 +202,12 @@ fn steering_yaw(g: &EarthGeometry<f64>, cam: &EarthCamera) -> Option<f64> {
 fn circularise(s: &StateVector) -> StateVector {
     let (r, v) = (s.position_m, s.velocity_mps);
     let rn = norm(r);
-    let vr = (r[0] * v[0] + r[1] * v[1] + r[2] * v[2]) / rn;
+    let vr = dot(r, v) / rn;
     let t: [f64; 3] = std::array::from_fn(|k| v[k] - vr * r[k] / rn);
     let k = (GM_M3_S2 / rn).sqrt() / norm(t);
     StateVector {
         position_m: r,
-        velocity_mps: t.map(|x| x * k),
+        velocity_mps: scale(k, t),
     }
 }
 
@@ -290,8 +294,8 @@ fn envelope_at(g: &EarthGeometry<f64>, cam: &EarthCamera, n: f64) -> String {
     let s = &g.state;
     let lat = lat_deg(s);
     let alt = norm(s.position_m) - Spheroid::WGS84.geocentric_radius_m(lat.to_radians());
-    let e = core_math::earth::kepler::Kepler::new(s.position_m, s.velocity_mps, GM_M3_S2)
-        .map_or(f64::NAN, |k| k.eccentricity());
+    let e =
+        Kepler::new(s.position_m, s.velocity_mps, GM_M3_S2).map_or(f64::NAN, |k| k.eccentricity());
     let a = &g.attitude;
     let d = f64::to_degrees;
     let mut o = format!(
@@ -607,14 +611,6 @@ pub fn costs(grid: Grid) -> Costs {
         default_cases: cases.len(),
         validation_worst,
         validation_cases,
-    }
-}
-
-fn signed(x: f64) -> String {
-    if x >= 0.0 {
-        format!("+{x:.2e}")
-    } else {
-        format!("{x:.2e}")
     }
 }
 

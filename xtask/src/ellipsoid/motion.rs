@@ -18,12 +18,9 @@
 //! ground point minus the satellite loses a factor |S| / |G - S| ~ 10 to cancellation,
 //! then the perspective division), so rounding contributes ~1.5e-15 / h m/s; the
 //! fifth derivative of P is about f (v_ground / range)^5 ~ 1e-10 m/s^5 at 645 km, so
-//! truncation is ~h^4 / 30 * 1e-10 m/s. h = 0.1 s balances them near 1e-14 m/s, about
-//! 3e-12 of the smallest |v_P| of the default scene (2.8 mm/s). Measured against
-//! `Reference` on a sphere over the grid of the test below (worst component / |v_P|):
-//! h = 0.01 s 7.6e-11, 0.03 s 2.3e-11, 0.1 s 8.6e-12, 0.3 s 1.1e-11 (truncation, at
-//! 300 km), 1 s over 1e-9: rounding falls as 1/h, truncation rises as h^4, as budgeted.
-//! Over the default scene's sweep (`cargo xtask ellipsoid`) it is 3.7e-12.
+//! truncation is ~h^4 / 30 * 1e-10 m/s. h = 0.1 s balances them near 1e-14 m/s, a few
+//! 1e-12 of the smallest |v_P| of the default scene. What the tests below and
+//! `cargo xtask ellipsoid` measure, and how it varies with h: docs/earth-model.md.
 //!
 //! The general model of `shared/EARTH-MODEL.md` ([`general_motion`]) extends this to an
 //! eccentric orbit (the exact two-body motion through the state vector, by Kepler's
@@ -36,24 +33,13 @@
 
 use core_math::earth::Attitude;
 use core_math::sample::SplitMix64;
+use core_math::vector::{add, cross, dot, norm, scale, sub, unit};
 use core_math::{Camera, EarthCamera, EarthGeometry, ImageMotion, StateVector, GM_M3_S2};
 use core_math::{Ellipsoid, EARTH_RATE_RAD_S};
 
 use core_math::earth::kepler::Kepler;
 
 pub type V3 = [f64; 3];
-
-pub fn dot(a: V3, b: V3) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-pub fn norm(a: V3) -> f64 {
-    dot(a, a).sqrt()
-}
-
-fn sub(a: V3, b: V3) -> V3 {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
 
 /// `x a + y b + z c`.
 fn comb(x: f64, a: V3, y: f64, b: V3, z: f64, c: V3) -> V3 {
@@ -99,7 +85,7 @@ impl Spheroid {
     /// Nearest point where the ray `s + rho d` (rho > 0) meets the surface, or None.
     pub fn intersect(&self, s: V3, d: V3) -> Option<V3> {
         let rho = self.intersect_range(s, d)?;
-        Some(std::array::from_fn(|i| s[i] + rho * d[i]))
+        Some(add(s, scale(rho, d)))
     }
 
     /// The smallest rho > 0 at which the ray `s + rho d` meets the surface, or None.
@@ -162,7 +148,7 @@ impl Orbit {
         let (su, cu) = u_rad.sin_cos();
         let up = comb(cu, p, su, q, 0.0, n);
         let fwd = comb(-su, p, cu, q, 0.0, n);
-        (up.map(|x| x * self.radius_m), [fwd, n, up])
+        (scale(self.radius_m, up), [fwd, n, up])
     }
 
     /// ECI state vector at argument of latitude `u_rad` (what NAV would send).
@@ -171,7 +157,7 @@ impl Orbit {
         let speed = self.rate_rad_s * self.radius_m;
         StateVector {
             position_m: pos,
-            velocity_mps: e[0].map(|x| x * speed),
+            velocity_mps: scale(speed, e[0]),
         }
     }
 }
@@ -281,19 +267,6 @@ fn rotate(k: usize, angle: f64, v: V3) -> V3 {
     w
 }
 
-fn cross(a: V3, b: V3) -> V3 {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-fn unit(a: V3) -> V3 {
-    let n = norm(a);
-    a.map(|x| x / n)
-}
-
 /// The general instant of `shared/EARTH-MODEL.md`, set up for the finite difference.
 struct General {
     orbit: Kepler,
@@ -327,7 +300,7 @@ impl General {
     /// Focal-plane position (P1, P2) at `t_s` of the Earth-fixed ground point.
     fn project(&self, t_s: f64) -> [f64; 2] {
         let (dr, v) = self.orbit.at(t_s);
-        let r: V3 = std::array::from_fn(|k| self.r0[k] + dr[k]);
+        let r = add(self.r0, dr);
         let e = Self::orbital_frame(r, v);
         // G(t) - r(t) = (G - r0) + (Rz(omega t) - I) G - (r(t) - r0): every term formed
         // as itself, none as a difference of two positions of Earth-radius size.
@@ -398,7 +371,7 @@ pub fn general_motion_step(
         attitude: *at,
         earth_rate_rad_s: g.earth_rate_rad_s,
         focal_m: camera.focal_m,
-        ground_m: std::array::from_fn(|i| r0[i] + to_ground_m[i]),
+        ground_m: add(r0, to_ground_m),
         to_ground_m,
     };
     let h = step_s;
@@ -505,6 +478,7 @@ pub fn envelope_draw(rng: &mut SplitMix64) -> (EarthGeometry<f64>, EarthCamera, 
 mod tests {
     use super::*;
     use core_math::earth::limb_margin_rad;
+    use core_math::sample::{roll_at_limb_margin, EarthCase};
     use core_math::sphere::{Geometry, Reference};
     use core_math::{Backend, EarthReference, ModelError};
 
@@ -529,7 +503,7 @@ mod tests {
     /// altitude the derivatives of P grow, hence the margin. Any modelling difference is
     /// far larger: the Earth-rotation terms are ~7 % of |v_P| (omega / Omega), the
     /// paper's doubled Eq. 14 cross term up to 1.5 %, a wrong orbit rate or radius at the
-    /// 1e-3 level. Measured: 8.6e-12 worst (printed with --nocapture).
+    /// 1e-3 level. The worst is printed with --nocapture (docs/earth-model.md).
     #[test]
     fn sphere_agrees_with_reference() {
         let mut worst: f64 = 0.0;
@@ -688,12 +662,12 @@ mod tests {
                 } else {
                     -1.0
                 };
-                let case = core_math::sample::EarthCase {
+                let case = EarthCase {
                     camera: cam,
                     geometry: g,
                     n_px: n,
                 };
-                if let Some(roll) = core_math::sample::roll_at_limb_margin(&case, m, side) {
+                if let Some(roll) = roll_at_limb_margin(&case, m, side) {
                     g.attitude.roll_rad = roll;
                 }
             }
@@ -774,15 +748,8 @@ mod tests {
     /// miss (0.5 deg or more outside the limb, `core_math::earth::limb_margin_rad`) must
     /// be a miss for both routes, a clear hit a hit for both; within 0.5 deg of the limb
     /// the cases are counted and excluded from the bound. The ground point must project
-    /// back onto (p1, p2) within 1e-12 m.
-    ///
-    /// Measured (`cargo test -p xtask general_agrees -- --nocapture`): 16 308 hits
-    /// compared (532 at 0.5-2 deg from the limb, 2 160 at 2-10 deg), worst 6.29e-12 at
-    /// |r| 7991 km, e 0.026, over the equator, roll -27.2, pitch -38.9, yaw +155.8 deg,
-    /// field -37 deg, where the attitude rates cancel most of the ground's motion
-    /// (|v| = 2.1e-4 m/s, 1/50 of the typical): the absolute difference is 1.4e-15 m/s,
-    /// the rounding floor. 2 553 clear misses agreed; 1 139 within 0.5 deg of the limb
-    /// excluded, none of them split on hit or miss (worst 1.8e-12 where both hit).
+    /// back onto (p1, p2) within 1e-12 m. What it finds (`cargo test -p xtask
+    /// general_agrees -- --nocapture`): docs/earth-model.md.
     #[test]
     fn general_agrees_with_earth_reference() {
         let o = two_route(20_000, GENERAL_STEP_S);
@@ -857,9 +824,8 @@ mod tests {
 
     /// The budget's shape: the worst difference against the stencil unit h (rounding
     /// falls as 1/h, truncation rises as h^8). Run with
-    /// `cargo test -p xtask general_step_sweep -- --ignored --nocapture`. Measured:
-    /// h = 0.003 s 1.50e-10, 0.01 s 2.97e-11, 0.03 s 1.20e-11, 0.1 s 6.29e-12,
-    /// 0.3 s 3.96e-11, 1 s 7.16e-7.
+    /// `cargo test -p xtask general_step_sweep -- --ignored --nocapture`; the figures:
+    /// docs/earth-model.md.
     #[test]
     #[ignore]
     fn general_step_sweep() {

@@ -13,6 +13,7 @@
 //!     .save(Path::new("out.png"))?;
 //! ```
 
+use anyhow::{bail, Result};
 use std::path::Path;
 
 use plotters::prelude::*;
@@ -155,9 +156,9 @@ impl Heatmap {
         self
     }
 
-    fn axis((lo, hi): (f64, f64), decades: bool) -> Result<Axis, String> {
+    fn axis((lo, hi): (f64, f64), decades: bool) -> Result<Axis> {
         if !(lo.is_finite() && hi.is_finite() && hi > lo) {
-            return Err(format!("bad heatmap range [{lo}, {hi}]"));
+            bail!("bad heatmap range [{lo}, {hi}]");
         }
         if decades {
             Axis::decades(lo, hi)
@@ -172,26 +173,26 @@ impl Heatmap {
     }
 
     /// Renders and encodes as an 8-bit RGB PNG.
-    pub fn to_png(&self) -> Result<Vec<u8>, String> {
+    pub fn to_png(&self) -> Result<Vec<u8>> {
         encode_png(self.width, self.height, &self.render()?)
     }
 
     /// Renders and writes a PNG file.
-    pub fn save(&self, path: &Path) -> Result<(), String> {
+    pub fn save(&self, path: &Path) -> Result<()> {
         write_png(path, &self.to_png()?)
     }
 
     /// The RGB pixels, row by row: title on top, the map on the left, the colour bar on
     /// the right with the same top and bottom.
-    fn render(&self) -> Result<Vec<u8>, String> {
+    fn render(&self) -> Result<Vec<u8>> {
         check_size(self.width, self.height, (300, 200))?;
         if self.nx == 0 || self.ny == 0 || self.values.len() != self.nx * self.ny {
-            return Err(format!(
+            bail!(
                 "heatmap: {} values for {} x {} cells",
                 self.values.len(),
                 self.nx,
                 self.ny
-            ));
+            );
         }
         let x_axis = Self::axis(self.x_range, self.x_decades)?;
         let y_axis = Self::axis(self.y_range, self.y_decades)?;
@@ -200,7 +201,7 @@ impl Heatmap {
             let bar_labels = y_label_area(root, &z_axis)?;
             let strip = MARGIN + BAR_PX + bar_labels + MARGIN;
             if strip + 200 > self.width {
-                return Err("heatmap too narrow for its colour bar".into());
+                bail!("heatmap too narrow for its colour bar");
             }
             let (map_area, bar_area) = body.split_horizontally(self.width - strip);
             self.draw_map(&map_area, &x_axis, &y_axis)?;
@@ -214,7 +215,7 @@ impl Heatmap {
         })
     }
 
-    fn draw_map(&self, area: &Area<'_>, x_axis: &Axis, y_axis: &Axis) -> Result<(), String> {
+    fn draw_map(&self, area: &Area<'_>, x_axis: &Axis, y_axis: &Axis) -> Result<()> {
         let names = (self.x_label.as_str(), self.y_label.as_str());
         let mut chart = labelled_chart(area, (x_axis, y_axis), names, false)?;
         let (x0, x1) = self.x_range;
@@ -246,7 +247,7 @@ impl Heatmap {
 
     /// The colour bar: z from bottom to top, ticks and the z label on its right, each z
     /// mark a black line with a white core across it.
-    fn draw_bar(&self, area: &Area<'_>, z_axis: Axis, labels_px: u32) -> Result<(), String> {
+    fn draw_bar(&self, area: &Area<'_>, z_axis: Axis, labels_px: u32) -> Result<()> {
         let (z0, z1) = self.z_range;
         let mut chart = ChartBuilder::on(area)
             .margin(MARGIN)
@@ -288,7 +289,7 @@ impl Heatmap {
     }
 
     /// A grey square and `missing_label` in the bottom right corner of the figure.
-    fn draw_missing_swatch(&self, root: &Area<'_>) -> Result<(), String> {
+    fn draw_missing_swatch(&self, root: &Area<'_>) -> Result<()> {
         let style = text(LABEL_PX);
         let (tw, th) = root
             .estimate_text_size(&self.missing_label, &style)

@@ -1,25 +1,18 @@
 //! The figures: PNG maps, the tables, and the values the document's template quotes.
 
+use anyhow::{Context, Result};
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use crate::plot::heatmap::Heatmap;
+use crate::markdown::{e2, f2, sig, table};
 
 use super::maps::{Cell, Map};
 use super::point::{Outcome, Point, RelErrors, INPUTS};
 use super::{C_F32, C_FIXED};
 
 /// log10 with a floor, so that an exact 0 lands at the bottom of the colour scale.
-fn lg(x: f64) -> f64 {
+pub fn lg(x: f64) -> f64 {
     x.max(1e-30).log10()
-}
-
-pub fn e2(x: f64) -> String {
-    format!("{x:.2e}")
-}
-
-fn f2(x: f64) -> String {
-    format!("{x:.2}")
 }
 
 /// A short description of where a point is.
@@ -34,19 +27,6 @@ pub fn describe(pt: &Point, o: &Outcome) -> String {
         g.arg_latitude_rad.to_degrees(),
         sig(o.margin_rad.to_degrees()),
     )
-}
-
-/// Three significant digits, plain or scientific.
-pub fn sig(x: f64) -> String {
-    if x != 0.0 && (x.abs() < 0.01 || x.abs() >= 1e4) {
-        format!("{x:.2e}")
-    } else if x.abs() >= 100.0 {
-        format!("{x:.0}")
-    } else if x.abs() >= 10.0 {
-        format!("{x:.1}")
-    } else {
-        format!("{x:.3}")
-    }
 }
 
 /// One panel of a map: file suffix, title, colour-bar label, z range (log10 unless
@@ -133,33 +113,6 @@ const V1_TERMS: Panel = Panel {
     bound: None,
 };
 
-fn heatmap(map: &Map, panel: &Panel, map_letter: &str) -> Heatmap {
-    let s = map.spec;
-    let values = map.values(panel.value);
-    let mut h = Heatmap::new(
-        &format!("{map_letter}: {}", panel.title),
-        s.x_label,
-        s.y_label,
-        panel.z_label,
-        (map.nx, map.ny),
-        values,
-    )
-    .x_range(s.x_range.0, s.x_range.1)
-    .y_range(s.y_range.0, s.y_range.1)
-    .y_decades(s.y_decades)
-    .z_range(panel.z_range.0, panel.z_range.1)
-    .z_decades(!panel.linear)
-    .missing_label(s.missing);
-    if let Some(c) = panel.bound {
-        h = h.z_mark(c.log10());
-    }
-    if let Some((ix, iy)) = map.argmax(panel.value) {
-        let (x, y) = map.centre(ix, iy);
-        h = h.mark(x, y);
-    }
-    h
-}
-
 /// The kappa panel (each cell's largest kappa) with its colour scale fitted to the map:
 /// decades when it spans one or more, linear (whole numbers) otherwise, where a log
 /// scale would show one colour.
@@ -187,7 +140,7 @@ fn kappa_panel(map: &Map) -> Panel {
 }
 
 /// Writes the PNGs of `map` into `dir`; returns the file names in panel order.
-pub fn write_pngs(map: &Map, letter: &str, dir: &Path) -> Result<Vec<String>, String> {
+pub fn write_pngs(map: &Map, dir: &Path) -> Result<Vec<String>> {
     let mut names = Vec::new();
     let extra = if map.spec.key == "inclination-latitude" {
         Some(&V1_TERMS)
@@ -201,7 +154,13 @@ pub fn write_pngs(map: &Map, letter: &str, dir: &Path) -> Result<Vec<String>, St
         } else {
             panel
         };
-        heatmap(map, panel, letter).save(&dir.join(&name))?;
+        map.heatmap(
+            (panel.title, panel.z_label),
+            (panel.z_range, !panel.linear),
+            panel.value,
+            panel.bound.map(f64::log10),
+        )
+        .save(&dir.join(&name))?;
         names.push(name);
     }
     Ok(names)
@@ -275,19 +234,6 @@ pub fn aggregate(map: &Map, keep: impl Fn(usize, usize, &Cell) -> bool) -> Agg {
         }
     }
     a
-}
-
-/// A markdown table.
-pub fn table(header: &[&str], rows: &[Vec<String>]) -> String {
-    let mut s = format!(
-        "| {} |\n|{}\n",
-        header.join(" | "),
-        "---|".repeat(header.len())
-    );
-    for r in rows {
-        s.push_str(&format!("| {} |\n", r.join(" | ")));
-    }
-    s
 }
 
 const AGG_HEADER: [&str; 12] = [
@@ -364,19 +310,19 @@ pub fn limb_slope(map: &Map, margin_deg: f64) -> Option<(f64, usize)> {
 }
 
 /// Fills `{{key}}` placeholders; an unknown key is an error.
-pub fn fill(template: &str, values: &BTreeMap<String, String>) -> Result<String, String> {
+pub fn fill(template: &str, values: &BTreeMap<String, String>) -> Result<String> {
     let mut out = String::with_capacity(template.len() * 2);
     let mut rest = template;
     while let Some(b) = rest.find("{{") {
         out.push_str(&rest[..b]);
         let e = rest[b..]
             .find("}}")
-            .ok_or("stability template: unclosed {{")?
+            .context("stability template: unclosed {{")?
             + b;
         let key = rest[b + 2..e].trim();
         let v = values
             .get(key)
-            .ok_or(format!("stability template: no value for `{key}`"))?;
+            .with_context(|| format!("stability template: no value for `{key}`"))?;
         out.push_str(v);
         rest = &rest[e + 2..];
     }

@@ -8,17 +8,23 @@
 //! motion). Error |dv|/|v|: hypot of the component differences over the reference's
 //! hypot(v1, v2), inputs as given in f64 (the f32 path rounds the attitude itself).
 
-use core_math::accuracy::{earth_kappa, EARTH_F32_KAPPA_C, EARTH_F32_REL_TOLERANCE};
+use anyhow::Result;
+use core_math::accuracy::{
+    earth_kappa, EARTH_F32_KAPPA_C, EARTH_F32_KAPPA_LIMIT, EARTH_F32_REL_TOLERANCE,
+};
 use core_math::earth::{circular_state, limb_margin_rad, Attitude, EarthCamera, EarthGeometry};
 use core_math::sample::{roll_at_limb_margin, EarthCase};
+use core_math::vector::norm;
 use core_math::{Backend, EarthReference, Ellipsoid, EARTH_RATE_RAD_S, GENERAL_F32};
 
 use std::path::Path;
 
-use super::doc::{e2, sig};
-use super::maps::{jitter, I0_SSO_DEG};
+use crate::markdown::{e2, sig, table};
+
+use super::doc::lg;
+use super::grid::{self, Spec};
+use super::maps::I0_SSO_DEG;
 use super::point::U_F32;
-use crate::plot::heatmap::Heatmap;
 
 /// The paper's camera on the detector line through the optical axis.
 pub const CAMERA: EarthCamera = EarthCamera {
@@ -61,26 +67,8 @@ fn angles(roll_deg: f64, pitch_deg: f64, yaw_deg: f64) -> Attitude<f64> {
     }
 }
 
-/// One 2-D map of the general model.
-pub struct GSpec {
-    /// File stem under docs/stability/ and key in the document.
-    pub key: &'static str,
-    pub letter: &'static str,
-    pub title: &'static str,
-    pub x_label: &'static str,
-    pub y_label: &'static str,
-    pub x_range: (f64, f64),
-    pub y_range: (f64, f64),
-    pub y_decades: bool,
-    /// Cells and sub-samples per cell (full run).
-    pub nx: usize,
-    pub ny: usize,
-    pub sub: usize,
-    /// The case of sub-sample `s` at (x, y); None where the map has none.
-    pub case: fn(x: f64, y: f64, s: usize) -> Option<EarthCase>,
-    /// What the other variables are, for the document.
-    pub others: &'static str,
-}
+/// The grey cells of every general map.
+const MISSING: &str = "< 0.01 deg inside the limb";
 
 fn pitch_roll(yaw_deg: f64, pitch: f64, roll: f64, s: usize) -> EarthCase {
     let n = PIXELS[s % PIXELS.len()];
@@ -117,8 +105,8 @@ fn rates(pitch_rate: f64, roll_rate: f64, s: usize) -> Option<EarthCase> {
     Some(case(H0_KM, I0_SSO_DEG, G0_DEG, a, PIXELS[s % 3]))
 }
 
-pub const GMAPS: [GSpec; 5] = [
-    GSpec {
+pub const GMAPS: [Spec<EarthCase>; 5] = [
+    Spec {
         key: "general-pitch-roll",
         letter: "D",
         title: "pitch x roll, yaw 0",
@@ -130,11 +118,12 @@ pub const GMAPS: [GSpec; 5] = [
         nx: 120,
         ny: 120,
         sub: 3,
-        case: |x, y, s| Some(pitch_roll(0.0, x, y, s)),
+        point: |x, y, s| Some(pitch_roll(0.0, x, y, s)),
         others: "645 km above the WGS 84 equatorial radius, circular, i0 97.98 deg, \
                  g0 45 deg, yaw 0, no rates; n_px = -30 000, 0, 30 000 over the sub-samples",
+        missing: MISSING,
     },
-    GSpec {
+    Spec {
         key: "general-pitch-roll-yaw30",
         letter: "D'",
         title: "pitch x roll, yaw 30 deg",
@@ -146,10 +135,11 @@ pub const GMAPS: [GSpec; 5] = [
         nx: 90,
         ny: 90,
         sub: 3,
-        case: |x, y, s| Some(pitch_roll(30.0, x, y, s)),
+        point: |x, y, s| Some(pitch_roll(30.0, x, y, s)),
         others: "as map D with yaw 30 deg",
+        missing: MISSING,
     },
-    GSpec {
+    Spec {
         key: "general-altitude-limb",
         letter: "E",
         title: "altitude x limb margin",
@@ -161,12 +151,13 @@ pub const GMAPS: [GSpec; 5] = [
         nx: 96,
         ny: 96,
         sub: 6,
-        case: altitude_limb,
+        point: altitude_limb,
         others: "circular, i0 97.98 deg; n_px = +/-30 000 (35.1 deg field angle) on the side \
                  of the roll, which is solved for the margin; pitch 0, 20, -30 deg; (yaw, g0) \
                  (0, 45) and (30, 135) deg, cycling over the sub-samples; no rates",
+        missing: MISSING,
     },
-    GSpec {
+    Spec {
         key: "general-rates",
         letter: "F",
         title: "pitch rate x roll rate",
@@ -178,11 +169,12 @@ pub const GMAPS: [GSpec; 5] = [
         nx: 120,
         ny: 120,
         sub: 6,
-        case: rates,
+        point: rates,
         others: "645 km, circular, i0 97.98 deg, g0 45 deg; n_px = -30 000, 0, 30 000 at \
                  roll = pitch = yaw = 0, then at roll 20, pitch -10 deg; yaw rate 0",
+        missing: MISSING,
     },
-    GSpec {
+    Spec {
         key: "general-rates-zoom",
         letter: "F'",
         title: "pitch rate x roll rate, the cancellation",
@@ -194,8 +186,9 @@ pub const GMAPS: [GSpec; 5] = [
         nx: 100,
         ny: 50,
         sub: 6,
-        case: rates,
+        point: rates,
         others: "as map F",
+        missing: MISSING,
     },
 ];
 
@@ -280,6 +273,26 @@ pub struct GCell {
     pub max_err_v1: Option<(EarthCase, GOutcome)>,
 }
 
+impl grid::Cell for GCell {
+    type Point = EarthCase;
+
+    fn empty() -> Self {
+        GCell::empty()
+    }
+
+    fn sample(&mut self, c: &EarthCase) {
+        match evaluate(c) {
+            Ok(o) => self.add(c, &o),
+            Err(GSkip::Outside) => {}
+            Err(GSkip::Refused) => self.refused += 1,
+        }
+    }
+
+    fn n(&self) -> u64 {
+        self.n
+    }
+}
+
 impl GCell {
     pub fn empty() -> Self {
         GCell {
@@ -298,7 +311,7 @@ impl GCell {
             self.over_tol += 1;
             self.over_tol_kappa_min = self.over_tol_kappa_min.min(o.kappa);
         }
-        if o.kappa <= core_math::accuracy::EARTH_F32_KAPPA_LIMIT
+        if o.kappa <= EARTH_F32_KAPPA_LIMIT
             && o.margin_rad.to_degrees() >= 1.0
             && o.err > self.err_tame
         {
@@ -359,25 +372,10 @@ impl GCell {
     }
 }
 
-pub struct GMap {
-    pub spec: &'static GSpec,
-    pub nx: usize,
-    pub ny: usize,
-    pub sub: usize,
-    /// Row-major from the bottom row.
-    pub cells: Vec<GCell>,
-}
+/// A swept map of the general model.
+pub type GMap = grid::Map<GCell>;
 
 impl GMap {
-    pub fn centre(&self, ix: usize, iy: usize) -> (f64, f64) {
-        let (x0, x1) = self.spec.x_range;
-        let (y0, y1) = self.spec.y_range;
-        (
-            x0 + (ix as f64 + 0.5) * (x1 - x0) / self.nx as f64,
-            y0 + (iy as f64 + 0.5) * (y1 - y0) / self.ny as f64,
-        )
-    }
-
     /// All cells that pass `keep` (by cell centre) merged.
     pub fn aggregate(&self, keep: impl Fn(f64, f64) -> bool) -> GCell {
         let mut a = GCell::empty();
@@ -391,43 +389,6 @@ impl GMap {
         }
         a
     }
-
-    fn argmax(&self, f: impl Fn(&GCell) -> f64) -> Option<(usize, usize)> {
-        (0..self.cells.len())
-            .filter(|&i| self.cells[i].n > 0)
-            .max_by(|&a, &b| f(&self.cells[a]).total_cmp(&f(&self.cells[b])))
-            .map(|i| (i % self.nx, i / self.nx))
-    }
-}
-
-/// Sweeps `spec` with `nx` x `ny` cells and `sub` sub-samples per cell, on every core.
-pub fn sweep(spec: &'static GSpec, nx: usize, ny: usize, sub: usize) -> GMap {
-    let (x0, x1) = spec.x_range;
-    let (y0, y1) = spec.y_range;
-    let (dx, dy) = ((x1 - x0) / nx as f64, (y1 - y0) / ny as f64);
-    let cell = |ix: usize, iy: usize| {
-        let mut c = GCell::empty();
-        for s in 0..sub {
-            let (fx, fy) = jitter(s, sub);
-            let (x, y) = (x0 + (ix as f64 + fx) * dx, y0 + (iy as f64 + fy) * dy);
-            let Some(k) = (spec.case)(x, y, s) else {
-                continue;
-            };
-            match evaluate(&k) {
-                Ok(o) => c.add(&k, &o),
-                Err(GSkip::Outside) => {}
-                Err(GSkip::Refused) => c.refused += 1,
-            }
-        }
-        c
-    };
-    GMap {
-        spec,
-        nx,
-        ny,
-        sub,
-        cells: super::maps::sweep_rows(nx, ny, cell),
-    }
 }
 
 /// Sweeps every general map: full grids, or every dimension divided by `coarse`.
@@ -436,7 +397,7 @@ pub fn sweep_all(coarse: Option<usize>) -> Vec<GMap> {
         .iter()
         .map(|s| {
             let c = coarse.unwrap_or(1);
-            sweep(s, s.nx / c, s.ny / c, s.sub)
+            GMap::sweep(s, s.nx / c, s.ny / c, s.sub)
         })
         .collect()
 }
@@ -469,8 +430,7 @@ pub fn check_bounds(maps: &[GMap]) -> Vec<String> {
 pub fn describe(c: &EarthCase, o: &GOutcome) -> String {
     let a = &c.geometry.attitude;
     let r = c.geometry.state.position_m;
-    let h_km =
-        (libm::sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]) - c.geometry.ellipsoid.a_m) / 1e3;
+    let h_km = (norm(r) - c.geometry.ellipsoid.a_m) / 1e3;
     let mut s = format!(
         "H {h_km:.0} km, roll {:.2} deg, pitch {:.2} deg, yaw {:.0} deg",
         a.roll_rad.to_degrees(),
@@ -494,12 +454,8 @@ pub fn describe(c: &EarthCase, o: &GOutcome) -> String {
     s
 }
 
-fn lg(x: f64) -> f64 {
-    x.max(1e-30).log10()
-}
-
 /// Writes the map's three PNGs (kappa, f32 error, err/(kappa u)) into `dir`.
-pub fn write_pngs(m: &GMap, dir: &Path) -> Result<(), String> {
+pub fn write_pngs(m: &GMap, dir: &Path) -> Result<()> {
     let s = m.spec;
     let kmax = m
         .cells
@@ -523,7 +479,7 @@ pub fn write_pngs(m: &GMap, dir: &Path) -> Result<(), String> {
             "kappa",
             (0.0, lg(kmax).ceil().max(2.0)),
             |c| lg(c.kappa),
-            Some(lg(core_math::accuracy::EARTH_F32_KAPPA_LIMIT)),
+            Some(lg(EARTH_F32_KAPPA_LIMIT)),
         ),
         (
             "err-f32",
@@ -543,30 +499,7 @@ pub fn write_pngs(m: &GMap, dir: &Path) -> Result<(), String> {
         ),
     ];
     for (suffix, title, z_label, z, value, bound) in panels {
-        let mut h = Heatmap::new(
-            &format!("{}: {title}", s.letter),
-            s.x_label,
-            s.y_label,
-            z_label,
-            (m.nx, m.ny),
-            m.cells
-                .iter()
-                .map(|c| if c.n > 0 { Some(value(c)) } else { None })
-                .collect(),
-        )
-        .x_range(s.x_range.0, s.x_range.1)
-        .y_range(s.y_range.0, s.y_range.1)
-        .y_decades(s.y_decades)
-        .z_range(z.0, z.1)
-        .z_decades(true)
-        .missing_label("< 0.01 deg inside the limb");
-        if let Some(b) = bound {
-            h = h.z_mark(b);
-        }
-        if let Some((ix, iy)) = m.argmax(value) {
-            let (x, y) = m.centre(ix, iy);
-            h = h.mark(x, y);
-        }
+        let h = m.heatmap((title, z_label), (z, true), value, bound);
         let name = format!("{}-{suffix}.png", s.key);
         h.save(&dir.join(name))?;
     }
@@ -694,7 +627,7 @@ pub fn figures(maps: &[GMap], secs: f64) -> std::collections::BTreeMap<String, S
             );
         }
     }
-    put("G.table", super::doc::table(&TABLE_HEADER, &rows));
+    put("G.table", table(&TABLE_HEADER, &rows));
     put(
         "G.bound_line",
         format!(
@@ -737,7 +670,7 @@ pub fn figures(maps: &[GMap], secs: f64) -> std::collections::BTreeMap<String, S
             .collect();
         let mut header = TABLE_HEADER;
         header[0] = "limb margin";
-        put("E.band_table", super::doc::table(&header, &rows));
+        put("E.band_table", table(&header, &rows));
         put(
             "E.mid_kappa_min",
             sig(e.aggregate(|_, y| y < 0.0).kappa_min),
@@ -793,10 +726,7 @@ pub fn figures(maps: &[GMap], secs: f64) -> std::collections::BTreeMap<String, S
                 100.0 * f.cells.iter().filter(|c| c.n > 0 && p(c)).count() as f64 / n
             )
         };
-        put(
-            "F.pct_stiff",
-            frac(&|c| c.kappa > core_math::accuracy::EARTH_F32_KAPPA_LIMIT),
-        );
+        put("F.pct_stiff", frac(&|c| c.kappa > EARTH_F32_KAPPA_LIMIT));
         put("F.pct_over", frac(&|c| c.over_tol > 0));
         if let Some((c, o)) = &f.aggregate(|_, _| true).max_kappa {
             let a = &c.geometry.attitude;

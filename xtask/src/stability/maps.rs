@@ -1,33 +1,11 @@
-//! The three maps: which variables span each, where the others sit, and the sweep.
+//! The three maps of the paper's round Earth: which variables span each, where the
+//! others sit, and what a cell keeps.
 
+use super::grid::{self, Spec};
 use super::point::{evaluate, Outcome, Point, RelErrors, Skip, EARTH_RADIUS_M};
 
 /// Sun-synchronous inclination of the paper's orbit (deg).
 pub const I0_SSO_DEG: f64 = 97.98;
-
-/// One 2-D map of the envelope.
-pub struct MapSpec {
-    /// File stem under docs/stability/ and key in the document.
-    pub key: &'static str,
-    pub title: &'static str,
-    pub x_label: &'static str,
-    pub y_label: &'static str,
-    pub x_range: (f64, f64),
-    pub y_range: (f64, f64),
-    /// The y coordinate is log10 of the quantity (decade ticks).
-    pub y_decades: bool,
-    /// Cells (full run).
-    pub nx: usize,
-    pub ny: usize,
-    /// Sub-samples per cell (full run).
-    pub sub: usize,
-    /// The point of sub-sample `s` at (x, y); None where the map has no line of sight.
-    pub point: fn(x: f64, y: f64, s: usize) -> Option<Point>,
-    /// What the other variables are, for the document.
-    pub others: &'static str,
-    /// Label of the grey cells (no line of sight there), empty if there are none.
-    pub missing: &'static str,
-}
 
 /// Inclination and argument of latitude (deg) the sub-samples of map A cycle through.
 const OTHERS_A: [(f64, f64); 6] = [
@@ -86,9 +64,10 @@ fn point_c(i0_deg: f64, g0_deg: f64, s: usize) -> Option<Point> {
     Some(Point::circular(roll, field, i0_deg, g0_deg, h_km))
 }
 
-pub const MAPS: [MapSpec; 3] = [
-    MapSpec {
+pub const MAPS: [Spec<Point>; 3] = [
+    Spec {
         key: "altitude-limb",
+        letter: "A",
         title: "altitude x distance to the limb",
         x_label: "altitude (km)",
         y_label: "limb margin (deg)",
@@ -104,8 +83,9 @@ pub const MAPS: [MapSpec; 3] = [
                  (97.98, 0), (97.98, 135), (50, 270), (0, 0), (150, 45), (85, 90) deg",
         missing: "past nadir",
     },
-    MapSpec {
+    Spec {
         key: "roll-field",
+        letter: "B",
         title: "roll x field angle, 645 km",
         x_label: "roll (deg)",
         y_label: "field angle (deg)",
@@ -119,8 +99,9 @@ pub const MAPS: [MapSpec; 3] = [
         others: "altitude 645 km, i0 97.98 deg; g0 = 0, 60, ..., 300 deg over the sub-samples",
         missing: "beyond the limb",
     },
-    MapSpec {
+    Spec {
         key: "inclination-latitude",
+        letter: "C",
         title: "inclination x arg. of latitude, 2000 km",
         x_label: "inclination (deg)",
         y_label: "argument of latitude (deg)",
@@ -157,6 +138,29 @@ pub struct Cell {
     pub max_kappa: Option<(Point, Outcome)>,
 }
 
+impl grid::Cell for Cell {
+    type Point = Point;
+
+    fn empty() -> Self {
+        Cell::default()
+    }
+
+    fn sample(&mut self, pt: &Point) {
+        match evaluate(pt) {
+            Ok(o) => self.add(pt, &o),
+            Err(Skip::Outside) => {}
+            Err(Skip::Refused(by)) => {
+                self.refused += 1;
+                self.refused_by = Some(by);
+            }
+        }
+    }
+
+    fn n(&self) -> u64 {
+        self.n.into()
+    }
+}
+
 impl Cell {
     fn add(&mut self, pt: &Point, o: &Outcome) {
         if self.n == 0 {
@@ -190,115 +194,5 @@ impl Cell {
     }
 }
 
-/// A swept map: the cells, row-major from the bottom row (index iy * nx + ix).
-pub struct Map {
-    pub spec: &'static MapSpec,
-    pub nx: usize,
-    pub ny: usize,
-    /// Sub-samples per cell.
-    pub sub: usize,
-    pub cells: Vec<Cell>,
-}
-
-impl Map {
-    /// Cell centre in map coordinates.
-    pub fn centre(&self, ix: usize, iy: usize) -> (f64, f64) {
-        let (x0, x1) = self.spec.x_range;
-        let (y0, y1) = self.spec.y_range;
-        (
-            x0 + (ix as f64 + 0.5) * (x1 - x0) / self.nx as f64,
-            y0 + (iy as f64 + 0.5) * (y1 - y0) / self.ny as f64,
-        )
-    }
-
-    /// One value per cell (None where the cell has no sample), for a heatmap.
-    pub fn values(&self, f: impl Fn(&Cell) -> f64) -> Vec<Option<f64>> {
-        self.cells
-            .iter()
-            .map(|c| if c.n > 0 { Some(f(c)) } else { None })
-            .collect()
-    }
-
-    /// The cell (ix, iy) maximising `f` over the cells with samples.
-    pub fn argmax(&self, f: impl Fn(&Cell) -> f64) -> Option<(usize, usize)> {
-        (0..self.cells.len())
-            .filter(|&i| self.cells[i].n > 0)
-            .max_by(|&a, &b| f(&self.cells[a]).total_cmp(&f(&self.cells[b])))
-            .map(|i| (i % self.nx, i / self.nx))
-    }
-
-    pub fn samples(&self) -> u64 {
-        self.cells.iter().map(|c| c.n as u64).sum()
-    }
-}
-
-/// Sub-sample `s` of `sub`: offsets in (0, 1) within the cell, stratified in x and
-/// spread by the golden ratio in y (deterministic).
-pub fn jitter(s: usize, sub: usize) -> (f64, f64) {
-    let fx = (s as f64 + 0.5) / sub as f64;
-    let fy = (0.5 + s as f64 * 0.618_033_988_749_894_9).fract();
-    (fx, fy)
-}
-
-/// Sweeps `spec` with `nx` x `ny` cells and `sub` sub-samples per cell, on every core.
-pub fn sweep(spec: &'static MapSpec, nx: usize, ny: usize, sub: usize) -> Map {
-    let (x0, x1) = spec.x_range;
-    let (y0, y1) = spec.y_range;
-    let (dx, dy) = ((x1 - x0) / nx as f64, (y1 - y0) / ny as f64);
-    let cell = |ix: usize, iy: usize| {
-        let mut c = Cell::default();
-        for s in 0..sub {
-            let (fx, fy) = jitter(s, sub);
-            let (x, y) = (x0 + (ix as f64 + fx) * dx, y0 + (iy as f64 + fy) * dy);
-            let Some(pt) = (spec.point)(x, y, s) else {
-                continue;
-            };
-            match evaluate(&pt) {
-                Ok(o) => c.add(&pt, &o),
-                Err(Skip::Outside) => {}
-                Err(Skip::Refused(by)) => {
-                    c.refused += 1;
-                    c.refused_by = Some(by);
-                }
-            }
-        }
-        c
-    };
-    Map {
-        spec,
-        nx,
-        ny,
-        sub,
-        cells: sweep_rows(nx, ny, cell),
-    }
-}
-
-/// `cell(ix, iy)` over an nx x ny grid, rows spread over the available threads, in
-/// row-major order (the same result for any number of threads).
-pub(crate) fn sweep_rows<C: Clone + Send>(
-    nx: usize,
-    ny: usize,
-    cell: impl Fn(usize, usize) -> C + Sync,
-) -> Vec<C> {
-    let workers = std::thread::available_parallelism().map_or(1, |n| n.get());
-    let mut rows: Vec<Vec<C>> = vec![Vec::new(); ny];
-    std::thread::scope(|scope| {
-        let handles: Vec<_> = (0..workers)
-            .map(|w| {
-                let cell = &cell;
-                scope.spawn(move || {
-                    (w..ny)
-                        .step_by(workers)
-                        .map(|iy| (iy, (0..nx).map(|ix| cell(ix, iy)).collect::<Vec<_>>()))
-                        .collect::<Vec<_>>()
-                })
-            })
-            .collect();
-        for h in handles {
-            for (iy, row) in h.join().expect("sweep worker panicked") {
-                rows[iy] = row;
-            }
-        }
-    });
-    rows.into_iter().flatten().collect()
-}
+/// A swept map of the round Earth.
+pub type Map = grid::Map<Cell>;

@@ -4,6 +4,7 @@
 //! ELF to `probe-rs run`, which flashes it, prints the defmt log from RTT and exits with
 //! the firmware's semihosting exit status.
 
+use anyhow::{anyhow, bail, Context, Result};
 use std::process::Command;
 
 use super::board::Board;
@@ -36,7 +37,7 @@ enum Bin {
 }
 
 /// `cargo xtask flash`: build for the board with its RTT logger, then `probe-rs run`.
-pub fn flash(args: &FlashArgs) -> Result<(), String> {
+pub fn flash(args: &FlashArgs) -> Result<()> {
     let board = args.board;
     let bin = match args.bin {
         Bin::Firmware => "firmware",
@@ -45,7 +46,7 @@ pub fn flash(args: &FlashArgs) -> Result<(), String> {
     let release = !args.debug;
     let print_only = args.print_command;
     let chip = board.probe_rs_chip().ok_or_else(|| {
-        format!(
+        anyhow!(
             "flash: the {} exists only in QEMU: `cargo xtask run --board {}`",
             board.name(),
             board.name()
@@ -60,15 +61,15 @@ pub fn flash(args: &FlashArgs) -> Result<(), String> {
         return Ok(());
     }
     if !tools::have("probe-rs") {
-        return Err(format!(
+        bail!(
             "flash: probe-rs is not installed: `cargo install probe-rs-tools --locked` (about ten minutes), then connect the probe and rerun; the command will be\n  {shown}"
-        ));
+        );
     }
     eprintln!("xtask: {shown}");
     let status = Command::new("probe-rs")
         .args(probe_rs_args)
         .arg(&elf)
         .status()
-        .map_err(|e| format!("cannot start probe-rs: {e}"))?;
+        .context("cannot start probe-rs")?;
     exit_like(status.code().unwrap_or(1))
 }

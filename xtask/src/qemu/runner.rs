@@ -11,6 +11,7 @@
 //! pass player's unix socket), never to stdout, so that no other byte mixes in; QEMU's
 //! exit status is the firmware's semihosting exit code.
 
+use anyhow::{anyhow, bail, Context, Result};
 use std::collections::BTreeMap;
 use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
@@ -60,9 +61,9 @@ pub struct Outcome {
 
 /// `cargo xtask qemu ELF [ARGS]`: the runner cargo calls for `cargo run` / `cargo test`
 /// on thumbv7em. Exits with the firmware's status.
-pub fn qemu(args: &[String]) -> Result<(), String> {
+pub fn qemu(args: &[String]) -> Result<()> {
     let Some((elf, rest)) = args.split_first() else {
-        return Err("qemu: usage: qemu ELF (the cargo runner for thumbv7em-none-eabihf)".into());
+        bail!("qemu: usage: qemu ELF (the cargo runner for thumbv7em-none-eabihf)");
     };
     if !rest.is_empty() {
         eprintln!("xtask qemu: ignoring arguments {rest:?} (the firmware takes none)");
@@ -73,15 +74,15 @@ pub fn qemu(args: &[String]) -> Result<(), String> {
 
 /// Runs `elf` under QEMU, prints its decoded defmt log on stdout and returns its exit
 /// status.
-pub fn run_elf(elf: &Path, options: &Options) -> Result<Outcome, String> {
-    let bytes = std::fs::read(elf).map_err(|e| format!("cannot read {}: {e}", elf.display()))?;
+pub fn run_elf(elf: &Path, options: &Options) -> Result<Outcome> {
+    let bytes = std::fs::read(elf).with_context(|| format!("cannot read {}", elf.display()))?;
     let table =
-        Table::parse(&bytes).map_err(|e| format!("bad defmt table in {}: {e}", elf.display()))?;
+        Table::parse(&bytes).with_context(|| format!("bad defmt table in {}", elf.display()))?;
     let locations = match &table {
         Some(t) => t.get_locations(&bytes).unwrap_or_default(),
         None => BTreeMap::new(),
     };
-    let board = Board::of_elf(&bytes).map_err(|e| format!("{}: {e}", elf.display()))?;
+    let board = Board::of_elf(&bytes).with_context(|| format!("{}", elf.display()))?;
 
     let mut cmd = Command::new(QEMU);
     cmd.args(["-cpu", "cortex-m4", "-machine", board.qemu_machine()])
@@ -96,9 +97,9 @@ pub fn run_elf(elf: &Path, options: &Options) -> Result<Outcome, String> {
         .stdout(Stdio::piped())
         .stderr(Stdio::inherit());
     let mut child = cmd.spawn().map_err(|e| {
-        format!("cannot start {QEMU} (run `cargo xtask run` once to install it): {e}")
+        anyhow!("cannot start {QEMU} (run `cargo xtask run` once to install it): {e}")
     })?;
-    let stdout = child.stdout.take().ok_or("no stdout from QEMU")?;
+    let stdout = child.stdout.take().context("no stdout from QEMU")?;
     let child = Arc::new(Mutex::new(child));
     let watchdog = spawn_watchdog(Arc::clone(&child), timeout());
 
@@ -115,19 +116,17 @@ pub fn run_elf(elf: &Path, options: &Options) -> Result<Outcome, String> {
         None => copy_raw(stdout),
     };
     let timed_out = watchdog.join().unwrap_or(false);
-    let status = lock(&child)
-        .wait()
-        .map_err(|e| format!("waiting for QEMU: {e}"))?;
+    let status = lock(&child).wait().context("waiting for QEMU")?;
     read?;
     if timed_out {
-        return Err(format!(
+        bail!(
             "QEMU timed out after {} s and was killed (set TDI_QEMU_TIMEOUT_S to change the limit)",
             timeout().as_secs()
-        ));
+        );
     }
     let status = status
         .code()
-        .ok_or_else(|| format!("QEMU ended without an exit code ({status})"))?;
+        .with_context(|| format!("QEMU ended without an exit code ({status})"))?;
     Ok(Outcome {
         status,
         messages: printer.messages,
@@ -214,11 +213,7 @@ impl Printer<'_> {
     }
 }
 
-fn decode_stream(
-    table: &Table,
-    mut input: impl Read,
-    printer: &mut Printer<'_>,
-) -> Result<(), String> {
+fn decode_stream(table: &Table, mut input: impl Read, printer: &mut Printer<'_>) -> Result<()> {
     let mut decoder = table.new_stream_decoder();
     let mut buf = [0u8; 4096];
     loop {
@@ -226,7 +221,7 @@ fn decode_stream(
             Ok(0) => return Ok(()),
             Ok(n) => n,
             Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
-            Err(e) => return Err(format!("reading QEMU's output: {e}")),
+            Err(e) => bail!("reading QEMU's output: {e}"),
         };
         decoder.received(buf.get(..n).unwrap_or(&[]));
         loop {
@@ -237,7 +232,7 @@ fn decode_stream(
                     if table.encoding().can_recover() {
                         eprintln!("xtask qemu: skipped a malformed defmt frame");
                     } else {
-                        return Err("malformed defmt frame (raw encoding: cannot resync)".into());
+                        bail!("malformed defmt frame (raw encoding: cannot resync)");
                     }
                 }
             }
@@ -245,8 +240,8 @@ fn decode_stream(
     }
 }
 
-fn copy_raw(mut input: impl Read) -> Result<(), String> {
+fn copy_raw(mut input: impl Read) -> Result<()> {
     std::io::copy(&mut input, &mut std::io::stdout().lock())
         .map(|_| ())
-        .map_err(|e| format!("reading QEMU's output: {e}"))
+        .context("reading QEMU's output")
 }

@@ -22,6 +22,7 @@ mod scenario;
 mod stream;
 mod truth;
 
+use anyhow::{anyhow, bail, Context, Result};
 use std::collections::BTreeMap;
 use std::io::{Read, Write};
 use std::os::unix::net::UnixListener;
@@ -35,42 +36,91 @@ use crate::plot::{Legend, Plot, Series};
 use check::{Downlink, F32_REL_TOLERANCE};
 use scenario::Pass;
 
-use super::board::Board;
-use super::{build_board_bin, ensure_target_tools, qemu, workspace_root};
+use super::board::{Board, BoardArg};
+use super::{build_board_bin, ensure_target_tools, exit_like, runner, workspace_root};
 
 /// Segments shown in the table by default (first, one of the two central ones, last).
 pub const TABLE_SEGMENTS: [u8; 3] = [0, 5, 9];
 /// Table row spacing by default (simulated seconds).
 pub const TABLE_EVERY_S: u64 = 10;
 
-/// What `run` was asked to do.
-pub struct RunOptions {
-    pub board: Board,
-    pub release: bool,
-    /// The end-to-end test's one-minute pass instead of the default one.
-    pub short: bool,
-    pub telemetry: Option<PathBuf>,
-    pub plot: Option<PathBuf>,
-    /// Table: seconds between rows, segments shown.
-    pub every_s: u64,
-    pub segments: Vec<u8>,
+/// `cargo xtask run`'s options.
+#[derive(clap::Args)]
+pub struct RunArgs {
+    #[command(flatten)]
+    board: BoardArg,
+    /// The default-scene demo (one synthetic NAV frame, no UART) instead of a pass
+    #[arg(long)]
+    demo: bool,
+    /// The firmware's dev profile instead of release
+    #[arg(long)]
+    debug: bool,
+    /// The release profile (the default)
+    #[arg(long, hide = true, conflicts_with = "debug")]
+    release: bool,
+    /// The end-to-end test's 1-minute pass instead of the 10-minute default
+    #[arg(long)]
+    short: bool,
+    /// Play this NAV telemetry (docs/telemetry.md) instead of the default pass
+    #[arg(long, value_name = "FILE.csv")]
+    telemetry: Option<PathBuf>,
+    /// Write the line-period plot here [default: target/pass/line-periods.png]
+    #[arg(long, value_name = "FILE.png")]
+    plot: Option<PathBuf>,
+    /// Seconds between the table's rows
+    #[arg(long, value_name = "SECONDS", default_value_t = TABLE_EVERY_S,
+          value_parser = clap::value_parser!(u64).range(1..))]
+    every: u64,
+    /// The table's segments: indices, or all [default: 0,5,9]
+    #[arg(long, value_name = "0,5,9|all", value_parser = parse_segments)]
+    segments: Option<Segments>,
+    /// Only write the default pass's NAV samples as telemetry CSV
+    #[arg(long, value_name = "FILE.csv")]
+    export_telemetry: Option<PathBuf>,
+}
+
+/// Segment indices given on the command line (one value, not a list of arguments).
+#[derive(Clone, Debug)]
+pub struct Segments(Vec<u8>);
+
+fn parse_segments(v: &str) -> Result<Segments> {
+    if v == "all" {
+        return Ok(Segments((0..16).collect()));
+    }
+    v.split(',')
+        .map(|x| x.trim().parse::<u8>())
+        .collect::<Result<_, _>>()
+        .map(Segments)
+        .map_err(|_| anyhow!("`{v}` is not a list of segment indices like 0,5,9"))
 }
 
 /// `cargo xtask run [--telemetry FILE]`: the default pass (or the file) through the
-/// firmware, table, plot, checks.
-pub fn run(options: &RunOptions) -> Result<(), String> {
+/// firmware, table, plot, checks; or the default-scene demo, or the export of the
+/// default pass's telemetry.
+pub fn run(args: &RunArgs) -> Result<()> {
+    let (board, release) = (args.board.board, !args.debug);
+    if let Some(path) = &args.export_telemetry {
+        return export(path);
+    }
+    if args.demo {
+        ensure_target_tools()?;
+        let elf = build_board_bin(board, "firmware", "demo", release, &[])?;
+        let outcome = runner::run_elf(&elf, &runner::Options::default())?;
+        return exit_like(outcome.status);
+    }
     let started = Instant::now();
     let tick_us = Config::default().update_period_us;
-    let pass = match &options.telemetry {
+    let pass = match &args.telemetry {
         Some(path) => scenario::from_csv(path, tick_us)?,
-        None if options.short => scenario::short_pass(tick_us)?,
+        None if args.short => scenario::short_pass(tick_us)?,
         None => scenario::default_pass(tick_us)?,
     };
     ensure_target_tools()?;
-    let elf = build_board_bin(options.board, "firmware", "firmware", options.release, &[])?;
+    let elf = build_board_bin(board, "firmware", "firmware", release, &[])?;
     let result = play(&elf, &pass)?;
-    print_table(&pass, &result, options.every_s.max(1), &options.segments);
-    let plot = options
+    let segments = args.segments.as_ref().map_or(&TABLE_SEGMENTS[..], |s| &s.0);
+    print_table(&pass, &result, args.every, segments);
+    let plot = args
         .plot
         .clone()
         .unwrap_or_else(|| workspace_root().join("target/pass/line-periods.png"));
@@ -88,7 +138,7 @@ pub fn run(options: &RunOptions) -> Result<(), String> {
 }
 
 /// `cargo xtask run --export-telemetry FILE`: the default pass's NAV samples as CSV.
-pub fn export(path: &Path) -> Result<(), String> {
+pub fn export(path: &Path) -> Result<()> {
     let pass = scenario::default_pass(Config::default().update_period_us)?;
     scenario::to_csv(&pass, path)?;
     println!(
@@ -103,7 +153,7 @@ pub fn export(path: &Path) -> Result<(), String> {
 /// The end-to-end test (`cargo xtask test`): a one-minute pass with every kind of
 /// fault through the firmware (release) under QEMU; every period against the
 /// reference, every fault counted, no output changed by a fault.
-pub fn e2e_test(board: Board) -> Result<(), String> {
+pub fn e2e_test(board: Board) -> Result<()> {
     let started = Instant::now();
     let pass = scenario::short_pass(Config::default().update_period_us)?;
     let elf = build_board_bin(board, "firmware", "firmware", true, &[])?;
@@ -148,7 +198,7 @@ impl Played {
 
     /// Prints the verdict lines (the last two in the fixed format) and fails on any
     /// broken check.
-    fn finish(&self) -> Result<(), String> {
+    fn finish(&self) -> Result<()> {
         let mut problems = Vec::new();
         if self.status != 0 {
             problems.push(format!("the firmware exited with status {}", self.status));
@@ -197,13 +247,13 @@ impl Played {
         if problems.is_empty() {
             Ok(())
         } else {
-            Err(format!("{} check(s) failed (see above)", problems.len()))
+            Err(anyhow!("{} check(s) failed (see above)", problems.len()))
         }
     }
 }
 
 /// Plays `pass` through the firmware `elf` and runs every check.
-fn play(elf: &Path, pass: &Pass) -> Result<Played, String> {
+fn play(elf: &Path, pass: &Pass) -> Result<Played> {
     let stream = stream::build(pass)?;
     let uplink = stream.faulty();
     println!(
@@ -337,7 +387,7 @@ fn reference_check(
     firmware: &Downlink,
     inputs: &BTreeMap<u64, check::InForce>,
     controller: &controller::Controller,
-) -> Result<(f64, f64, usize, Vec<String>), String> {
+) -> Result<(f64, f64, usize, Vec<String>)> {
     let mut max_rel = 0.0f64;
     let mut max_ticks = 0.0f64;
     let mut compared = 0;
@@ -360,7 +410,7 @@ fn reference_check(
             &input.nav,
             t_us,
         )
-        .map_err(|e| format!("reference at {t_us} us: {}", e.name()))?;
+        .map_err(|e| anyhow!("reference at {t_us} us: {}", e.name()))?;
         for r in periods.records().iter().filter(|r| !r.held) {
             let Some(exact) = golden
                 .segments
@@ -392,7 +442,7 @@ fn reference_check(
 
 /// Starts QEMU with UART0 on a unix socket, sends `uplink`, returns the firmware's
 /// exit status and everything it sent.
-fn run_qemu(elf: &Path, uplink: &[u8]) -> Result<(i32, Vec<u8>), String> {
+fn run_qemu(elf: &Path, uplink: &[u8]) -> Result<(i32, Vec<u8>)> {
     let socket = std::env::temp_dir().join(format!(
         "tdi-pass-{}-{}.sock",
         std::process::id(),
@@ -402,9 +452,9 @@ fn run_qemu(elf: &Path, uplink: &[u8]) -> Result<(i32, Vec<u8>), String> {
     ));
     let _ = std::fs::remove_file(&socket);
     let listener = UnixListener::bind(&socket)
-        .map_err(|e| format!("cannot listen on {}: {e}", socket.display()))?;
+        .with_context(|| format!("cannot listen on {}", socket.display()))?;
     let (link_ready, ready) = std::sync::mpsc::channel();
-    let options = qemu::Options {
+    let options = runner::Options {
         extra_args: vec![
             "-chardev".into(),
             format!("socket,id=telemetry,path={}", socket.display()),
@@ -415,23 +465,21 @@ fn run_qemu(elf: &Path, uplink: &[u8]) -> Result<(i32, Vec<u8>), String> {
         link_ready: Some(link_ready),
     };
     let elf_owned = elf.to_path_buf();
-    let emulator = std::thread::spawn(move || qemu::run_elf(&elf_owned, &options));
+    let emulator = std::thread::spawn(move || runner::run_elf(&elf_owned, &options));
 
     // QEMU connects as soon as it starts; give up if it ends first or takes too long.
-    listener
-        .set_nonblocking(true)
-        .map_err(|e| format!("socket: {e}"))?;
+    listener.set_nonblocking(true).context("socket")?;
     let t0 = Instant::now();
     let conn = loop {
         match listener.accept() {
             Ok((conn, _)) => break Ok(conn),
             Err(e) if e.kind() == std::io::ErrorKind::WouldBlock => {
                 if emulator.is_finished() || t0.elapsed() > Duration::from_secs(30) {
-                    break Err("QEMU did not connect to the telemetry socket".to_string());
+                    break Err(anyhow!("QEMU did not connect to the telemetry socket"));
                 }
                 std::thread::sleep(Duration::from_millis(10));
             }
-            Err(e) => break Err(format!("accepting QEMU's connection: {e}")),
+            Err(e) => break Err(anyhow!("accepting QEMU's connection: {e}")),
         }
     };
     let _ = std::fs::remove_file(&socket);
@@ -440,47 +488,39 @@ fn run_qemu(elf: &Path, uplink: &[u8]) -> Result<(i32, Vec<u8>), String> {
         Err(e) => {
             let outcome = emulator.join();
             return Err(match outcome {
-                Ok(Err(q)) => format!("{e}: {q}"),
+                Ok(Err(q)) => anyhow!("{e}: {q:#}"),
                 _ => e,
             });
         }
     };
-    conn.set_nonblocking(false)
-        .map_err(|e| format!("socket: {e}"))?;
+    conn.set_nonblocking(false).context("socket")?;
     // Not a byte before the firmware says its link is enabled: the STM32F405's USART
     // drops what arrives earlier (docs/target.md, "Boards").
     ready
         .recv_timeout(Duration::from_secs(30))
-        .map_err(|_| "the firmware never said that its telemetry link was ready".to_string())?;
-    let mut writer = conn.try_clone().map_err(|e| format!("socket: {e}"))?;
+        .map_err(|_| anyhow!("the firmware never said that its telemetry link was ready"))?;
+    let mut writer = conn.try_clone().context("socket")?;
     let data = uplink.to_vec();
     // The firmware reads as fast as it computes; the writer blocks when QEMU's side is
     // full, while this thread drains the downlink so that the firmware never waits.
-    let sender = std::thread::spawn(move || -> Result<(), String> {
+    let sender = std::thread::spawn(move || -> Result<()> {
         for chunk in data.chunks(4096) {
-            writer
-                .write_all(chunk)
-                .map_err(|e| format!("sending telemetry: {e}"))?;
+            writer.write_all(chunk).context("sending telemetry")?;
         }
-        writer
-            .flush()
-            .map_err(|e| format!("sending telemetry: {e}"))
+        writer.flush().context("sending telemetry")
     });
     let mut downlink = Vec::new();
     let mut reader = conn;
     let read = reader.read_to_end(&mut downlink);
     let outcome = emulator
         .join()
-        .map_err(|_| "the QEMU thread panicked".to_string())??;
+        .map_err(|_| anyhow!("the QEMU thread panicked"))??;
     let sent = sender
         .join()
-        .map_err(|_| "the sender thread panicked".to_string())?;
-    read.map_err(|e| format!("reading the downlink: {e}"))?;
+        .map_err(|_| anyhow!("the sender thread panicked"))?;
+    read.context("reading the downlink")?;
     if let Err(e) = sent {
-        return Err(format!(
-            "{e} (the firmware exited with status {})",
-            outcome.status
-        ));
+        bail!("{e:#} (the firmware exited with status {})", outcome.status);
     }
     Ok((outcome.status, downlink))
 }
@@ -605,7 +645,7 @@ fn telemetry_attitude_deg(pass: &Pass, t_us: u64) -> Option<[f64; 3]> {
 }
 
 /// The line period of every segment over time, as programmed.
-fn plot_periods(pass: &Pass, played: &Played, path: &Path) -> Result<(), String> {
+fn plot_periods(pass: &Pass, played: &Played, path: &Path) -> Result<()> {
     let decoded = played.firmware.decoded();
     let mut series: BTreeMap<u8, Vec<(f64, f64)>> = BTreeMap::new();
     for (t_us, p) in &decoded {
@@ -628,7 +668,7 @@ fn plot_periods(pass: &Pass, played: &Played, path: &Path) -> Result<(), String>
         plot = plot.series(Series::line(&format!("segment {index}"), points).palette(i));
     }
     if let Some(dir) = path.parent() {
-        std::fs::create_dir_all(dir).map_err(|e| format!("creating {}: {e}", dir.display()))?;
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     }
     plot.save(path)
 }

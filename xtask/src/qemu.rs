@@ -1,5 +1,5 @@
-//! The on-target half of the xtask: the firmware under QEMU, the on-target tests, the
-//! instruction counts. See docs/target.md and docs/bench.md.
+//! The on-target half of the xtask (QEMU runs and boards): the firmware under QEMU, the
+//! on-target tests, the instruction counts. See docs/target.md and docs/bench.md.
 //!
 //! - `cargo xtask run [--board NAME]`: build the firmware (release) for a board
 //!   ([`board`]: `mps2-an386`, the default, or `stm32f405` on QEMU's netduinoplus2) and
@@ -19,19 +19,20 @@ mod board;
 mod flash;
 mod pass;
 mod profile;
-mod qemu;
+mod runner;
 mod tools;
 
+use anyhow::{anyhow, bail, Context, Result};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
 
 pub use bench::{bench, measure as bench_counts, BenchArgs, BenchCounts};
+use board::Board;
 pub use board::{size, SizeArgs};
-use board::{Board, BoardArg};
 pub use flash::{flash, FlashArgs};
-pub use pass::e2e_test;
-pub use qemu::qemu;
+pub use pass::{e2e_test, run, RunArgs};
+pub use runner::qemu;
 pub use tools::ensure_target_tools;
 
 /// The firmware's target: Cortex-M4F, hard-float ABI.
@@ -39,91 +40,13 @@ pub const TARGET: &str = "thumbv7em-none-eabihf";
 /// A core without an FPU (Cortex-M3), for the fixed-point backend's build check.
 pub const NO_FPU_TARGET: &str = "thumbv7m-none-eabi";
 
-/// `cargo xtask run`'s options.
-#[derive(clap::Args)]
-pub struct RunArgs {
-    #[command(flatten)]
-    board: BoardArg,
-    /// The default-scene demo (one synthetic NAV frame, no UART) instead of a pass
-    #[arg(long)]
-    demo: bool,
-    /// The firmware's dev profile instead of release
-    #[arg(long)]
-    debug: bool,
-    /// The release profile (the default)
-    #[arg(long, hide = true, conflicts_with = "debug")]
-    release: bool,
-    /// The end-to-end test's 1-minute pass instead of the 10-minute default
-    #[arg(long)]
-    short: bool,
-    /// Play this NAV telemetry (docs/telemetry.md) instead of the default pass
-    #[arg(long, value_name = "FILE.csv")]
-    telemetry: Option<PathBuf>,
-    /// Write the line-period plot here [default: target/pass/line-periods.png]
-    #[arg(long, value_name = "FILE.png")]
-    plot: Option<PathBuf>,
-    /// Seconds between the table's rows
-    #[arg(long, value_name = "SECONDS", default_value_t = pass::TABLE_EVERY_S,
-          value_parser = clap::value_parser!(u64).range(1..))]
-    every: u64,
-    /// The table's segments: indices, or all [default: 0,5,9]
-    #[arg(long, value_name = "0,5,9|all", value_parser = parse_segments)]
-    segments: Option<Segments>,
-    /// Only write the default pass's NAV samples as telemetry CSV
-    #[arg(long, value_name = "FILE.csv")]
-    export_telemetry: Option<PathBuf>,
-}
-
-/// Segment indices given on the command line (one value, not a list of arguments).
-#[derive(Clone, Debug)]
-pub struct Segments(Vec<u8>);
-
-fn parse_segments(v: &str) -> Result<Segments, String> {
-    if v == "all" {
-        return Ok(Segments((0..16).collect()));
-    }
-    v.split(',')
-        .map(|x| x.trim().parse::<u8>())
-        .collect::<Result<_, _>>()
-        .map(Segments)
-        .map_err(|_| format!("`{v}` is not a list of segment indices like 0,5,9"))
-}
-
-/// `cargo xtask run`: a pass through the firmware under QEMU (docs/telemetry.md), or the
-/// default-scene demo.
-pub fn run(args: &RunArgs) -> Result<(), String> {
-    let board = args.board.board;
-    let release = !args.debug;
-    if let Some(path) = &args.export_telemetry {
-        return pass::export(path);
-    }
-    if args.demo {
-        ensure_target_tools()?;
-        let elf = build_board_bin(board, "firmware", "demo", release, &[])?;
-        let outcome = qemu::run_elf(&elf, &qemu::Options::default())?;
-        return exit_like(outcome.status);
-    }
-    pass::run(&pass::RunOptions {
-        board,
-        release,
-        short: args.short,
-        telemetry: args.telemetry.clone(),
-        plot: args.plot.clone(),
-        every_s: args.every,
-        segments: args
-            .segments
-            .clone()
-            .map_or(pass::TABLE_SEGMENTS.to_vec(), |s| s.0),
-    })
-}
-
 /// Every check of the target crates, for `cargo xtask test`: toolchain and QEMU present,
 /// clippy with `-D warnings` on thumbv7em for core-math, controller, firmware and
 /// hil-tests (the firmware for each board, and the STM32F405 with its real-board logger
 /// too), and on thumbv7m (no FPU) for core-math's fixed-point backend; then, on each
 /// board's QEMU machine, the hil-tests in the test (dev) and release profiles and the
 /// end-to-end pass test ([`e2e_test`]).
-pub fn test_target() -> Result<(), String> {
+pub fn test_target() -> Result<()> {
     let started = Instant::now();
     ensure_target_tools()?;
     // core-math with its default backends and as the lean flight build links it (the
@@ -205,16 +128,16 @@ fn cargo_command() -> Command {
 }
 
 /// Runs cargo with `args` in the workspace root; an error if it fails.
-pub(crate) fn cargo(args: &[&str]) -> Result<(), String> {
+pub(crate) fn cargo(args: &[&str]) -> Result<()> {
     eprintln!("xtask: cargo {}", args.join(" "));
     let status = cargo_command()
         .args(args)
         .status()
-        .map_err(|e| format!("cannot start cargo: {e}"))?;
+        .context("cannot start cargo")?;
     if status.success() {
         Ok(())
     } else {
-        Err(format!("`cargo {}` failed ({status})", args.join(" ")))
+        Err(anyhow!("`cargo {}` failed ({status})", args.join(" ")))
     }
 }
 
@@ -222,10 +145,11 @@ pub(crate) fn cargo(args: &[&str]) -> Result<(), String> {
 /// cargo runs QEMU without building anything else (no nested cargo). Cargo splits a
 /// runner string at spaces (and cannot merge an array into the config's string), so a
 /// binary whose path has whitespace keeps the configured `tools/qemu-runner` instead.
-fn runner_config() -> Result<Vec<String>, String> {
-    let exe =
-        std::env::current_exe().map_err(|e| format!("cannot locate the xtask binary: {e}"))?;
-    let exe = exe.to_str().ok_or("the xtask binary's path is not UTF-8")?;
+fn runner_config() -> Result<Vec<String>> {
+    let exe = std::env::current_exe().context("cannot locate the xtask binary")?;
+    let exe = exe
+        .to_str()
+        .context("the xtask binary's path is not UTF-8")?;
     if exe.chars().any(char::is_whitespace) {
         return Ok(Vec::new());
     }
@@ -244,7 +168,7 @@ fn build_board_bin(
     bin: &str,
     release: bool,
     features: &[&str],
-) -> Result<PathBuf, String> {
+) -> Result<PathBuf> {
     build_elf(board, package, bin, release, features, &[])
 }
 
@@ -256,7 +180,7 @@ pub(crate) fn build_bin_with(
     release: bool,
     features: &[&str],
     rustc_args: &[&str],
-) -> Result<PathBuf, String> {
+) -> Result<PathBuf> {
     build_elf(Board::DEFAULT, package, bin, release, features, rustc_args)
 }
 
@@ -267,7 +191,7 @@ fn build_elf(
     release: bool,
     features: &[&str],
     rustc_args: &[&str],
-) -> Result<PathBuf, String> {
+) -> Result<PathBuf> {
     let subcommand = if rustc_args.is_empty() {
         "build"
     } else {
@@ -298,9 +222,9 @@ fn build_elf(
         .args(&args)
         .stderr(std::process::Stdio::inherit())
         .output()
-        .map_err(|e| format!("cannot start cargo: {e}"))?;
+        .context("cannot start cargo")?;
     if !out.status.success() {
-        return Err(format!("building `{bin}` failed ({})", out.status));
+        bail!("building `{bin}` failed ({})", out.status);
     }
     let stdout = String::from_utf8_lossy(&out.stdout);
     let mut elf = None;
@@ -314,11 +238,11 @@ fn build_elf(
             }
         }
     }
-    elf.ok_or_else(|| format!("cargo reported no executable for `{bin}`"))
+    elf.with_context(|| format!("cargo reported no executable for `{bin}`"))
 }
 
 /// Ends the process with the firmware's exit status (0 returns normally).
-fn exit_like(status: i32) -> Result<(), String> {
+pub(super) fn exit_like(status: i32) -> Result<()> {
     if status == 0 {
         Ok(())
     } else {

@@ -1,6 +1,7 @@
 //! The host side of the checks: the twin run (the same `controller` crate, same
 //! `Session`, on the host), the downlink decoder, the reference periods.
 
+use anyhow::{anyhow, Result};
 use std::collections::BTreeMap;
 
 use controller::frame::{kind, Decoder, Event};
@@ -64,9 +65,9 @@ impl LinePeriodSink for Accept {
 }
 
 /// The controller the firmware runs (same config, same boot scene).
-pub fn new_controller() -> Result<Controller, String> {
+pub fn new_controller() -> Result<Controller> {
     Controller::new(Config::default(), Scene::paper_default())
-        .map_err(|f| format!("the default scene was refused: {}", f.name()))
+        .map_err(|f| anyhow!("the default scene was refused: {}", f.name()))
 }
 
 /// What the controller had in force at one update: the NAV frame and the ground heights.
@@ -79,7 +80,7 @@ pub struct InForce {
 /// A host run of `bytes` through a `Session`, as the firmware does, byte by byte.
 /// Also returns the NAV frame and terrain in force at each update (the inputs of the
 /// reference check).
-pub fn twin(bytes: &[u8]) -> Result<(Downlink, BTreeMap<u64, InForce>), String> {
+pub fn twin(bytes: &[u8]) -> Result<(Downlink, BTreeMap<u64, InForce>)> {
     let mut session = Session::new(new_controller()?);
     let mut out = Vec::new();
     let mut inputs = BTreeMap::new();

@@ -1,5 +1,6 @@
 //! Making sure the target toolchain and QEMU are there, installing them where we can.
 
+use anyhow::{anyhow, bail, Context, Result};
 use std::process::{Command, Stdio};
 
 use super::board::Board;
@@ -8,14 +9,14 @@ use super::TARGET;
 /// The Rust target (rustup) and qemu-system-arm with every board's machine. Installs
 /// the target with rustup and QEMU with apt-get when running as root; otherwise an
 /// error that says what to install.
-pub fn ensure_target_tools() -> Result<(), String> {
+pub fn ensure_target_tools() -> Result<()> {
     ensure_rust_target(TARGET)?;
     // The fixed-point backend must build for FPU-less cores (docs/fixed-point.md).
     ensure_rust_target(super::NO_FPU_TARGET)?;
     ensure_qemu()
 }
 
-fn ensure_rust_target(target: &str) -> Result<(), String> {
+fn ensure_rust_target(target: &str) -> Result<()> {
     let installed = Command::new("rustup")
         .args(["target", "list", "--installed"])
         .output();
@@ -31,11 +32,11 @@ fn ensure_rust_target(target: &str) -> Result<(), String> {
             let status = Command::new("rustup")
                 .args(["target", "add", target])
                 .status()
-                .map_err(|e| format!("cannot run rustup: {e}"))?;
+                .context("cannot run rustup")?;
             if status.success() {
                 Ok(())
             } else {
-                Err(format!("`rustup target add {target}` failed ({status})"))
+                Err(anyhow!("`rustup target add {target}` failed ({status})"))
             }
         }
         _ => {
@@ -51,7 +52,7 @@ fn ensure_rust_target(target: &str) -> Result<(), String> {
             if has_core {
                 Ok(())
             } else {
-                Err(format!(
+                Err(anyhow!(
                     "no rustup, and the toolchain lacks {target}: install rustup and run `rustup target add {target}`"
                 ))
             }
@@ -77,42 +78,42 @@ fn is_root() -> bool {
 }
 
 /// Installs Debian packages when root, else explains what to install.
-pub(super) fn apt_install(packages: &[&str], why: &str) -> Result<(), String> {
+pub(super) fn apt_install(packages: &[&str], why: &str) -> Result<()> {
     let list = packages.join(" ");
     if !is_root() || !have("apt-get") {
-        return Err(format!(
+        bail!(
             "{why} is missing: install it (Debian/Ubuntu: `sudo apt-get install -y {list}`) and retry"
-        ));
+        );
     }
     eprintln!("xtask: {why} is missing; apt-get update && apt-get install -y {list}");
     let update = Command::new("apt-get")
         .args(["update"])
         .status()
-        .map_err(|e| format!("cannot run apt-get: {e}"))?;
+        .context("cannot run apt-get")?;
     if !update.success() {
-        return Err(format!("`apt-get update` failed ({update})"));
+        bail!("`apt-get update` failed ({update})");
     }
     let install = Command::new("apt-get")
         .args(["install", "-y"])
         .args(packages)
         .env("DEBIAN_FRONTEND", "noninteractive")
         .status()
-        .map_err(|e| format!("cannot run apt-get: {e}"))?;
+        .context("cannot run apt-get")?;
     if install.success() {
         Ok(())
     } else {
-        Err(format!("`apt-get install -y {list}` failed ({install})"))
+        Err(anyhow!("`apt-get install -y {list}` failed ({install})"))
     }
 }
 
-fn ensure_qemu() -> Result<(), String> {
-    if !have(super::qemu::QEMU) {
+fn ensure_qemu() -> Result<()> {
+    if !have(super::runner::QEMU) {
         apt_install(&["qemu-system-arm"], "qemu-system-arm")?;
     }
-    let machines = Command::new(super::qemu::QEMU)
+    let machines = Command::new(super::runner::QEMU)
         .args(["-machine", "help"])
         .output()
-        .map_err(|e| format!("cannot run {}: {e}", super::qemu::QEMU))?;
+        .with_context(|| format!("cannot run {}", super::runner::QEMU))?;
     let listed = String::from_utf8_lossy(&machines.stdout);
     let missing: Vec<&str> = Board::ALL
         .iter()
@@ -126,9 +127,9 @@ fn ensure_qemu() -> Result<(), String> {
     if missing.is_empty() {
         Ok(())
     } else {
-        Err(format!(
+        Err(anyhow!(
             "{} lacks the machine(s) {}: QEMU 6.0 or newer is needed",
-            super::qemu::QEMU,
+            super::runner::QEMU,
             missing.join(", ")
         ))
     }

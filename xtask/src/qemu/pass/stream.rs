@@ -5,11 +5,13 @@
 //! Every item knows whether it is an injected fault: the firmware gets all of them, the
 //! host twin only the others ("the stream with the injected faulty frames removed").
 
+use anyhow::{anyhow, bail, Context, Result};
 use controller::frame::{encode, kind, MAX_FRAME, SYNC};
 use controller::nav::Nav;
 use controller::Fault;
 
 use controller::EARTH;
+use core_math::vector::{norm, scale};
 
 use super::scenario::{schedule, terrain_payload, us, FaultSpec, Pass, SlotKind};
 
@@ -74,7 +76,7 @@ impl Frames {
 }
 
 /// Builds the stream of `pass`.
-pub fn build(pass: &Pass) -> Result<Stream, String> {
+pub fn build(pass: &Pass) -> Result<Stream> {
     // The pass's time line (the same the player built it on): NAV samples, TERRAIN
     // uploads, TIME ticks in between.
     let nav_us: Vec<u64> = pass.samples.iter().map(|s| s.t_us).collect();
@@ -91,14 +93,14 @@ pub fn build(pass: &Pass) -> Result<Stream, String> {
             SlotKind::Nav => {
                 let s = navs
                     .next()
-                    .ok_or("the schedule has more NAV slots than samples")?;
+                    .context("the schedule has more NAV slots than samples")?;
                 nav_item.insert(s.t_us, items.len());
                 frames.nav(s.t_us, &s.nav)
             }
             SlotKind::Terrain => {
                 let (_, heights) = uploads
                     .next()
-                    .ok_or("the schedule has more TERRAIN slots than uploads")?;
+                    .context("the schedule has more TERRAIN slots than uploads")?;
                 frames.frame(kind::TERRAIN, t, &terrain_payload(heights))
             }
             SlotKind::Time => frames.frame(kind::TIME, t, &[]),
@@ -109,20 +111,20 @@ pub fn build(pass: &Pass) -> Result<Stream, String> {
     let mut injected = Vec::new();
     // Extra items, inserted after building (index to insert before, item).
     let mut extra: Vec<(usize, Item)> = Vec::new();
-    let item_at = |t_s: f64| -> Result<usize, String> {
+    let item_at = |t_s: f64| -> Result<usize> {
         nav_item
             .get(&us(t_s))
             .copied()
-            .ok_or_else(|| format!("no NAV frame at {t_s} s to inject a fault into"))
+            .with_context(|| format!("no NAV frame at {t_s} s to inject a fault into"))
     };
     // The first item whose frame is time-tagged after `t_us` (extra frames go before it).
     let times: Vec<u64> = slots.iter().map(|s| s.0).collect();
     let after = |t_us: u64| times.iter().position(|&t| t > t_us).unwrap_or(times.len());
-    let truth_nav = |t_s: f64| -> Result<Nav, String> {
+    let truth_nav = |t_s: f64| -> Result<Nav> {
         pass.truth
             .agile()
             .map(|a| a.nav(t_s))
-            .ok_or_else(|| "faults are injected into the built-in passes only".to_string())
+            .context("faults are injected into the built-in passes only")
     };
     for (k, f) in pass.faults.iter().enumerate() {
         let expect = match *f {
@@ -164,9 +166,7 @@ pub fn build(pass: &Pass) -> Result<Stream, String> {
             FaultSpec::Altitude { t_s, altitude_m } => {
                 let mut nav = truth_nav(t_s)?;
                 let r = nav.state.position_m;
-                let norm = (r[0] * r[0] + r[1] * r[1] + r[2] * r[2]).sqrt();
-                let scale = (EARTH.a_m + altitude_m) / norm;
-                nav.state.position_m = r.map(|x| x * scale);
+                nav.state.position_m = scale((EARTH.a_m + altitude_m) / norm(r), r);
                 let bytes = frames.nav(us(t_s), &nav);
                 extra.push(injected_item(after(us(t_s)), bytes, k));
                 Some(Fault::OutOfRange)
@@ -208,7 +208,7 @@ pub fn build(pass: &Pass) -> Result<Stream, String> {
             let mut p = vec![0u8; controller::frame::MAX_PAYLOAD];
             let n = controller::Scene::paper_default()
                 .encode(&mut p)
-                .ok_or("the default scene does not fit a SCENE frame")?;
+                .context("the default scene does not fit a SCENE frame")?;
             let bytes = frames.frame(kind::SCENE, t0 + 1, &p[..n]);
             extra.push((1, Item { bytes, fault: None }));
         }
@@ -245,7 +245,7 @@ fn has_sync(bytes: &[u8]) -> bool {
 /// The frame with one payload bit flipped: the first bit whose flip leaves no sync word
 /// inside the frame, so that the decoder sees exactly one bad CRC and then skips the
 /// frame's remains.
-fn bit_flip(frame: &[u8]) -> Result<Vec<u8>, String> {
+fn bit_flip(frame: &[u8]) -> Result<Vec<u8>> {
     let header = controller::frame::HEADER_LEN;
     for bit in 0..(frame.len() - header - 2) * 8 {
         let mut f = frame.to_vec();
@@ -254,14 +254,14 @@ fn bit_flip(frame: &[u8]) -> Result<Vec<u8>, String> {
             return Ok(f);
         }
     }
-    Err("no bit of the frame could be flipped cleanly".into())
+    Err(anyhow!("no bit of the frame could be flipped cleanly"))
 }
 
 /// The frame cut after its header and 20 payload bytes (no sync word in the remains).
-fn truncate(frame: &[u8]) -> Result<Vec<u8>, String> {
+fn truncate(frame: &[u8]) -> Result<Vec<u8>> {
     let f = frame[..controller::frame::HEADER_LEN + 20].to_vec();
     if has_sync(&f[1..]) {
-        return Err("the truncated frame holds a sync word: pick another instant".into());
+        bail!("the truncated frame holds a sync word: pick another instant");
     }
     Ok(f)
 }

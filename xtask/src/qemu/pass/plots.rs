@@ -1,6 +1,7 @@
 //! The plots of a played pass, from what the firmware sent (and the terrain the pass
 //! uploaded): drift, MTF and the yaw request per segment over time, and the terrain.
 
+use anyhow::{Context, Result};
 use std::collections::BTreeMap;
 use std::path::Path;
 
@@ -26,12 +27,7 @@ fn per_segment(
     series
 }
 
-fn save(
-    pass: &Pass,
-    plot: Plot,
-    series: BTreeMap<u8, Vec<(f64, f64)>>,
-    path: &Path,
-) -> Result<(), String> {
+fn save(pass: &Pass, plot: Plot, series: BTreeMap<u8, Vec<(f64, f64)>>, path: &Path) -> Result<()> {
     let mut plot = plot
         .legend(Legend::TopRight)
         .x_range(0.0, (pass.end_us as f64 * 1e-6).max(1.0))
@@ -43,8 +39,8 @@ fn save(
 }
 
 /// Writes drift.png, mtf.png, terrain.png and yaw.png into `dir`.
-pub fn pass_plots(pass: &Pass, firmware: &Downlink, dir: &Path) -> Result<(), String> {
-    std::fs::create_dir_all(dir).map_err(|e| format!("creating {}: {e}", dir.display()))?;
+pub fn pass_plots(pass: &Pass, firmware: &Downlink, dir: &Path) -> Result<()> {
+    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     save(
         pass,
         Plot::new(

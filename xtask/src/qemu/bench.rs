@@ -6,6 +6,7 @@
 //! with the `BENCH <label>` lines the binary logs. Counts are exact and repeatable;
 //! they are instructions, not cycles (QEMU models no pipeline, no wait states).
 
+use anyhow::{anyhow, bail, Context, Result};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -13,7 +14,7 @@ use object::{Object, ObjectSymbol};
 
 use super::board::{Board, BoardArg};
 use super::profile;
-use super::{build_board_bin, ensure_target_tools, qemu, tools, workspace_root};
+use super::{build_board_bin, ensure_target_tools, runner, tools, workspace_root};
 
 const PLUGIN_SOURCE: &str = "tools/qemu-stopwatch/stopwatch.c";
 const LABEL_PREFIX: &str = "BENCH ";
@@ -54,7 +55,7 @@ pub struct BenchArgs {
 
 /// `cargo xtask bench`: measure on the board's QEMU machine, then print every region
 /// (and, with `--profile`, where one region's instructions go).
-pub fn bench(args: &BenchArgs) -> Result<(), String> {
+pub fn bench(args: &BenchArgs) -> Result<()> {
     let board = args.board.board;
     let counts = measure_on(board, false, None)?;
     let overhead = counts.overhead;
@@ -71,14 +72,14 @@ pub fn bench(args: &BenchArgs) -> Result<(), String> {
             .filter(|&i| counts.regions[i].0.contains(text.as_str()))
             .collect();
         let [region] = matching[..] else {
-            return Err(format!(
+            bail!(
                 "--profile `{text}` matches {} regions; give text that one label alone contains",
                 matching.len()
-            ));
+            );
         };
         let profiled = measure_on(board, true, Some(region))?;
         if profiled.regions.get(region) != counts.regions.get(region) {
-            return Err("the profiled run counted the region differently".into());
+            bail!("the profiled run counted the region differently");
         }
         let (label, raw) = &counts.regions[region];
         println!();
@@ -91,23 +92,22 @@ pub fn bench(args: &BenchArgs) -> Result<(), String> {
 /// Builds the bench firmware and the plugin, runs the firmware under QEMU and returns
 /// the parsed counts. The decoded defmt log is echoed as the firmware runs, to stdout or,
 /// with `log_to_stderr`, to stderr.
-pub fn measure(log_to_stderr: bool) -> Result<BenchCounts, String> {
+pub fn measure(log_to_stderr: bool) -> Result<BenchCounts> {
     measure_on(Board::DEFAULT, log_to_stderr, None)
 }
 
 /// [`measure`] on `board`; with `profile`, the per-address counts of that region (its
 /// index in the run, 0 being the empty region) too.
-fn measure_on(
-    board: Board,
-    log_to_stderr: bool,
-    profile: Option<usize>,
-) -> Result<BenchCounts, String> {
+fn measure_on(board: Board, log_to_stderr: bool, profile: Option<usize>) -> Result<BenchCounts> {
     ensure_target_tools()?;
     if !tools::have("gcc") {
         tools::apt_install(&["gcc", "libc6-dev"], "gcc (to build the QEMU plugin)")?;
     }
     let elf = build_board_bin(board, "firmware", "bench", true, &["bench"])?;
-    let dir = elf.parent().ok_or("bench ELF has no folder")?.to_path_buf();
+    let dir = elf
+        .parent()
+        .context("bench ELF has no folder")?
+        .to_path_buf();
     let plugin = build_plugin(&dir)?;
     let (start, stop) = marker_addresses(&elf)?;
     let counts_path = dir.join("bench-counts.txt");
@@ -123,28 +123,25 @@ fn measure_on(
         plugin_args += &format!(",profile={region},pcs={}", pcs_path.display());
     }
 
-    let options = qemu::Options {
+    let options = runner::Options {
         extra_args: vec!["-plugin".into(), plugin_args],
         capture: true,
         serial: None,
         log_to_stderr,
         link_ready: None,
     };
-    let outcome = qemu::run_elf(&elf, &options)?;
+    let outcome = runner::run_elf(&elf, &options)?;
     if outcome.status != 0 {
-        return Err(format!(
-            "the bench firmware exited with status {}",
-            outcome.status
-        ));
+        bail!("the bench firmware exited with status {}", outcome.status);
     }
     let counts = std::fs::read_to_string(&counts_path)
-        .map_err(|e| format!("no counts from the plugin ({}): {e}", counts_path.display()))?;
+        .with_context(|| format!("no counts from the plugin ({})", counts_path.display()))?;
     let counts: Vec<u64> = counts
         .lines()
         .map(|l| {
             l.trim()
                 .parse::<u64>()
-                .map_err(|_| format!("bad plugin output line `{l}`"))
+                .map_err(|_| anyhow!("bad plugin output line `{l}`"))
         })
         .collect::<Result<_, _>>()?;
     let labels: Vec<&str> = outcome
@@ -153,11 +150,11 @@ fn measure_on(
         .filter_map(|m| m.strip_prefix(LABEL_PREFIX))
         .collect();
     if labels.len() != counts.len() || counts.is_empty() {
-        return Err(format!(
+        bail!(
             "{} regions logged but {} counts measured",
             labels.len(),
             counts.len()
-        ));
+        );
     }
     let pc_counts = match profile {
         Some(_) => profile::read_counts(&pcs_path)?,
@@ -173,7 +170,7 @@ fn measure_on(
 }
 
 /// Compiles the plugin next to the bench ELF (a few hundred ms with gcc).
-fn build_plugin(dir: &Path) -> Result<PathBuf, String> {
+fn build_plugin(dir: &Path) -> Result<PathBuf> {
     let source = workspace_root().join(PLUGIN_SOURCE);
     let out = dir.join("libstopwatch.so");
     let status = Command::new("gcc")
@@ -183,11 +180,11 @@ fn build_plugin(dir: &Path) -> Result<PathBuf, String> {
         .arg(&out)
         .arg(&source)
         .status()
-        .map_err(|e| format!("cannot run gcc: {e}"))?;
+        .context("cannot run gcc")?;
     if status.success() {
         Ok(out)
     } else {
-        Err(format!(
+        Err(anyhow!(
             "building the QEMU plugin {} failed ({status})",
             source.display()
         ))
@@ -195,21 +192,21 @@ fn build_plugin(dir: &Path) -> Result<PathBuf, String> {
 }
 
 /// Addresses of the first instructions of the two markers (Thumb bit cleared).
-fn marker_addresses(elf: &Path) -> Result<(u64, u64), String> {
-    let bytes = std::fs::read(elf).map_err(|e| format!("cannot read {}: {e}", elf.display()))?;
+fn marker_addresses(elf: &Path) -> Result<(u64, u64)> {
+    let bytes = std::fs::read(elf).with_context(|| format!("cannot read {}", elf.display()))?;
     let file =
-        object::File::parse(&*bytes).map_err(|e| format!("cannot parse {}: {e}", elf.display()))?;
+        object::File::parse(&*bytes).with_context(|| format!("cannot parse {}", elf.display()))?;
     let find = |name: &str| {
         file.symbols()
             .find(|s| s.name() == Ok(name))
             .map(|s| s.address() & !1)
-            .ok_or_else(|| format!("no symbol `{name}` in {}", elf.display()))
+            .with_context(|| format!("no symbol `{name}` in {}", elf.display()))
     };
     Ok((find("bench_start")?, find("bench_stop")?))
 }
 
 fn qemu_version() -> String {
-    Command::new(qemu::QEMU)
+    Command::new(runner::QEMU)
         .arg("--version")
         .output()
         .ok()

@@ -2,6 +2,7 @@
 //! the cargo feature that selects one, the QEMU machine that emulates it, the probe-rs
 //! chip of the real part; which board an ELF was linked for; and `cargo xtask size`.
 
+use anyhow::{anyhow, Context, Result};
 use std::path::Path;
 
 use object::{Object, ObjectSection, ObjectSymbol};
@@ -74,8 +75,8 @@ impl Board {
     }
 
     /// The board `elf` was linked for, from its symbol table.
-    pub fn of_elf(elf: &[u8]) -> Result<Board, String> {
-        let file = object::File::parse(elf).map_err(|e| format!("not an ELF file: {e}"))?;
+    pub fn of_elf(elf: &[u8]) -> Result<Board> {
+        let file = object::File::parse(elf).context("not an ELF file")?;
         let found: Vec<Board> = Board::ALL
             .into_iter()
             .filter(|b| {
@@ -85,11 +86,11 @@ impl Board {
             .collect();
         match found.as_slice() {
             [board] => Ok(*board),
-            [] => Err(format!(
+            [] => Err(anyhow!(
                 "the ELF names no board (no symbol __tdi_board_*; boards: {})",
                 names()
             )),
-            _ => Err("the ELF names several boards".into()),
+            _ => Err(anyhow!("the ELF names several boards")),
         }
     }
 }
@@ -114,7 +115,7 @@ pub struct SizeArgs {
 /// `cargo xtask size`: the release flight binary of each board (or of the one named):
 /// flash (every section loaded from flash: vector table, code, constants, `.data`'s
 /// initial image) and static RAM.
-pub fn size(args: &SizeArgs) -> Result<(), String> {
+pub fn size(args: &SizeArgs) -> Result<()> {
     let boards = match args.board {
         Some(board) => vec![board],
         None => Board::ALL.to_vec(),
@@ -133,10 +134,10 @@ pub fn size(args: &SizeArgs) -> Result<(), String> {
     Ok(())
 }
 
-fn size_line(board: Board, elf: &Path) -> Result<String, String> {
+fn size_line(board: Board, elf: &Path) -> Result<String> {
     let flash = crate::footprint::flash_bytes(elf)?;
-    let bytes = std::fs::read(elf).map_err(|e| format!("reading {}: {e}", elf.display()))?;
-    let file = object::File::parse(&*bytes).map_err(|e| format!("{}: {e}", elf.display()))?;
+    let bytes = std::fs::read(elf).with_context(|| format!("reading {}", elf.display()))?;
+    let file = object::File::parse(&*bytes).with_context(|| format!("{}", elf.display()))?;
     let ram: Vec<String> = RAM_SECTIONS
         .iter()
         .map(|name| {

@@ -4,8 +4,11 @@
 //! (closed loop through a host run of the same controller); a user's pass comes from a
 //! CSV file.
 
+use anyhow::{anyhow, bail, Context, Result};
 use controller::nav::{Attitude, Nav};
 use controller::EARTH;
+use core_math::earth::kepler::Kepler;
+use core_math::vector::{add, dot, scale};
 use core_math::{StateVector, GM_M3_S2};
 
 use crate::csv::Table;
@@ -32,7 +35,7 @@ pub struct J2Orbit {
 }
 
 fn accel(r: [f64; 3]) -> [f64; 3] {
-    let r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+    let r2 = dot(r, r);
     let rn = r2.sqrt();
     let mu_r3 = GM_M3_S2 / (r2 * rn);
     let re = EARTH.a_m;
@@ -46,12 +49,13 @@ fn accel(r: [f64; 3]) -> [f64; 3] {
 }
 
 fn rk4(s: &StateVector, h: f64) -> StateVector {
-    let add = |a: [f64; 3], b: [f64; 3], k: f64| std::array::from_fn(|i| a[i] + k * b[i]);
+    // a + k b
+    let step = |a, b, k| add(a, scale(k, b));
     let (r, v) = (s.position_m, s.velocity_mps);
     let (k1r, k1v) = (v, accel(r));
-    let (k2r, k2v) = (add(v, k1v, h / 2.0), accel(add(r, k1r, h / 2.0)));
-    let (k3r, k3v) = (add(v, k2v, h / 2.0), accel(add(r, k2r, h / 2.0)));
-    let (k4r, k4v) = (add(v, k3v, h), accel(add(r, k3r, h)));
+    let (k2r, k2v) = (step(v, k1v, h / 2.0), accel(step(r, k1r, h / 2.0)));
+    let (k3r, k3v) = (step(v, k2v, h / 2.0), accel(step(r, k2r, h / 2.0)));
+    let (k4r, k4v) = (step(v, k3v, h), accel(step(r, k3r, h)));
     StateVector {
         position_m: std::array::from_fn(|i| {
             r[i] + h / 6.0 * (k1r[i] + 2.0 * k2r[i] + 2.0 * k3r[i] + k4r[i])
@@ -114,8 +118,7 @@ impl J2Orbit {
     /// Eccentricity of the osculating two-body orbit at `t_s` (for the pass line).
     pub fn eccentricity(&self, t_s: f64) -> f64 {
         let s = self.state(t_s);
-        core_math::earth::kepler::Kepler::new(s.position_m, s.velocity_mps, GM_M3_S2)
-            .map_or(f64::NAN, |k| k.eccentricity())
+        Kepler::new(s.position_m, s.velocity_mps, GM_M3_S2).map_or(f64::NAN, |k| k.eccentricity())
     }
 }
 
@@ -468,7 +471,7 @@ pub struct Manoeuvres {
 /// NAV frame reports the yaw and rate it flies. The host run sees exactly the clean
 /// stream the firmware will see (the injected faults change no output, which the pass
 /// checks), so its requests are the firmware's.
-pub fn build(m: Manoeuvres, tick_us: u64) -> Result<Pass, String> {
+pub fn build(m: Manoeuvres, tick_us: u64) -> Result<Pass> {
     use controller::frame::{encode, kind, MAX_FRAME};
     let end_us = us(m.duration_s);
     let in_gap = |t_us: u64| {
@@ -494,7 +497,7 @@ pub fn build(m: Manoeuvres, tick_us: u64) -> Result<Pass, String> {
         segments: usize::from(scene.count),
     };
     let controller = controller::Controller::new(controller::Config::default(), scene)
-        .map_err(|f| format!("the default scene was refused: {}", f.name()))?;
+        .map_err(|f| anyhow!("the default scene was refused: {}", f.name()))?;
     let mut session = controller::session::Session::new(controller);
     let mut sequence = 0u16;
     let mut feed =
@@ -523,7 +526,7 @@ pub fn build(m: Manoeuvres, tick_us: u64) -> Result<Pass, String> {
         f64::from(
             probe
                 .yaw_request_rad()
-                .ok_or("no yaw request at the start of the pass")?,
+                .context("no yaw request at the start of the pass")?,
         )
     };
     truth.yaw.push((0, target_rad, 0.0));
@@ -619,7 +622,7 @@ fn deg(corners: &[(f64, f64)]) -> Profile {
 /// reverse it.) Faults spread over it, none at a corner of a profile (a lost frame there
 /// would leave the controller extrapolating the old rate, which is the telemetry's loss,
 /// not an error).
-pub fn default_pass(tick_us: u64) -> Result<Pass, String> {
+pub fn default_pass(tick_us: u64) -> Result<Pass> {
     let mut faults = vec![
         FaultSpec::BitFlip { t_s: 30.0 },
         FaultSpec::BitFlip { t_s: 70.5 },
@@ -667,7 +670,7 @@ pub fn default_pass(tick_us: u64) -> Result<Pass, String> {
 
 /// The end-to-end test's pass: one minute, roll 0 -> 20 deg at 1.25 deg/s, then pitch
 /// 0 -> 5 deg at 0.2 deg/s, a ridge at 40 s, every kind of fault.
-pub fn short_pass(tick_us: u64) -> Result<Pass, String> {
+pub fn short_pass(tick_us: u64) -> Result<Pass> {
     let mut faults = vec![
         FaultSpec::BitFlip { t_s: 5.0 },
         FaultSpec::Truncate { t_s: 8.0 },
@@ -731,25 +734,25 @@ pub const CSV_COLUMNS: [&str; 13] = [
 
 /// Reads a telemetry CSV file (header naming [`CSV_COLUMNS`] in any order, `#` lines
 /// ignored); the rows are sent in file order.
-pub fn from_csv(path: &std::path::Path, tick_us: u64) -> Result<Pass, String> {
+pub fn from_csv(path: &std::path::Path, tick_us: u64) -> Result<Pass> {
     let text = std::fs::read_to_string(path)
-        .map_err(|e| format!("cannot read telemetry {}: {e}", path.display()))?;
+        .with_context(|| format!("cannot read telemetry {}", path.display()))?;
     let text: String = text
         .lines()
         .filter(|l| !l.trim_start().starts_with('#'))
         .map(|l| format!("{l}\n"))
         .collect();
-    let table = Table::parse(&text).map_err(|e| format!("{}: {e}", path.display()))?;
+    let table = Table::parse(&text).with_context(|| format!("{}", path.display()))?;
     let cols = table.columns(&CSV_COLUMNS)?;
     let mut samples = Vec::with_capacity(table.rows.len());
     for (i, row) in table.rows.iter().enumerate() {
         let line = i + 2;
-        let field = |k: usize| -> Result<f64, String> {
+        let field = |k: usize| -> Result<f64> {
             let text = row
                 .get(cols[k])
-                .ok_or_else(|| format!("{}: line {line}: too few fields", path.display()))?;
+                .with_context(|| format!("{}: line {line}: too few fields", path.display()))?;
             text.parse::<f64>().map_err(|_| {
-                format!(
+                anyhow!(
                     "{}: line {line}: `{text}` is not a number ({})",
                     path.display(),
                     CSV_COLUMNS[k]
@@ -758,10 +761,7 @@ pub fn from_csv(path: &std::path::Path, tick_us: u64) -> Result<Pass, String> {
         };
         let t_s = field(0)?;
         if !(0.0..1e9).contains(&t_s) {
-            return Err(format!(
-                "{}: line {line}: time {t_s} s out of range",
-                path.display()
-            ));
+            bail!("{}: line {line}: time {t_s} s out of range", path.display());
         }
         let v = |k: usize| field(k);
         samples.push(Sample {
@@ -786,7 +786,7 @@ pub fn from_csv(path: &std::path::Path, tick_us: u64) -> Result<Pass, String> {
         .iter()
         .map(|s| s.t_us)
         .max()
-        .ok_or_else(|| format!("{}: no telemetry rows", path.display()))?;
+        .with_context(|| format!("{}: no telemetry rows", path.display()))?;
     Ok(Pass {
         name: format!("telemetry from {}", path.display()),
         samples,
@@ -799,7 +799,7 @@ pub fn from_csv(path: &std::path::Path, tick_us: u64) -> Result<Pass, String> {
 }
 
 /// Writes the pass's NAV samples as a telemetry CSV file.
-pub fn to_csv(pass: &Pass, path: &std::path::Path) -> Result<(), String> {
+pub fn to_csv(pass: &Pass, path: &std::path::Path) -> Result<()> {
     let preamble = format!("# {} (see docs/telemetry.md)\n", pass.name);
     let mut out = crate::csv::Writer::new(&preamble, &CSV_COLUMNS)?;
     for s in &pass.samples {
@@ -821,5 +821,5 @@ pub fn to_csv(pass: &Pass, path: &std::path::Path) -> Result<(), String> {
         let t = (s.t_us as f64 * 1e-6).to_string();
         out.row(&[[t].as_slice(), &state, &attitude].concat())?;
     }
-    std::fs::write(path, out.into_bytes()?).map_err(|e| format!("writing {}: {e}", path.display()))
+    std::fs::write(path, out.into_bytes()?).with_context(|| format!("writing {}", path.display()))
 }

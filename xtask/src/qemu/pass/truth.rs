@@ -8,11 +8,12 @@
 //! paper's model: today's round Earth (R = 6 371 km), roll only, circular orbit from
 //! the state, period from |v_P|, the same pixels.
 
+use anyhow::{anyhow, Result};
 use controller::golden::{self, NavInput};
 use controller::Controller;
 use core_math::earth::{Attitude, EarthGeometry};
 use core_math::sphere::{Geometry, OrbitState, Reference};
-use core_math::{Backend, EARTH_RATE_RAD_S};
+use core_math::{Backend, EarthCamera, EarthReference, StateVector, EARTH_RATE_RAD_S};
 
 use super::check::Downlink;
 use super::scenario::AgileTruth;
@@ -44,8 +45,8 @@ pub struct Report {
     holds: usize,
 }
 
-fn drift(g: &EarthGeometry<f64>, camera: &core_math::EarthCamera, n: f64) -> Option<f64> {
-    core_math::EarthReference
+fn drift(g: &EarthGeometry<f64>, camera: &EarthCamera, n: f64) -> Option<f64> {
+    EarthReference
         .evaluate(camera, g, n)
         .ok()
         .map(|m| (m.v2_mps / m.v1_mps).atan())
@@ -53,7 +54,7 @@ fn drift(g: &EarthGeometry<f64>, camera: &core_math::EarthCamera, n: f64) -> Opt
 
 /// The geometry flown over ground `h_m`, and the same with the yaw left at zero.
 fn flown_and_unsteered(
-    state: core_math::StateVector,
+    state: StateVector,
     attitude: Attitude<f64>,
     h_m: f32,
 ) -> (EarthGeometry<f64>, EarthGeometry<f64>) {
@@ -76,11 +77,7 @@ fn flown_and_unsteered(
 }
 
 /// Every update of the firmware's downlink with fresh periods against the truth.
-pub fn check(
-    truth: &AgileTruth,
-    firmware: &Downlink,
-    controller: &Controller,
-) -> Result<Report, String> {
+pub fn check(truth: &AgileTruth, firmware: &Downlink, controller: &Controller) -> Result<Report> {
     let scene = controller.scene();
     let plan = controller.plan();
     let mut r = Report {
@@ -107,10 +104,10 @@ pub fn check(
             .iter()
             .map(|s| Reference.pixel(&scene.camera, f64::from(s.px)))
             .collect::<Result<Vec<_>, _>>()
-            .map_err(|e| e.name().to_string())?;
+            .map_err(|e| anyhow!(e.name()))?;
         paper_pixels.insert(seg.index, pixels);
     }
-    let boresight = core_math::EarthCamera {
+    let boresight = EarthCamera {
         p1_m: 0.0,
         ..scene.earth_camera(&scene.segments[0])
     };
@@ -141,9 +138,9 @@ pub fn check(
             },
             t_us,
         )
-        .map_err(|e| format!("truth at {t_s} s: {}", e.name()))?;
+        .map_err(|e| anyhow!("truth at {t_s} s: {}", e.name()))?;
         let orbit = OrbitState::from_state(&state, PAPER_EARTH_RADIUS_M)
-            .map_err(|e| format!("paper model at {t_s} s: {}", e.name()))?;
+            .map_err(|e| anyhow!("paper model at {t_s} s: {}", e.name()))?;
         let paper = Geometry {
             roll_rad: attitude.roll_rad,
             inclination_rad: orbit.inclination_rad,

@@ -10,6 +10,7 @@
 //! written), and "inclusive", by every function on the address's inline stack (what a
 //! call costs with everything it inlined).
 
+use anyhow::{anyhow, Context, Result};
 use std::borrow::Cow;
 use std::collections::HashMap;
 use std::path::Path;
@@ -20,12 +21,12 @@ use object::{Object, ObjectSection};
 const ROWS: usize = 25;
 
 /// The plugin's `pcs=` file: "ADDR COUNT" lines (hex, decimal).
-pub fn read_counts(path: &Path) -> Result<Vec<(u64, u64)>, String> {
+pub fn read_counts(path: &Path) -> Result<Vec<(u64, u64)>> {
     let text = std::fs::read_to_string(path)
-        .map_err(|e| format!("no profile from the plugin ({}): {e}", path.display()))?;
+        .with_context(|| format!("no profile from the plugin ({})", path.display()))?;
     text.lines()
         .map(|line| {
-            let bad = || format!("bad profile line `{line}`");
+            let bad = || anyhow!("bad profile line `{line}`");
             let (addr, count) = line.split_once(' ').ok_or_else(bad)?;
             Ok((
                 u64::from_str_radix(addr, 16).map_err(|_| bad())?,
@@ -37,20 +38,20 @@ pub fn read_counts(path: &Path) -> Result<Vec<(u64, u64)>, String> {
 
 /// Prints the self and inclusive tables of `pc_counts` (the region's `raw` count, the
 /// markers' own instructions included, is the 100 %).
-pub fn print(elf: &Path, pc_counts: &[(u64, u64)], raw: u64) -> Result<(), String> {
-    let bytes = std::fs::read(elf).map_err(|e| format!("cannot read {}: {e}", elf.display()))?;
+pub fn print(elf: &Path, pc_counts: &[(u64, u64)], raw: u64) -> Result<()> {
+    let bytes = std::fs::read(elf).with_context(|| format!("cannot read {}", elf.display()))?;
     let file =
-        object::File::parse(&*bytes).map_err(|e| format!("cannot parse {}: {e}", elf.display()))?;
+        object::File::parse(&*bytes).with_context(|| format!("cannot parse {}", elf.display()))?;
     let sections = gimli::DwarfSections::load(|id| -> Result<Cow<[u8]>, gimli::Error> {
         Ok(file
             .section_by_name(id.name())
             .and_then(|s| s.uncompressed_data().ok())
             .unwrap_or(Cow::Borrowed(&[])))
     })
-    .map_err(|e| format!("DWARF of {}: {e}", elf.display()))?;
+    .with_context(|| format!("DWARF of {}", elf.display()))?;
     let dwarf = sections.borrow(|s| gimli::EndianSlice::new(s, gimli::LittleEndian));
     let context = addr2line::Context::from_dwarf(dwarf)
-        .map_err(|e| format!("DWARF of {}: {e}", elf.display()))?;
+        .with_context(|| format!("DWARF of {}", elf.display()))?;
 
     let mut own: HashMap<String, u64> = HashMap::new();
     let mut inclusive: HashMap<String, u64> = HashMap::new();

@@ -1,0 +1,181 @@
+//! What every stability map shares, whatever the model: the spec of a 2-D map of the
+//! envelope, the sweep of its cells (each the worst of a few sub-samples) over every
+//! core, the cells' lookup and their heatmaps.
+
+use crate::plot::heatmap::Heatmap;
+
+/// One 2-D map of the envelope, whose samples are points of type `P`.
+pub struct Spec<P> {
+    /// File stem under docs/stability/ and key in the document.
+    pub key: &'static str,
+    /// The map's letter in the document.
+    pub letter: &'static str,
+    pub title: &'static str,
+    pub x_label: &'static str,
+    pub y_label: &'static str,
+    pub x_range: (f64, f64),
+    pub y_range: (f64, f64),
+    /// The y coordinate is log10 of the quantity (decade ticks).
+    pub y_decades: bool,
+    /// Cells and sub-samples per cell (full run).
+    pub nx: usize,
+    pub ny: usize,
+    pub sub: usize,
+    /// The point of sub-sample `s` at (x, y); None where the map has none.
+    pub point: fn(x: f64, y: f64, s: usize) -> Option<P>,
+    /// What the other variables are, for the document.
+    pub others: &'static str,
+    /// Label of the grey cells (no sample there).
+    pub missing: &'static str,
+}
+
+/// A map cell: what it keeps of its sub-samples.
+pub trait Cell: Clone + Send {
+    type Point: Sync + 'static;
+    /// A cell with no sample yet.
+    fn empty() -> Self;
+    /// Evaluates one sub-sample and keeps what the cell keeps of it.
+    fn sample(&mut self, point: &Self::Point);
+    /// The samples it holds.
+    fn n(&self) -> u64;
+}
+
+/// A swept map: the cells, row-major from the bottom row (index iy * nx + ix).
+pub struct Map<C: Cell> {
+    pub spec: &'static Spec<C::Point>,
+    pub nx: usize,
+    pub ny: usize,
+    /// Sub-samples per cell.
+    pub sub: usize,
+    pub cells: Vec<C>,
+}
+
+impl<C: Cell> Map<C> {
+    /// Sweeps `spec` with `nx` x `ny` cells and `sub` sub-samples per cell, on every core.
+    pub fn sweep(spec: &'static Spec<C::Point>, nx: usize, ny: usize, sub: usize) -> Self {
+        let (x0, x1) = spec.x_range;
+        let (y0, y1) = spec.y_range;
+        let (dx, dy) = ((x1 - x0) / nx as f64, (y1 - y0) / ny as f64);
+        let cell = |ix: usize, iy: usize| {
+            let mut c = C::empty();
+            for s in 0..sub {
+                let (fx, fy) = jitter(s, sub);
+                let (x, y) = (x0 + (ix as f64 + fx) * dx, y0 + (iy as f64 + fy) * dy);
+                if let Some(pt) = (spec.point)(x, y, s) {
+                    c.sample(&pt);
+                }
+            }
+            c
+        };
+        Map {
+            spec,
+            nx,
+            ny,
+            sub,
+            cells: sweep_rows(nx, ny, cell),
+        }
+    }
+
+    /// Cell centre in map coordinates.
+    pub fn centre(&self, ix: usize, iy: usize) -> (f64, f64) {
+        let (x0, x1) = self.spec.x_range;
+        let (y0, y1) = self.spec.y_range;
+        (
+            x0 + (ix as f64 + 0.5) * (x1 - x0) / self.nx as f64,
+            y0 + (iy as f64 + 0.5) * (y1 - y0) / self.ny as f64,
+        )
+    }
+
+    /// One value per cell (None where the cell has no sample), for a heatmap.
+    pub fn values(&self, f: impl Fn(&C) -> f64) -> Vec<Option<f64>> {
+        self.cells
+            .iter()
+            .map(|c| if c.n() > 0 { Some(f(c)) } else { None })
+            .collect()
+    }
+
+    /// The cell (ix, iy) maximising `f` over the cells with samples.
+    pub fn argmax(&self, f: impl Fn(&C) -> f64) -> Option<(usize, usize)> {
+        (0..self.cells.len())
+            .filter(|&i| self.cells[i].n() > 0)
+            .max_by(|&a, &b| f(&self.cells[a]).total_cmp(&f(&self.cells[b])))
+            .map(|i| (i % self.nx, i / self.nx))
+    }
+
+    pub fn samples(&self) -> u64 {
+        self.cells.iter().map(C::n).sum()
+    }
+
+    /// A heatmap of `value` over the cells, titled by the map's letter, the largest
+    /// cell marked, `bound` (in plotted units) marked on the colour bar;
+    /// `z_decades`: `z_range` and the values are log10.
+    pub fn heatmap(
+        &self,
+        (title, z_label): (&str, &str),
+        (z_range, z_decades): ((f64, f64), bool),
+        value: impl Fn(&C) -> f64,
+        bound: Option<f64>,
+    ) -> Heatmap {
+        let s = self.spec;
+        let mut h = Heatmap::new(
+            &format!("{}: {title}", s.letter),
+            s.x_label,
+            s.y_label,
+            z_label,
+            (self.nx, self.ny),
+            self.values(&value),
+        )
+        .x_range(s.x_range.0, s.x_range.1)
+        .y_range(s.y_range.0, s.y_range.1)
+        .y_decades(s.y_decades)
+        .z_range(z_range.0, z_range.1)
+        .z_decades(z_decades)
+        .missing_label(s.missing);
+        if let Some(b) = bound {
+            h = h.z_mark(b);
+        }
+        if let Some((ix, iy)) = self.argmax(&value) {
+            let (x, y) = self.centre(ix, iy);
+            h = h.mark(x, y);
+        }
+        h
+    }
+}
+
+/// Sub-sample `s` of `sub`: offsets in (0, 1) within the cell, stratified in x and
+/// spread by the golden ratio in y (deterministic).
+pub fn jitter(s: usize, sub: usize) -> (f64, f64) {
+    let fx = (s as f64 + 0.5) / sub as f64;
+    let fy = (0.5 + s as f64 * 0.618_033_988_749_894_9).fract();
+    (fx, fy)
+}
+
+/// `cell(ix, iy)` over an nx x ny grid, rows spread over the available threads, in
+/// row-major order (the same result for any number of threads).
+fn sweep_rows<C: Clone + Send>(
+    nx: usize,
+    ny: usize,
+    cell: impl Fn(usize, usize) -> C + Sync,
+) -> Vec<C> {
+    let workers = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let mut rows: Vec<Vec<C>> = vec![Vec::new(); ny];
+    std::thread::scope(|scope| {
+        let handles: Vec<_> = (0..workers)
+            .map(|w| {
+                let cell = &cell;
+                scope.spawn(move || {
+                    (w..ny)
+                        .step_by(workers)
+                        .map(|iy| (iy, (0..nx).map(|ix| cell(ix, iy)).collect::<Vec<_>>()))
+                        .collect::<Vec<_>>()
+                })
+            })
+            .collect();
+        for h in handles {
+            for (iy, row) in h.join().expect("sweep worker panicked") {
+                rows[iy] = row;
+            }
+        }
+    });
+    rows.into_iter().flatten().collect()
+}
