@@ -9,6 +9,7 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod bytes;
+pub mod config;
 pub mod control;
 pub mod crc;
 pub mod fault;
@@ -21,7 +22,8 @@ pub mod report;
 pub mod scene;
 pub mod session;
 
-pub use control::{Config, Controller, LinePeriodSink, Mode, SegmentOutput, EARTH};
+pub use config::{Config, EARTH};
+pub use control::{Controller, LinePeriodSink, Mode, SegmentOutput};
 pub use fault::{Counters, Fault};
 pub use frame::{Decoder, Event, Frame, FrameError};
 pub use scene::{Scene, Terrain};

@@ -550,7 +550,7 @@ fn time_tags_at_the_end_of_the_clock_do_not_wrap_the_schedule() {
     let mut c = Controller::new(Config::default(), Scene::paper_default()).unwrap();
     let mut regs = Registers::default();
     // The largest tag the clock takes is accepted even as the first one.
-    let t = controller::control::MAX_TIME_TAG_US;
+    let t = controller::config::MAX_TIME_TAG_US;
     feed(
         &mut c,
         &nav_frame(1, t, state(I0.to_radians(), 0.3, H), roll(0.2)),

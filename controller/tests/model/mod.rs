@@ -8,7 +8,7 @@
 //! which panics on the first divergence.
 #![allow(dead_code)]
 
-use controller::control::MAX_TIME_TAG_US;
+use controller::config::MAX_TIME_TAG_US;
 use controller::frame::{
     encode, kind, Decoder, Event, FrameError, HEADER_LEN, MAX_FRAME, MAX_PAYLOAD, SYNC, VERSION,
 };
