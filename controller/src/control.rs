@@ -22,14 +22,7 @@ use crate::frame::{kind, Frame};
 use crate::nav::{attitude_at, Nav, Propagator};
 use crate::plan::{Plan, SegmentPlan, MAX_SPEED2_RATIO, MIN_SPEED2_RATIO};
 use crate::scene::{AttitudeEnvelope, Scene, Terrain, MAX_SEGMENTS};
-
-/// Where line periods go: the period registers of the camera's line clock (one per
-/// segment), in the spirit of embedded-hal: small, and the only way out.
-pub trait LinePeriodSink {
-    type Error;
-    /// Programs segment `index`'s line period, in ticks of the scene's line clock.
-    fn write_period(&mut self, index: u8, ticks: u32) -> Result<(), Self::Error>;
-}
+use crate::sink::LinePeriodSink;
 
 /// The last accepted NAV state.
 #[derive(Clone, Copy, Debug, PartialEq)]

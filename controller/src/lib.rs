@@ -21,9 +21,11 @@ pub mod plan;
 pub mod report;
 pub mod scene;
 pub mod session;
+pub mod sink;
 
 pub use config::{Config, EARTH};
-pub use control::{Controller, LinePeriodSink, Mode, SegmentOutput};
+pub use control::{Controller, Mode, SegmentOutput};
 pub use fault::{Counters, Fault};
 pub use frame::{Decoder, Event, Frame, FrameError};
 pub use scene::{Scene, Terrain};
+pub use sink::LinePeriodSink;

@@ -4,6 +4,8 @@
 
 mod common;
 
+use std::convert::Infallible;
+
 use common::{nav_frame, roll, state};
 use controller::frame::{encode, kind, Decoder, Event, MAX_FRAME};
 use controller::golden;
@@ -19,8 +21,8 @@ struct Registers {
 }
 
 impl LinePeriodSink for Registers {
-    type Error = ();
-    fn write_period(&mut self, index: u8, ticks: u32) -> Result<(), ()> {
+    type Error = Infallible;
+    fn write_period(&mut self, index: u8, ticks: u32) -> Result<(), Infallible> {
         self.writes.push((index, ticks));
         Ok(())
     }

@@ -8,6 +8,8 @@
 //! which panics on the first divergence.
 #![allow(dead_code)]
 
+use std::convert::Infallible;
+
 use controller::config::MAX_TIME_TAG_US;
 use controller::frame::{
     encode, kind, Decoder, Event, FrameError, HEADER_LEN, MAX_FRAME, MAX_PAYLOAD, SYNC, VERSION,
@@ -243,8 +245,8 @@ pub struct Recorder {
 }
 
 impl LinePeriodSink for Recorder {
-    type Error = ();
-    fn write_period(&mut self, index: u8, ticks: u32) -> Result<(), ()> {
+    type Error = Infallible;
+    fn write_period(&mut self, index: u8, ticks: u32) -> Result<(), Infallible> {
         self.writes.push((index, ticks));
         Ok(())
     }

@@ -2,6 +2,7 @@
 //! `Session`, on the host), the downlink decoder, the reference periods.
 
 use std::collections::BTreeMap;
+use std::convert::Infallible;
 
 use controller::frame::{kind, Decoder, Event};
 use controller::golden::NavInput;
@@ -57,8 +58,8 @@ impl Downlink {
 pub struct Accept;
 
 impl LinePeriodSink for Accept {
-    type Error = ();
-    fn write_period(&mut self, _index: u8, _ticks: u32) -> Result<(), ()> {
+    type Error = Infallible;
+    fn write_period(&mut self, _index: u8, _ticks: u32) -> Result<(), Infallible> {
         Ok(())
     }
 }
