@@ -1,5 +1,5 @@
-//! The line-rate controller: accepts frames, keeps the last good state, and at every
-//! update instant computes each active segment's line period, its MTF (mismatch times
+//! The line-rate controller: keeps the last good state (frames are accepted into it by
+//! [`crate::intake`]), and at every update instant computes each active segment's line period, its MTF (mismatch times
 //! drift smear) and TDI stage limit, its drift angles, and the yaw steering request,
 //! writing the periods through a [`LinePeriodSink`].
 //!
@@ -18,10 +18,9 @@ use core_math::{nearest_ticks, sinc, Backend, Real, GENERAL_F32};
 
 use crate::config::{Config, EARTH, EARTH_RATE_RAD_S, MAX_TIME_TAG_US};
 use crate::fault::{Counters, Fault};
-use crate::frame::{kind, Frame};
-use crate::nav::{attitude_at, Nav, Propagator};
-use crate::plan::{Plan, SegmentPlan, MAX_SPEED2_RATIO, MIN_SPEED2_RATIO};
-use crate::scene::{AttitudeEnvelope, Scene, Terrain, MAX_SEGMENTS};
+use crate::nav::{attitude_at, Propagator};
+use crate::plan::{Plan, SegmentPlan};
+use crate::scene::{Scene, MAX_SEGMENTS};
 use crate::sink::LinePeriodSink;
 
 /// The last accepted NAV state.
@@ -75,38 +74,38 @@ pub enum Mode {
 #[derive(Clone)]
 pub struct Controller {
     pub config: Config,
-    scene: Scene,
-    plan: Plan,
+    pub(crate) scene: Scene,
+    pub(crate) plan: Plan,
     /// Where a new scene's plan is built, in place, before it replaces `plan` (a plan is
     /// 4.7 KB: kept off the stack, docs/target.md).
-    spare_plan: Plan,
+    pub(crate) spare_plan: Plan,
     /// Ground height of each table entry (m): from the scene, then TERRAIN frames.
-    heights_m: [f32; MAX_SEGMENTS],
-    nav: Option<NavState>,
+    pub(crate) heights_m: [f32; MAX_SEGMENTS],
+    pub(crate) nav: Option<NavState>,
     /// Time tag of the last accepted frame of any kind (us).
-    last_time_us: Option<u64>,
+    pub(crate) last_time_us: Option<u64>,
     /// Time tag of the previous frame, when it was refused for its time tag alone: the
     /// first half of a re-synchronisation.
-    resync_candidate_us: Option<u64>,
-    now_us: u64,
-    next_update_us: u64,
+    pub(crate) resync_candidate_us: Option<u64>,
+    pub(crate) now_us: u64,
+    pub(crate) next_update_us: u64,
     /// The update period `next_update_us` was scheduled with (0: none yet).
-    scheduled_period_us: u64,
-    last_update_us: Option<u64>,
+    pub(crate) scheduled_period_us: u64,
+    pub(crate) last_update_us: Option<u64>,
     pub counters: Counters,
     pub last_fault: Option<Fault>,
     pub frames_accepted: u32,
     /// Re-synchronisations of the clock (each also counts as an accepted frame).
     pub time_resyncs: u32,
-    outputs: [SegmentOutput; MAX_SEGMENTS],
-    has_output: [bool; MAX_SEGMENTS],
+    pub(crate) outputs: [SegmentOutput; MAX_SEGMENTS],
+    pub(crate) has_output: [bool; MAX_SEGMENTS],
     /// The yaw correction (rad) that zeroes the drift at the array centre, from the
     /// last update; `None` when that update could not form it.
-    yaw_request_rad: Option<f32>,
+    pub(crate) yaw_request_rad: Option<f32>,
     /// Update instants run, whatever they computed: one PERIODS frame each.
     pub updates: u32,
     /// The mode an update ran in (the one its PERIODS frame reports).
-    update_mode: Mode,
+    pub(crate) update_mode: Mode,
 }
 
 impl Controller {
@@ -235,156 +234,6 @@ impl Controller {
     pub fn reject(&mut self, f: Fault) {
         self.counters.count(f);
         self.last_fault = Some(f);
-    }
-
-    /// One decoded frame. Its time tag moves the controller's clock forward.
-    ///
-    /// The time window (docs/telemetry.md "Time"): a tag is taken when it is after the
-    /// last accepted one and at most `max_time_jump_us` ahead of the clock (any tag up
-    /// to [`MAX_TIME_TAG_US`] before the first frame). A tag outside it is refused, but
-    /// remembered: if the very next frame is valid and lies after it by at most the
-    /// jump, the two agree on a new time line and the clock re-synchronises to it.
-    pub fn on_frame(&mut self, frame: &Frame<'_>) {
-        let t = frame.time_us;
-        let candidate = self.resync_candidate_us.take();
-        let resync = match self.time_check(t) {
-            Ok(()) => false,
-            Err(f) => {
-                let confirms = candidate.is_some_and(|c| {
-                    t > c && t - c <= self.config.max_time_jump_us && t <= MAX_TIME_TAG_US
-                });
-                if !confirms {
-                    // A tag the clock can never take cannot start a new time line.
-                    if t <= MAX_TIME_TAG_US {
-                        self.resync_candidate_us = Some(t);
-                    }
-                    return self.reject(f);
-                }
-                true
-            }
-        };
-        if resync {
-            // Content first: a frame refused for its content re-synchronises nothing.
-            if let Err(f) = self.check_content(frame) {
-                return self.reject(f);
-            }
-            self.resynchronise(t);
-        }
-        let result = self.apply(frame);
-        match result {
-            Ok(()) => {
-                self.frames_accepted = self.frames_accepted.saturating_add(1);
-                self.last_time_us = Some(t);
-                self.now_us = self.now_us.max(t);
-            }
-            Err(f) => self.reject(f),
-        }
-    }
-
-    /// Whether `t_us` lies in the time window.
-    fn time_check(&self, t_us: u64) -> Result<(), Fault> {
-        if t_us > MAX_TIME_TAG_US {
-            return Err(Fault::TimeJump);
-        }
-        let Some(last) = self.last_time_us else {
-            return Ok(());
-        };
-        if t_us <= last {
-            return Err(Fault::TimeWentBackwards);
-        }
-        // `now_us` <= MAX_TIME_TAG_US, but the jump is configuration: saturate.
-        if t_us > self.now_us.saturating_add(self.config.max_time_jump_us) {
-            return Err(Fault::TimeJump);
-        }
-        Ok(())
-    }
-
-    /// The checks `apply` makes, without their effect (a SCENE's plan is built in the
-    /// spare plan, which only a successful `set_scene` puts in force).
-    fn check_content(&mut self, frame: &Frame<'_>) -> Result<(), Fault> {
-        match frame.kind {
-            kind::NAV => self.check_nav(frame).map(|_| ()),
-            kind::SCENE => {
-                let scene = Scene::decode(frame.payload)?;
-                self.spare_plan.build_into(&scene, &self.config, false)
-            }
-            kind::TERRAIN => Terrain::decode(frame.payload, &self.scene).map(|_| ()),
-            kind::TIME if frame.payload.is_empty() => Ok(()),
-            kind::TIME => Err(Fault::BadLength),
-            _ => Err(Fault::UnknownKind),
-        }
-    }
-
-    /// A new time line from `t_us` on: the NAV state of the old one cannot be
-    /// propagated across the discontinuity, so it is dropped (mode waiting for NAV, the
-    /// periods in force held), and the next update is the one due at the new clock.
-    fn resynchronise(&mut self, t_us: u64) {
-        self.time_resyncs = self.time_resyncs.saturating_add(1);
-        self.last_time_us = None;
-        self.now_us = t_us;
-        self.next_update_us = 0;
-        self.nav = None;
-        self.hold_all();
-    }
-
-    fn apply(&mut self, frame: &Frame<'_>) -> Result<(), Fault> {
-        match frame.kind {
-            kind::NAV => self.accept_nav(frame),
-            kind::SCENE => self.accept_scene(frame.payload),
-            kind::TERRAIN => {
-                let terrain = Terrain::decode(frame.payload, &self.scene)?;
-                self.heights_m = terrain.heights_m;
-                Ok(())
-            }
-            kind::TIME if frame.payload.is_empty() => Ok(()),
-            kind::TIME => Err(Fault::BadLength),
-            _ => Err(Fault::UnknownKind),
-        }
-    }
-
-    fn accept_nav(&mut self, frame: &Frame<'_>) -> Result<(), Fault> {
-        self.nav = Some(self.check_nav(frame)?);
-        Ok(())
-    }
-
-    /// A NAV frame's checks: finite; an orbital frame; |r| in the altitude band and a
-    /// speed of an imaging orbit ([`MIN_SPEED2_RATIO`]..[`MAX_SPEED2_RATIO`] of the
-    /// circular speed squared) (`out_of_range`); the attitude inside the scene's
-    /// envelope at the frame's instant and propagated at its rates over every update it
-    /// may serve, one update period back (an update instant precedes the frame's tag by
-    /// up to that) to `stale_after` ahead (`attitude_outside_model`).
-    fn check_nav(&self, frame: &Frame<'_>) -> Result<NavState, Fault> {
-        let nav = Nav::decode(frame.payload)?;
-        let r_m = nav.check_state()?;
-        let (h_lo, h_hi) = self.config.altitude_range_m;
-        if !(r_m >= EARTH.b_m() + h_lo && r_m <= EARTH.a_m + h_hi) {
-            return Err(Fault::OutOfRange);
-        }
-        let v = nav.state.velocity_mps;
-        let speed2_ratio = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) * r_m / core_math::GM_M3_S2;
-        if !(MIN_SPEED2_RATIO..=MAX_SPEED2_RATIO).contains(&speed2_ratio) {
-            return Err(Fault::OutOfRange);
-        }
-        let back_s = self.config.update_period_us as f32 * 1e-6;
-        let ahead_s = self.config.stale_after_us as f32 * 1e-6;
-        if !inside_envelope(&nav.attitude, &self.plan.envelope, back_s, ahead_s) {
-            return Err(Fault::AttitudeOutsideModel);
-        }
-        // Any yaw is allowed: wrapped once here (in f64: an f32 yaw of any size), the
-        // per-update trigonometry then works near zero.
-        let yaw = libm::remainder(f64::from(nav.attitude.yaw_rad), 2.0 * core::f64::consts::PI);
-        Ok(NavState {
-            time_us: frame.time_us,
-            propagator: Propagator::new(&nav.state),
-            attitude: Attitude {
-                yaw_rad: yaw as f32,
-                ..nav.attitude
-            },
-        })
-    }
-
-    fn accept_scene(&mut self, payload: &[u8]) -> Result<(), Fault> {
-        self.set_scene(Scene::decode(payload)?)
     }
 
     /// Moves the clock to `now_us` (from the time source) and runs the update that is due,
@@ -528,7 +377,8 @@ impl Controller {
             .unwrap_or(0.0)
     }
 
-    fn hold_all(&mut self) {
+    /// Every output in force is now the last good value held over a fault.
+    pub(crate) fn hold_all(&mut self) {
         for o in self.outputs.iter_mut() {
             o.held = true;
         }
@@ -739,21 +589,6 @@ fn steered_centre(
     cos: f32,
 ) -> Result<ImageMotion<f32>, core_math::ModelError> {
     GENERAL_F32.motion_yawed(update, &seg.centre, sin, cos)
-}
-
-/// Whether `a` and its propagation at its rates `back_s` before and `ahead_s` after its
-/// instant stay inside `env` (linear in time: the ends are the extremes).
-fn inside_envelope(a: &Attitude<f32>, env: &AttitudeEnvelope, back_s: f32, ahead_s: f32) -> bool {
-    let rates = [a.roll_rate_rad_s, a.pitch_rate_rad_s, a.yaw_rate_rad_s];
-    let angle_ok = |x: f32, rate: f32, max: f32| {
-        [x, x - rate * back_s, x + rate * ahead_s]
-            .iter()
-            .all(|y| y.abs() <= max)
-    };
-    // Yaw is free (finite: `Nav::check_state`).
-    rates.iter().all(|r| r.abs() <= env.max_rate_rad_s)
-        && angle_ok(a.roll_rad, a.roll_rate_rad_s, env.max_roll_rad)
-        && angle_ok(a.pitch_rad, a.pitch_rate_rad_s, env.max_pitch_rad)
 }
 
 /// A segment's drift angles from their tangents: at the centre, the worst (`tan_max`

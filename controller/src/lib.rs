@@ -16,6 +16,7 @@ pub mod fault;
 pub mod frame;
 #[cfg(feature = "reference")]
 pub mod golden;
+pub mod intake;
 pub mod nav;
 pub mod plan;
 pub mod report;

@@ -21,7 +21,7 @@ pub struct Nav {
 }
 
 impl Nav {
-    /// Parses the payload; only the layout is checked here (see [`crate::control`] for
+    /// Parses the payload; only the layout is checked here (see [`crate::intake`] for
     /// the physical checks).
     pub fn decode(payload: &[u8]) -> Result<Nav, Fault> {
         if payload.len() != NAV_LEN {
