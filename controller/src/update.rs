@@ -160,8 +160,8 @@ impl Controller {
 
     /// Out of line, so that the plan's values it reads are loaded where they are used:
     /// inlined into the update's loop, they were hoisted out of it into registers that
-    /// every call in the segment's work then saved and restored (`cargo xtask bench`:
-    /// with its helpers inlined here, 9 739 instructions an update against 10 656).
+    /// every call in the segment's work then saved and restored (the counts:
+    /// docs/controller.md, "What it costs").
     #[inline(never)]
     fn segment(
         &self,
@@ -265,8 +265,8 @@ impl Controller {
     }
 }
 
-/// `x as f32` out of line: inline, LLVM evaluated it (a 37-instruction software call)
-/// beside the one-instruction i32 conversion on every update, then picked one.
+/// `x as f32` out of line: inline, LLVM evaluated it (a software call) beside the
+/// one-instruction i32 conversion on every update, then picked one.
 #[cold]
 #[inline(never)]
 fn i64_to_f32(x: i64) -> f32 {
@@ -288,13 +288,12 @@ struct Extremes {
 ///
 /// Its own function, never inlined: the loop's square root is a call
 /// (`core_math::sqrt`), which clobbers s0-s15; inlined into `segment`, whose values
-/// then live across it, every sample reloaded a dozen of them (68 instructions a sample,
-/// `cargo xtask bench --profile`). Here the row's constants and the running extremes
-/// nearly fit the callee-saved s16-s31 (four reloads a sample). The row is formed here
-/// from the update in memory: formed by the caller and passed by reference, its 16
-/// constants went through the stack (190 instructions an update). Computing the steered
-/// centre in here too cost 600 instructions more (the update's values reloaded across
-/// the calls).
+/// then live across it, every sample reloaded many of them. Here the row's constants
+/// and the running extremes nearly fit the callee-saved s16-s31. The row is formed here
+/// from the update in memory: formed by the caller and passed by reference, its
+/// constants went through the stack. The steered centre stays out of here: computed in
+/// here too, it made the update's values reload across the calls. (The counts:
+/// docs/controller.md, "What it costs".)
 #[inline(never)]
 fn extremes(update: &GeneralUpdate<f32>, seg: &SegmentPlan) -> Result<Extremes, Fault> {
     let row = GENERAL_F32.row_motion(update, &seg.row);
@@ -385,8 +384,9 @@ fn drift_angles_rad(tan_centre: f32, tan_max: f32, tan_residual: f32) -> [f32; 3
 }
 
 /// The drift angle atan(t) (rad) of a drift tangent t = v2/v1: `core_math::trig::atan_f32`
-/// (2.2 ulp, a tenth of libm's `atanf` cost here), which the drift smear of keystoned
-/// outer segments (|t| up to 0.3 at 20 deg of pitch) needs beyond any short series.
+/// (accurate to a few ulp, and cheaper than libm's `atanf`: docs/controller.md), which
+/// the drift smear of keystoned outer segments (|t| up to 0.3 at 20 deg of pitch) needs
+/// beyond any short series.
 #[inline(always)]
 pub fn drift_angle_rad(t: f32) -> f32 {
     core_math::trig::atan_f32(t)
