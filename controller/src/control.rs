@@ -1,10 +1,12 @@
-//! The line-rate controller: accepts frames, keeps the last good state, and at every
-//! update instant computes each active segment's line period, its MTF (mismatch times
-//! drift smear) and TDI stage limit, its drift angles, and the yaw steering request,
-//! writing the periods through a [`LinePeriodSink`].
+//! The line-rate controller's state: the scene and its plan in force, the last accepted
+//! NAV state, the clock and the update schedule, the outputs in force and the fault
+//! counters, with their accessors. The work on that state is in two modules of its own:
+//! [`crate::intake`] (frames to state, [`Controller::on_frame`]) and [`crate::update`]
+//! (state to periods, [`Controller::advance`]). Both read and write the fields, which
+//! are crate-visible for them; this module uses neither.
 //!
 //! The model is the general real-Earth form of core-math (`GENERAL_F32`): WGS 84
-//! ([`EARTH`]), the NAV state propagated on a two-body orbit to the update instant
+//! ([`crate::EARTH`]), the NAV state propagated on a two-body orbit to the update instant
 //! ([`crate::nav::Propagator`]), the full attitude at its rates, each segment's ground
 //! at its own height (SCENE, TERRAIN).
 //!
@@ -12,62 +14,13 @@
 //! refused computation leaves that segment's last good period in force, and nothing
 //! outside the physically possible period range is ever written.
 
-use core_math::earth::{Attitude, GeneralRowMotion, GeneralUpdate};
-use core_math::ImageMotion;
-use core_math::{nearest_ticks, sinc, Backend, Ellipsoid, Real, GENERAL_F32};
+use core_math::earth::Attitude;
 
+use crate::config::Config;
 use crate::fault::{Counters, Fault};
-use crate::frame::{kind, Frame};
-use crate::nav::{attitude_at, Nav, Propagator};
-use crate::plan::{Plan, SegmentPlan, MAX_SPEED2_RATIO, MIN_SPEED2_RATIO};
-use crate::scene::{AttitudeEnvelope, Scene, Terrain, MAX_SEGMENTS};
-
-/// The Earth of the model: WGS 84, a = 6 378 137 m, f = 1/298.257223563.
-pub const EARTH: Ellipsoid = Ellipsoid::WGS84;
-/// The Earth's rotation rate (rad/s): 7.292 115 9e-5 (IERS), core-math's.
-pub const EARTH_RATE_RAD_S: f64 = core_math::EARTH_RATE_RAD_S;
-
-/// Where line periods go: the period registers of the camera's line clock (one per
-/// segment), in the spirit of embedded-hal: small, and the only way out.
-pub trait LinePeriodSink {
-    type Error;
-    /// Programs segment `index`'s line period, in ticks of the scene's line clock.
-    fn write_period(&mut self, index: u8, ticks: u32) -> Result<(), Self::Error>;
-}
-
-/// Controller settings (defaults: `Config::default()`; rationale in docs/controller.md).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Config {
-    /// Time between updates (us). Default 20 ms (docs/controller.md, "The update rate").
-    pub update_period_us: u64,
-    /// No valid NAV frame for longer than this (us) is a [`Fault::Stale`] and stops
-    /// updates. It is also how far ahead a NAV frame's attitude is propagated when it
-    /// is checked against the scene's envelope.
-    pub stale_after_us: u64,
-    /// Largest step (us) a time tag may take ahead of the controller's clock. A tag
-    /// further ahead is refused ([`Fault::TimeJump`]) unless the next frame confirms
-    /// the new time line (a re-synchronisation, docs/telemetry.md "Time").
-    pub max_time_jump_us: u64,
-    /// The mission's altitude band above the ellipsoid (m): NAV frames whose |r| is
-    /// outside b + low ..= a + high are refused, and scenes are planned and the period
-    /// guard set for it.
-    pub altitude_range_m: (f64, f64),
-}
-
-impl Default for Config {
-    fn default() -> Self {
-        Config {
-            update_period_us: 20_000,
-            stale_after_us: 1_000_000,
-            max_time_jump_us: 5_000_000,
-            altitude_range_m: (500e3, 800e3),
-        }
-    }
-}
-
-/// Largest time tag the clock takes (us, 2^53: 285 years). Up to it every tag is exact
-/// in f64, and the schedule's sums cannot overflow.
-pub const MAX_TIME_TAG_US: u64 = 1 << 53;
+use crate::nav::Propagator;
+use crate::plan::Plan;
+use crate::scene::{Scene, MAX_SEGMENTS};
 
 /// The last accepted NAV state.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -117,41 +70,43 @@ pub enum Mode {
     Stale = 2,
 }
 
+/// The controller: its state here, frame intake in [`crate::intake`], the update in
+/// [`crate::update`].
 #[derive(Clone)]
 pub struct Controller {
     pub config: Config,
-    scene: Scene,
-    plan: Plan,
+    pub(crate) scene: Scene,
+    pub(crate) plan: Plan,
     /// Where a new scene's plan is built, in place, before it replaces `plan` (a plan is
     /// 4.7 KB: kept off the stack, docs/target.md).
-    spare_plan: Plan,
+    pub(crate) spare_plan: Plan,
     /// Ground height of each table entry (m): from the scene, then TERRAIN frames.
-    heights_m: [f32; MAX_SEGMENTS],
-    nav: Option<NavState>,
+    pub(crate) heights_m: [f32; MAX_SEGMENTS],
+    pub(crate) nav: Option<NavState>,
     /// Time tag of the last accepted frame of any kind (us).
-    last_time_us: Option<u64>,
+    pub(crate) last_time_us: Option<u64>,
     /// Time tag of the previous frame, when it was refused for its time tag alone: the
     /// first half of a re-synchronisation.
-    resync_candidate_us: Option<u64>,
-    now_us: u64,
-    next_update_us: u64,
+    pub(crate) resync_candidate_us: Option<u64>,
+    pub(crate) now_us: u64,
+    pub(crate) next_update_us: u64,
     /// The update period `next_update_us` was scheduled with (0: none yet).
-    scheduled_period_us: u64,
-    last_update_us: Option<u64>,
+    pub(crate) scheduled_period_us: u64,
+    pub(crate) last_update_us: Option<u64>,
     pub counters: Counters,
     pub last_fault: Option<Fault>,
     pub frames_accepted: u32,
     /// Re-synchronisations of the clock (each also counts as an accepted frame).
     pub time_resyncs: u32,
-    outputs: [SegmentOutput; MAX_SEGMENTS],
-    has_output: [bool; MAX_SEGMENTS],
+    pub(crate) outputs: [SegmentOutput; MAX_SEGMENTS],
+    pub(crate) has_output: [bool; MAX_SEGMENTS],
     /// The yaw correction (rad) that zeroes the drift at the array centre, from the
     /// last update; `None` when that update could not form it.
-    yaw_request_rad: Option<f32>,
+    pub(crate) yaw_request_rad: Option<f32>,
     /// Update instants run, whatever they computed: one PERIODS frame each.
     pub updates: u32,
     /// The mode an update ran in (the one its PERIODS frame reports).
-    update_mode: Mode,
+    pub(crate) update_mode: Mode,
 }
 
 impl Controller {
@@ -260,7 +215,7 @@ impl Controller {
         self.update_mode
     }
 
-    fn mode_at(&self, t_us: u64) -> Mode {
+    pub(crate) fn mode_at(&self, t_us: u64) -> Mode {
         match &self.nav {
             None => Mode::WaitingForNav,
             Some(n) if t_us.saturating_sub(n.time_us) > self.config.stale_after_us => Mode::Stale,
@@ -282,581 +237,10 @@ impl Controller {
         self.last_fault = Some(f);
     }
 
-    /// One decoded frame. Its time tag moves the controller's clock forward.
-    ///
-    /// The time window (docs/telemetry.md "Time"): a tag is taken when it is after the
-    /// last accepted one and at most `max_time_jump_us` ahead of the clock (any tag up
-    /// to [`MAX_TIME_TAG_US`] before the first frame). A tag outside it is refused, but
-    /// remembered: if the very next frame is valid and lies after it by at most the
-    /// jump, the two agree on a new time line and the clock re-synchronises to it.
-    pub fn on_frame(&mut self, frame: &Frame<'_>) {
-        let t = frame.time_us;
-        let candidate = self.resync_candidate_us.take();
-        let resync = match self.time_check(t) {
-            Ok(()) => false,
-            Err(f) => {
-                let confirms = candidate.is_some_and(|c| {
-                    t > c && t - c <= self.config.max_time_jump_us && t <= MAX_TIME_TAG_US
-                });
-                if !confirms {
-                    // A tag the clock can never take cannot start a new time line.
-                    if t <= MAX_TIME_TAG_US {
-                        self.resync_candidate_us = Some(t);
-                    }
-                    return self.reject(f);
-                }
-                true
-            }
-        };
-        if resync {
-            // Content first: a frame refused for its content re-synchronises nothing.
-            if let Err(f) = self.check_content(frame) {
-                return self.reject(f);
-            }
-            self.resynchronise(t);
-        }
-        let result = self.apply(frame);
-        match result {
-            Ok(()) => {
-                self.frames_accepted = self.frames_accepted.saturating_add(1);
-                self.last_time_us = Some(t);
-                self.now_us = self.now_us.max(t);
-            }
-            Err(f) => self.reject(f),
-        }
-    }
-
-    /// Whether `t_us` lies in the time window.
-    fn time_check(&self, t_us: u64) -> Result<(), Fault> {
-        if t_us > MAX_TIME_TAG_US {
-            return Err(Fault::TimeJump);
-        }
-        let Some(last) = self.last_time_us else {
-            return Ok(());
-        };
-        if t_us <= last {
-            return Err(Fault::TimeWentBackwards);
-        }
-        // `now_us` <= MAX_TIME_TAG_US, but the jump is configuration: saturate.
-        if t_us > self.now_us.saturating_add(self.config.max_time_jump_us) {
-            return Err(Fault::TimeJump);
-        }
-        Ok(())
-    }
-
-    /// The checks `apply` makes, without their effect (a SCENE's plan is built in the
-    /// spare plan, which only a successful `set_scene` puts in force).
-    fn check_content(&mut self, frame: &Frame<'_>) -> Result<(), Fault> {
-        match frame.kind {
-            kind::NAV => self.check_nav(frame).map(|_| ()),
-            kind::SCENE => {
-                let scene = Scene::decode(frame.payload)?;
-                self.spare_plan.build_into(&scene, &self.config, false)
-            }
-            kind::TERRAIN => Terrain::decode(frame.payload, &self.scene).map(|_| ()),
-            kind::TIME if frame.payload.is_empty() => Ok(()),
-            kind::TIME => Err(Fault::BadLength),
-            _ => Err(Fault::UnknownKind),
-        }
-    }
-
-    /// A new time line from `t_us` on: the NAV state of the old one cannot be
-    /// propagated across the discontinuity, so it is dropped (mode waiting for NAV, the
-    /// periods in force held), and the next update is the one due at the new clock.
-    fn resynchronise(&mut self, t_us: u64) {
-        self.time_resyncs = self.time_resyncs.saturating_add(1);
-        self.last_time_us = None;
-        self.now_us = t_us;
-        self.next_update_us = 0;
-        self.nav = None;
-        self.hold_all();
-    }
-
-    fn apply(&mut self, frame: &Frame<'_>) -> Result<(), Fault> {
-        match frame.kind {
-            kind::NAV => self.accept_nav(frame),
-            kind::SCENE => self.accept_scene(frame.payload),
-            kind::TERRAIN => {
-                let terrain = Terrain::decode(frame.payload, &self.scene)?;
-                self.heights_m = terrain.heights_m;
-                Ok(())
-            }
-            kind::TIME if frame.payload.is_empty() => Ok(()),
-            kind::TIME => Err(Fault::BadLength),
-            _ => Err(Fault::UnknownKind),
-        }
-    }
-
-    fn accept_nav(&mut self, frame: &Frame<'_>) -> Result<(), Fault> {
-        self.nav = Some(self.check_nav(frame)?);
-        Ok(())
-    }
-
-    /// A NAV frame's checks: finite; an orbital frame; |r| in the altitude band and a
-    /// speed of an imaging orbit ([`MIN_SPEED2_RATIO`]..[`MAX_SPEED2_RATIO`] of the
-    /// circular speed squared) (`out_of_range`); the attitude inside the scene's
-    /// envelope at the frame's instant and propagated at its rates over every update it
-    /// may serve, one update period back (an update instant precedes the frame's tag by
-    /// up to that) to `stale_after` ahead (`attitude_outside_model`).
-    fn check_nav(&self, frame: &Frame<'_>) -> Result<NavState, Fault> {
-        let nav = Nav::decode(frame.payload)?;
-        let r_m = nav.check_state()?;
-        let (h_lo, h_hi) = self.config.altitude_range_m;
-        if !(r_m >= EARTH.b_m() + h_lo && r_m <= EARTH.a_m + h_hi) {
-            return Err(Fault::OutOfRange);
-        }
-        let v = nav.state.velocity_mps;
-        let speed2_ratio = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) * r_m / core_math::GM_M3_S2;
-        if !(MIN_SPEED2_RATIO..=MAX_SPEED2_RATIO).contains(&speed2_ratio) {
-            return Err(Fault::OutOfRange);
-        }
-        let back_s = self.config.update_period_us as f32 * 1e-6;
-        let ahead_s = self.config.stale_after_us as f32 * 1e-6;
-        if !inside_envelope(&nav.attitude, &self.plan.envelope, back_s, ahead_s) {
-            return Err(Fault::AttitudeOutsideModel);
-        }
-        // Any yaw is allowed: wrapped once here (in f64: an f32 yaw of any size), the
-        // per-update trigonometry then works near zero.
-        let yaw = libm::remainder(f64::from(nav.attitude.yaw_rad), 2.0 * core::f64::consts::PI);
-        Ok(NavState {
-            time_us: frame.time_us,
-            propagator: Propagator::new(&nav.state),
-            attitude: Attitude {
-                yaw_rad: yaw as f32,
-                ..nav.attitude
-            },
-        })
-    }
-
-    fn accept_scene(&mut self, payload: &[u8]) -> Result<(), Fault> {
-        self.set_scene(Scene::decode(payload)?)
-    }
-
-    /// Moves the clock to `now_us` (from the time source) and runs the update that is due,
-    /// if any, writing periods to `sink`. Returns true when an update ran.
-    pub fn advance<S: LinePeriodSink>(&mut self, now_us: u64, sink: &mut S) -> bool {
-        // The clock never passes the largest tag, whatever the time source says: past
-        // it no frame could be accepted again.
-        self.now_us = self.now_us.max(now_us.min(MAX_TIME_TAG_US));
-        if self.now_us < self.next_update_us {
-            return false;
-        }
-        // Only the latest due instant is computed: after a gap, catching up on missed
-        // updates would only delay the current one.
-        let period = self.config.update_period_us.max(1);
-        // The instant due is the one scheduled, unless the clock has passed the next one
-        // too or the period was changed: a 64-bit division (a software call here) only
-        // then.
-        let t = if period == self.scheduled_period_us && self.now_us - self.next_update_us < period
-        {
-            self.next_update_us
-        } else {
-            self.now_us - self.now_us % period
-        };
-        self.scheduled_period_us = period;
-        // t <= MAX_TIME_TAG_US; saturating all the same, for any configured period.
-        self.next_update_us = t.saturating_add(period);
-        self.last_update_us = Some(t);
-        self.updates = self.updates.saturating_add(1);
-        let previous = self.update_mode;
-        self.update_mode = self.mode_at(t);
-        // One stale episode is a run of updates in mode stale: so the counter equals
-        // the PERIODS frames in mode stale whose predecessor was not.
-        if self.update_mode == Mode::Stale && previous != Mode::Stale {
-            self.reject(Fault::Stale);
-        }
-        self.update_at(t, sink);
-        true
-    }
-
-    fn update_at<S: LinePeriodSink>(&mut self, t_us: u64, sink: &mut S) {
-        self.yaw_request_rad = None;
-        let Some(nav) = self.nav else { return };
-        if self.update_mode == Mode::Stale {
-            self.hold_all();
-            return;
-        }
-        // Not stale: t - t_nav lies in [-update period, stale_after], both < 2^53 us:
-        // the difference is exact in i64 and small in f32. Converted from i32 when it
-        // fits (one instruction; from i64 it is a software call), to the same f32.
-        let dt_us = (t_us as i64).wrapping_sub(nav.time_us as i64);
-        let dt_s = match i32::try_from(dt_us) {
-            Ok(dt) => dt as f32,
-            Err(_) => i64_to_f32(dt_us),
-        } * 1e-6;
-        let state = nav.propagator.parts_at(dt_s);
-        let attitude = attitude_at(&nav.attitude, dt_s);
-        let instant = match GENERAL_F32.instant_parts(
-            state.position_m,
-            state.velocity_mps,
-            state.r2_minus_a2_m2,
-            &attitude,
-            EARTH_RATE_RAD_S as f32,
-        ) {
-            Ok(i) => i,
-            Err(e) => {
-                self.reject(Fault::from(e));
-                self.hold_all();
-                return;
-            }
-        };
-        // The yaw steering request: at the boresight a turn about it turns (v1, v2) by
-        // the turn and changes nothing else, so atan(v2/v1) there zeroes its drift.
-        let boresight_h = self.height(self.plan.boresight_segment);
-        let steer = GENERAL_F32
-            .ground(&instant, &EARTH, boresight_h)
-            .and_then(|u| GENERAL_F32.motion(&u, &self.plan.boresight))
-            .ok()
-            .and_then(|m| {
-                let speed = Real::sqrt(m.v1_mps * m.v1_mps + m.v2_mps * m.v2_mps);
-                let sign = if m.v1_mps < 0.0 { -1.0 } else { 1.0 };
-                let (sin, cos) = (sign * m.v2_mps / speed, sign * m.v1_mps / speed);
-                (sin.is_finite() && cos.is_finite())
-                    .then(|| (sin, cos, drift_angle_rad(m.v2_mps / m.v1_mps)))
-            });
-        self.yaw_request_rad = steer.map(|(_, _, rad)| rad);
-        // Output slots by `get` (`index` < MAX_SEGMENTS by construction of the plan): no
-        // panic path (docs/no-panic.md).
-        // Segments over the same ground height share its update: made once per height
-        // in a row (a flat scene makes one, terrain one per segment). It stays in one
-        // place in memory, which the out-of-line `segment` and `extremes` read.
-        let mut ground_h_m = f32::NAN;
-        let mut ground: Result<GeneralUpdate<f32>, Fault> = Err(Fault::OutOfRange);
-        for k in 0..self.plan.segments.len() {
-            let Some(seg) = self.plan.segments.get(k) else {
-                break;
-            };
-            let index = seg.index;
-            let height_m = self.height(index);
-            // NaN never equals: the first segment makes the first ground.
-            if height_m != ground_h_m {
-                ground = GENERAL_F32
-                    .ground(&instant, &EARTH, height_m)
-                    .map_err(Fault::from);
-                ground_h_m = height_m;
-            }
-            let result = match &ground {
-                Ok(update) => self.segment(update, seg, steer),
-                Err(f) => Err(*f),
-            };
-            let slot = usize::from(index);
-            match result {
-                Ok(out) => {
-                    // Only a period inside the physical range reaches a register.
-                    if sink.write_period(index, out.ticks).is_ok() {
-                        if let (Some(o), Some(h)) =
-                            (self.outputs.get_mut(slot), self.has_output.get_mut(slot))
-                        {
-                            *o = out;
-                            *h = true;
-                        }
-                    } else if let Some(o) = self.outputs.get_mut(slot) {
-                        // The register kept its old period: report it as held, not as
-                        // the new value.
-                        o.held = true;
-                    }
-                }
-                Err(f) => {
-                    self.reject(f);
-                    if let Some(o) = self.outputs.get_mut(slot) {
-                        o.held = true;
-                    }
-                }
-            }
-        }
-    }
-
-    fn height(&self, index: u8) -> f32 {
-        self.heights_m
-            .get(usize::from(index))
-            .copied()
-            .unwrap_or(0.0)
-    }
-
-    fn hold_all(&mut self) {
+    /// Every output in force is now the last good value held over a fault.
+    pub(crate) fn hold_all(&mut self) {
         for o in self.outputs.iter_mut() {
             o.held = true;
         }
-    }
-
-    /// Out of line, so that the plan's values it reads are loaded where they are used:
-    /// inlined into the update's loop, they were hoisted out of it into registers that
-    /// every call in the segment's work then saved and restored (`cargo xtask bench`:
-    /// with its helpers inlined here, 9 739 instructions an update against 10 656).
-    #[inline(never)]
-    fn segment(
-        &self,
-        update: &GeneralUpdate<f32>,
-        seg: &SegmentPlan,
-        steer: Option<(f32, f32, f32)>,
-    ) -> Result<SegmentOutput, Fault> {
-        // |v1| extremes and the largest |v2/v1| over the samples and the centre; every
-        // one must move the same way along P1 (one transfer direction per segment). In
-        // forward flight the image moves towards -P1 (the ground runs backwards under
-        // the camera); towards +P1 is the reversed transfer.
-        // The samples and the centre lie on the segment's row: its constants once, then
-        // about twenty operations a pixel.
-        let Extremes {
-            centre,
-            lo,
-            hi,
-            drift_v2,
-            drift_v1,
-        } = extremes(update, seg)?;
-        let reversed = centre.v1_mps > 0.0;
-        let tan_centre = centre.v2_mps / centre.v1_mps;
-        // v1's extremes are tracked signed, and its sign checked once after the loop;
-        // the largest |v2/v1| as the pair (|v2|, |v1|) that gives it, compared by
-        // cross-multiplying (|v1| > 0): one division at the end, not one a pixel. The loop
-        // keeps no error exit of its own, so none of the exit's work is hoisted into it.
-        // Every sample must move the same way as the centre (one transfer direction per
-        // segment).
-        let (v_min, v_max) = if reversed { (lo, hi) } else { (-hi, -lo) };
-        if !(v_min > 0.0) {
-            return Err(Fault::PeriodOutOfRange);
-        }
-        let tan_max = drift_v2 / drift_v1;
-        // The period minimising the worst relative mismatch over [v_min, v_max]: the
-        // line speed equal to the harmonic mean of the extremes, i.e. the mean of the
-        // extremes' periods.
-        let a = self.plan.pixel_m;
-        let period_s = 0.5 * (a / v_min + a / v_max);
-        let (lo, hi) = self.plan.period_bounds_s;
-        if !(period_s >= lo && period_s <= hi) {
-            return Err(Fault::PeriodOutOfRange);
-        }
-        // The clock was checked when the scene arrived and the period just above:
-        // only the rounding to whole ticks is left (`line_period_ticks` less its input
-        // checks, a tenth of a segment's work).
-        let ticks = nearest_ticks(period_s * self.plan.line_clock_hz).map_err(Fault::from)?;
-        // The mismatch of the period actually programmed, rounding to ticks included,
-        // against the range v1 may take between the samples.
-        let v_line = a * self.plan.line_clock_hz / ticks as f32;
-        let (v_lo, v_hi) = (v_min - seg.interpolation_mps, v_max + seg.interpolation_mps);
-        let stages = u32::from(seg.tdi_stages);
-        let (worst_mismatch, mtf, max_stages) = if v_lo > 0.0 {
-            let (below, above) = ((v_line / v_lo - 1.0).abs(), (1.0 - v_line / v_hi).abs());
-            let worst = if below > above { below } else { above };
-            let half_pi_m = core::f32::consts::FRAC_PI_2 * stages as f32;
-            // Past the sinc's first zero no contrast is left; its negative lobe is a
-            // phase reversal, not an MTF below 0. Never above 1: the polynomial's
-            // (sinc(x) - 1) / x^2 part is negative on its whole range, and past pi
-            // |sinc| < 1/pi.
-            let contrast = |x: f32| {
-                let s = sinc(x);
-                if s > 0.0 {
-                    s
-                } else {
-                    0.0
-                }
-            };
-            let mtf = contrast(half_pi_m * worst) * contrast(half_pi_m * tan_max);
-            let m = self
-                .plan
-                .stage_rule
-                .max_stages_with_drift(worst, tan_max, u32::from(self.plan.max_stages))
-                .map_err(Fault::from)?;
-            (worst, mtf, m as u16)
-        } else {
-            // The image is slower than the interpolation bound: no bound on the
-            // mismatch, no contrast promised.
-            (f32::MAX, 0.0, 0)
-        };
-        let tan_residual = match steer {
-            Some((sin, cos, _)) => {
-                let m = steered_centre(update, seg, sin, cos)?;
-                m.v2_mps / m.v1_mps
-            }
-            None => tan_centre,
-        };
-        let [drift_rad, worst_drift_rad, residual_drift_rad] =
-            drift_angles_rad(tan_centre, tan_max, tan_residual);
-        Ok(SegmentOutput {
-            index: seg.index,
-            ticks,
-            worst_mismatch,
-            mtf,
-            max_stages,
-            drift_rad,
-            worst_drift_rad,
-            residual_drift_rad,
-            reversed,
-            held: false,
-        })
-    }
-}
-
-/// `x as f32` out of line: inline, LLVM evaluated it (a 37-instruction software call)
-/// beside the one-instruction i32 conversion on every update, then picked one.
-#[cold]
-#[inline(never)]
-fn i64_to_f32(x: i64) -> f32 {
-    x as f32
-}
-
-/// What a segment's samples show: v1's signed extremes, and the (|v2|, |v1|) of the
-/// largest |v2/v1| over the samples and the centre.
-struct Extremes {
-    centre: ImageMotion<f32>,
-    lo: f32,
-    hi: f32,
-    drift_v2: f32,
-    drift_v1: f32,
-}
-
-/// The segment's row at this update, its centre, and the samples' [`Extremes`] (the
-/// centre's drift included).
-///
-/// Its own function, never inlined: the loop's square root is a call
-/// (`core_math::sqrt`), which clobbers s0-s15; inlined into `segment`, whose values
-/// then live across it, every sample reloaded a dozen of them (68 instructions a sample,
-/// `cargo xtask bench --profile`). Here the row's constants and the running extremes
-/// nearly fit the callee-saved s16-s31 (four reloads a sample). The row is formed here
-/// from the update in memory: formed by the caller and passed by reference, its 16
-/// constants went through the stack (190 instructions an update). Computing the steered
-/// centre in here too cost 600 instructions more (the update's values reloaded across
-/// the calls).
-#[inline(never)]
-fn extremes(update: &GeneralUpdate<f32>, seg: &SegmentPlan) -> Result<Extremes, Fault> {
-    let row = GENERAL_F32.row_motion(update, &seg.row);
-    // The samples run from the segment's first pixel to its last, the centre between:
-    // when both ends face the ground, every pixel does, and each one costs one check
-    // instead of three (`GeneralRowMotion::motion_at_facing`: the same results and
-    // errors). Otherwise some pixel misses, and the checked route finds which first.
-    let ends = (seg.samples.get(1), seg.samples.last());
-    match ends {
-        (Some(a), Some(b)) if row.faces_ground_over(a.p2_m, b.p2_m) => {
-            sweep(seg, |p2| row.motion_at_facing(p2))
-        }
-        _ => sweep_checked(&row, seg),
-    }
-}
-
-#[cold]
-#[inline(never)]
-fn sweep_checked(row: &GeneralRowMotion<f32>, seg: &SegmentPlan) -> Result<Extremes, Fault> {
-    sweep(seg, |p2| row.motion_at(p2))
-}
-
-/// The centre's motion, then the extremes over the centre and the samples, by
-/// `motion_at` (`SegmentPlan::samples`: the centre first).
-#[inline(always)]
-fn sweep(
-    seg: &SegmentPlan,
-    motion_at: impl Fn(f32) -> Result<ImageMotion<f32>, core_math::ModelError>,
-) -> Result<Extremes, Fault> {
-    let Some((first, samples)) = seg.samples.split_first() else {
-        return Err(Fault::InvalidScene);
-    };
-    let centre = motion_at(first.p2_m)?;
-    // Comparisons, not f32::min/max: those are software calls on this core
-    // (fminf/fmaxf, NaN handling). `motion_at` refuses a NaN v1.
-    let mut e = Extremes {
-        centre,
-        lo: centre.v1_mps,
-        hi: centre.v1_mps,
-        drift_v2: centre.v2_mps.abs(),
-        drift_v1: centre.v1_mps.abs(),
-    };
-    for sample in samples {
-        let m = motion_at(sample.p2_m)?;
-        if m.v1_mps < e.lo {
-            e.lo = m.v1_mps;
-        }
-        if m.v1_mps > e.hi {
-            e.hi = m.v1_mps;
-        }
-        let (v1, v2) = (m.v1_mps.abs(), m.v2_mps.abs());
-        if v2 * e.drift_v1 > e.drift_v2 * v1 {
-            (e.drift_v2, e.drift_v1) = (v2, v1);
-        }
-    }
-    Ok(e)
-}
-
-/// The segment's centre pixel seen by the camera turned by the yaw request
-/// (`General::motion_yawed`).
-#[inline(always)]
-fn steered_centre(
-    update: &GeneralUpdate<f32>,
-    seg: &SegmentPlan,
-    sin: f32,
-    cos: f32,
-) -> Result<ImageMotion<f32>, core_math::ModelError> {
-    GENERAL_F32.motion_yawed(update, &seg.centre, sin, cos)
-}
-
-/// Whether `a` and its propagation at its rates `back_s` before and `ahead_s` after its
-/// instant stay inside `env` (linear in time: the ends are the extremes).
-fn inside_envelope(a: &Attitude<f32>, env: &AttitudeEnvelope, back_s: f32, ahead_s: f32) -> bool {
-    let rates = [a.roll_rate_rad_s, a.pitch_rate_rad_s, a.yaw_rate_rad_s];
-    let angle_ok = |x: f32, rate: f32, max: f32| {
-        [x, x - rate * back_s, x + rate * ahead_s]
-            .iter()
-            .all(|y| y.abs() <= max)
-    };
-    // Yaw is free (finite: `Nav::check_state`).
-    rates.iter().all(|r| r.abs() <= env.max_rate_rad_s)
-        && angle_ok(a.roll_rad, a.roll_rate_rad_s, env.max_roll_rad)
-        && angle_ok(a.pitch_rad, a.pitch_rate_rad_s, env.max_pitch_rad)
-}
-
-/// A segment's drift angles from their tangents: at the centre, the worst (`tan_max`
-/// >= |`tan_centre`|), and the steered centre's.
-///
-/// The worst is the centre's magnitude plus atan of the tangent of their difference,
-/// (tan_max - |t|) / (1 + tan_max |t|): a small tangent, which `atan_f32` takes without
-/// reduction, where the worst drift itself (0.8 rad in a roll slew) needs one; and the
-/// sum is never below the centre's.
-#[inline(always)]
-fn drift_angles_rad(tan_centre: f32, tan_max: f32, tan_residual: f32) -> [f32; 3] {
-    let centre_rad = drift_angle_rad(tan_centre);
-    let t = tan_centre.abs();
-    let beyond_rad = drift_angle_rad((tan_max - t) / (1.0 + tan_max * t));
-    [
-        centre_rad,
-        centre_rad.abs() + beyond_rad,
-        drift_angle_rad(tan_residual),
-    ]
-}
-
-/// The drift angle atan(t) (rad) of a drift tangent t = v2/v1: `core_math::trig::atan_f32`
-/// (2.2 ulp, a tenth of libm's `atanf` cost here), which the drift smear of keystoned
-/// outer segments (|t| up to 0.3 at 20 deg of pitch) needs beyond any short series.
-#[inline(always)]
-pub fn drift_angle_rad(t: f32) -> f32 {
-    core_math::trig::atan_f32(t)
-}
-
-#[cfg(test)]
-mod tests {
-    extern crate std;
-    use super::drift_angles_rad;
-
-    /// The three drift angles against atan in f64: the worst one by its difference form
-    /// within 4 f32 ulp of 1 rad, never below the centre's magnitude.
-    #[test]
-    fn drift_angles_match_atan() {
-        let mut rng = core_math::sample::SplitMix64(0x5EED_2026_1124);
-        let mut next = || rng.uniform(0.0, 1.0);
-        let mut worst_err = 0f64;
-        for _ in 0..200_000 {
-            // Tangents over drifts of 0 to 1.5 rad, either sign.
-            let c = libm::tan(1.5 * next()) * if next() < 0.5 { -1.0 } else { 1.0 };
-            let m = libm::fabs(c) + libm::tan(1.5 * next()) * next();
-            let r = libm::tan(0.3 * next() - 0.15);
-            let (c, m, r) = (c as f32, (m as f32).max((c as f32).abs()), r as f32);
-            let [dc, dm, dr] = drift_angles_rad(c, m, r);
-            for (got, t) in [(dc, c), (dm, m), (dr, r)] {
-                let want = libm::atan(f64::from(t));
-                worst_err = worst_err.max(libm::fabs(f64::from(got) - want));
-            }
-            assert!(dm >= dc.abs(), "{c} {m}: {dm} < |{dc}|");
-        }
-        assert!(
-            worst_err <= 4.0 * f64::from(f32::EPSILON) / 2.0,
-            "{worst_err:e}"
-        );
-        std::eprintln!("drift angles: worst error {worst_err:.2e} rad");
     }
 }

@@ -14,7 +14,7 @@ use core_math::earth::kepler::Kepler;
 use core_math::earth::{Attitude, EarthCamera, EarthGeometry};
 use core_math::{Backend, EarthReference, ModelError, StateVector, GM_M3_S2};
 
-use crate::control::{EARTH, EARTH_RATE_RAD_S};
+use crate::config::{EARTH, EARTH_RATE_RAD_S};
 use crate::plan::Plan;
 use crate::scene::{Scene, MAX_SEGMENTS};
 

@@ -2,26 +2,34 @@
 //! scene and its plan, per-segment TDI line periods out. `no_std`, no allocation, no
 //! hardware: the firmware feeds it bytes and a clock, and gives it a [`LinePeriodSink`].
 //!
-//! telemetry in ([`frame`], [`nav`]) -> scene ([`scene`], [`plan`]) -> math (core-math's
-//! general real-Earth form) -> line periods out ([`control`], [`report`]).
+//! telemetry in ([`frame`], [`nav`]) -> frames to state ([`intake`]; the scene and its
+//! plan: [`scene`], [`plan`]) -> the controller's state ([`control`], its settings in
+//! [`config`]) -> state to periods ([`update`]: core-math's general real-Earth form) ->
+//! line periods out ([`sink`], [`report`]).
 #![no_std]
 #![forbid(unsafe_code)]
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod bytes;
+pub mod config;
 pub mod control;
 pub mod crc;
 pub mod fault;
 pub mod frame;
 #[cfg(feature = "reference")]
 pub mod golden;
+pub mod intake;
 pub mod nav;
 pub mod plan;
 pub mod report;
 pub mod scene;
 pub mod session;
+pub mod sink;
+pub mod update;
 
-pub use control::{Config, Controller, LinePeriodSink, Mode, SegmentOutput, EARTH};
+pub use config::{Config, EARTH};
+pub use control::{Controller, Mode, SegmentOutput};
 pub use fault::{Counters, Fault};
 pub use frame::{Decoder, Event, Frame, FrameError};
 pub use scene::{Scene, Terrain};
+pub use sink::LinePeriodSink;

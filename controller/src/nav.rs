@@ -21,7 +21,7 @@ pub struct Nav {
 }
 
 impl Nav {
-    /// Parses the payload; only the layout is checked here (see [`crate::control`] for
+    /// Parses the payload; only the layout is checked here (see [`crate::intake`] for
     /// the physical checks).
     pub fn decode(payload: &[u8]) -> Result<Nav, Fault> {
         if payload.len() != NAV_LEN {
@@ -87,8 +87,8 @@ impl Nav {
 /// velocity are held as f32 pairs (value + remainder, 48 bits of mantissa: below 1e-7 m
 /// at 7 000 km), the increment is added to the remainder first, and |r|^2 - a^2, the one
 /// difference that cancels, is the NAV frame's (formed in f64) plus 2 r.dr + dr.dr. The
-/// results round like the f64 sum rounded to f32, without the soft-f64 additions (about
-/// 1 300 instructions an update, `cargo xtask bench`).
+/// results round like the f64 sum rounded to f32, without the soft-f64 additions (their
+/// cost: docs/controller.md, "What it costs").
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Propagator {
     pub state: StateVector,

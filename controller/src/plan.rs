@@ -20,7 +20,7 @@ use core_math::earth::{circular_state, Attitude, GeneralPixel, GeneralRow, Gener
 use core_math::{Backend, StageRule, GENERAL_F32};
 use heapless::Vec;
 
-use crate::control::{Config, EARTH, EARTH_RATE_RAD_S};
+use crate::config::{Config, EARTH, EARTH_RATE_RAD_S};
 use crate::fault::Fault;
 use crate::scene::{
     AttitudeEnvelope, Scene, SegmentSpec, MAX_GROUND_H_M, MAX_SEGMENTS, MIN_GROUND_H_M,

@@ -9,10 +9,11 @@
 //! Bytes are processed one at a time (the decoder sees every byte alone), so that the
 //! outputs do not depend on how the bytes were chunked by the link.
 
-use crate::control::{Controller, LinePeriodSink};
+use crate::control::Controller;
 use crate::fault::Fault;
 use crate::frame::{encode, kind, Decoder, Event, MAX_FRAME, MAX_PAYLOAD};
 use crate::report::{encode_periods, encode_status};
+use crate::sink::LinePeriodSink;
 
 /// Time between STATUS frames (controller time, us).
 pub const STATUS_PERIOD_US: u64 = 1_000_000;

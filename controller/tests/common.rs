@@ -1,6 +1,8 @@
 //! Shared by the controller tests: frames built from a circular orbit.
 #![allow(dead_code)]
 
+use std::convert::Infallible;
+
 use controller::frame::{encode, kind, MAX_FRAME};
 use controller::nav::{Attitude, Nav};
 use core_math::{StateVector, GM_M3_S2};
@@ -49,8 +51,8 @@ pub fn roll(rad: f32) -> Attitude<f32> {
 pub struct Accept;
 
 impl controller::LinePeriodSink for Accept {
-    type Error = ();
-    fn write_period(&mut self, _index: u8, _ticks: u32) -> Result<(), ()> {
+    type Error = Infallible;
+    fn write_period(&mut self, _index: u8, _ticks: u32) -> Result<(), Infallible> {
         Ok(())
     }
 }

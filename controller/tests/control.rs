@@ -4,6 +4,8 @@
 
 mod common;
 
+use std::convert::Infallible;
+
 use common::{nav_frame, roll, state};
 use controller::frame::{encode, kind, Decoder, Event, MAX_FRAME};
 use controller::golden;
@@ -19,8 +21,8 @@ struct Registers {
 }
 
 impl LinePeriodSink for Registers {
-    type Error = ();
-    fn write_period(&mut self, index: u8, ticks: u32) -> Result<(), ()> {
+    type Error = Infallible;
+    fn write_period(&mut self, index: u8, ticks: u32) -> Result<(), Infallible> {
         self.writes.push((index, ticks));
         Ok(())
     }
@@ -550,7 +552,7 @@ fn time_tags_at_the_end_of_the_clock_do_not_wrap_the_schedule() {
     let mut c = Controller::new(Config::default(), Scene::paper_default()).unwrap();
     let mut regs = Registers::default();
     // The largest tag the clock takes is accepted even as the first one.
-    let t = controller::control::MAX_TIME_TAG_US;
+    let t = controller::config::MAX_TIME_TAG_US;
     feed(
         &mut c,
         &nav_frame(1, t, state(I0.to_radians(), 0.3, H), roll(0.2)),

@@ -11,6 +11,7 @@
 //! is the register path, not the rate.
 
 use controller::scene::MAX_SEGMENTS;
+use controller::sink::{Error, ErrorKind};
 use controller::LinePeriodSink;
 
 /// A counter's reload register (the board layer's line clock; embedded-hal 1.0 has no
@@ -29,6 +30,16 @@ pub enum LineClockError {
     NoSuchSegment,
     /// The register read back another value than was written.
     Readback,
+}
+
+impl Error for LineClockError {
+    fn kind(&self) -> ErrorKind {
+        match self {
+            LineClockError::ZeroPeriod => ErrorKind::InvalidPeriod,
+            LineClockError::NoSuchSegment => ErrorKind::NoSuchSegment,
+            LineClockError::Readback => ErrorKind::NotApplied,
+        }
+    }
 }
 
 /// The line clocks of all segments.

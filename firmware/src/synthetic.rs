@@ -4,6 +4,7 @@
 //! The frame goes through the same encoder, decoder and `Controller::on_frame` as a
 //! frame from the UART, so the demo exercises the flight path from the frame on.
 
+use core::convert::Infallible;
 use core::hint::black_box;
 
 use controller::frame::{encode, kind, Decoder, Event, MAX_FRAME};
@@ -24,8 +25,8 @@ const ARG_LATITUDE_RAD: f64 = 0.5;
 pub struct NoRegisters;
 
 impl LinePeriodSink for NoRegisters {
-    type Error = ();
-    fn write_period(&mut self, _index: u8, ticks: u32) -> Result<(), ()> {
+    type Error = Infallible;
+    fn write_period(&mut self, _index: u8, ticks: u32) -> Result<(), Infallible> {
         black_box(ticks);
         Ok(())
     }

@@ -14,6 +14,8 @@
 //!   downlink frame (`encode_failures == 0`, "never expected").
 #![no_main]
 
+use std::convert::Infallible;
+
 use arbitrary::{Arbitrary, Unstructured};
 use controller::frame::{encode, kind, Decoder, Event, FrameError, MAX_FRAME};
 use controller::nav::{Attitude, Nav};
@@ -329,8 +331,8 @@ impl CheckedSink {
 }
 
 impl LinePeriodSink for CheckedSink {
-    type Error = ();
-    fn write_period(&mut self, index: u8, ticks: u32) -> Result<(), ()> {
+    type Error = Infallible;
+    fn write_period(&mut self, index: u8, ticks: u32) -> Result<(), Infallible> {
         let (lo, hi) = self.bounds_ticks;
         let t = f64::from(ticks);
         assert!(
@@ -353,8 +355,8 @@ impl LinePeriodSink for CheckedSink {
 struct Record(Vec<(u8, u32)>);
 
 impl LinePeriodSink for Record {
-    type Error = ();
-    fn write_period(&mut self, index: u8, ticks: u32) -> Result<(), ()> {
+    type Error = Infallible;
+    fn write_period(&mut self, index: u8, ticks: u32) -> Result<(), Infallible> {
         self.0.push((index, ticks));
         Ok(())
     }

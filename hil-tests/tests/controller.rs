@@ -8,6 +8,8 @@
 
 use hil_tests as _;
 
+use core::convert::Infallible;
+
 use controller::frame::{encode, kind, Decoder, Event, MAX_FRAME};
 use controller::nav::Nav;
 use controller::{Config, Controller, Fault, LinePeriodSink, Mode, Terrain};
@@ -25,8 +27,8 @@ struct Registers {
 }
 
 impl LinePeriodSink for Registers {
-    type Error = ();
-    fn write_period(&mut self, _index: u8, _ticks: u32) -> Result<(), ()> {
+    type Error = Infallible;
+    fn write_period(&mut self, _index: u8, _ticks: u32) -> Result<(), Infallible> {
         self.writes += 1;
         Ok(())
     }

@@ -7,6 +7,8 @@
 
 use hil_tests as _;
 
+use core::convert::Infallible;
+
 use controller::frame::{encode, kind, MAX_FRAME};
 use controller::nav::{Attitude, Nav};
 use controller::session::Session;
@@ -16,8 +18,8 @@ use core_math::{StateVector, GM_M3_S2};
 struct Accept;
 
 impl LinePeriodSink for Accept {
-    type Error = ();
-    fn write_period(&mut self, _index: u8, _ticks: u32) -> Result<(), ()> {
+    type Error = Infallible;
+    fn write_period(&mut self, _index: u8, _ticks: u32) -> Result<(), Infallible> {
         Ok(())
     }
 }

@@ -8,7 +8,9 @@
 //! which panics on the first divergence.
 #![allow(dead_code)]
 
-use controller::control::MAX_TIME_TAG_US;
+use std::convert::Infallible;
+
+use controller::config::MAX_TIME_TAG_US;
 use controller::frame::{
     encode, kind, Decoder, Event, FrameError, HEADER_LEN, MAX_FRAME, MAX_PAYLOAD, SYNC, VERSION,
 };
@@ -19,6 +21,7 @@ use controller::scene::{
 };
 use controller::session::Session;
 use controller::{Config, Controller, Fault, LinePeriodSink, Mode, Scene, SegmentOutput};
+use core_math::sample::SplitMix64;
 use core_math::{StateVector, GM_M3_S2};
 
 const R_M: f64 = 6_371_000.0;
@@ -243,8 +246,8 @@ pub struct Recorder {
 }
 
 impl LinePeriodSink for Recorder {
-    type Error = ();
-    fn write_period(&mut self, index: u8, ticks: u32) -> Result<(), ()> {
+    type Error = Infallible;
+    fn write_period(&mut self, index: u8, ticks: u32) -> Result<(), Infallible> {
         self.writes.push((index, ticks));
         Ok(())
     }
@@ -292,14 +295,6 @@ fn nav_payload(sv: StateVector, attitude: Attitude<f32>) -> Vec<u8> {
     .encode(&mut p)
     .unwrap();
     p[..n].to_vec()
-}
-
-fn splitmix(x: &mut u64) -> u64 {
-    *x = x.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    let mut z = *x;
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
 }
 
 /// An edit of the encoded bytes, for what `Scene::encode` cannot express.
@@ -834,8 +829,8 @@ impl Harness {
                 self.one_frame(k, now + 1, &payload, verdict, None);
             }
             Action::BitFlip { bit, seed } => {
-                let mut s = seed;
-                let Some(mut f) = self.clean_frame(kind::TIME, splitmix(&mut s) & 0xFFFF_FFFF, &[])
+                let mut s = SplitMix64(seed);
+                let Some(mut f) = self.clean_frame(kind::TIME, s.next_u64() & 0xFFFF_FFFF, &[])
                 else {
                     return self.check();
                 };
@@ -898,9 +893,9 @@ impl Harness {
                 self.deliver(&next, now + dt_us, Ok(()), None);
             }
             Action::Noise { len, seed } => {
-                let mut s = seed;
+                let mut s = SplitMix64(seed);
                 let noise: Vec<u8> = (0..len)
-                    .map(|_| match splitmix(&mut s) as u8 {
+                    .map(|_| match s.next_u64() as u8 {
                         b if b == SYNC[0] => 0x55,
                         b => b,
                     })
@@ -920,8 +915,8 @@ impl Harness {
                 } else {
                     version
                 };
-                let mut s = seed;
-                let Some(mut f) = self.clean_frame(kind::TIME, splitmix(&mut s) & 0xFFFF_FFFF, &[])
+                let mut s = SplitMix64(seed);
+                let Some(mut f) = self.clean_frame(kind::TIME, s.next_u64() & 0xFFFF_FFFF, &[])
                 else {
                     return self.check();
                 };
@@ -935,9 +930,8 @@ impl Harness {
                 assert!(sent.periods.is_empty() && sent.status.is_empty());
             }
             Action::Oversized { len, seed } => {
-                let mut s = seed;
-                let Some(f) = self.clean_frame(kind::TIME, splitmix(&mut s) & 0xFFFF_FFFF, &[])
-                else {
+                let mut s = SplitMix64(seed);
+                let Some(f) = self.clean_frame(kind::TIME, s.next_u64() & 0xFFFF_FFFF, &[]) else {
                     return self.check();
                 };
                 let mut h = f[..HEADER_LEN].to_vec();

@@ -3,6 +3,7 @@
 
 use anyhow::{anyhow, Result};
 use std::collections::BTreeMap;
+use std::convert::Infallible;
 
 use controller::frame::{kind, Decoder, Event};
 use controller::golden::NavInput;
@@ -58,8 +59,8 @@ impl Downlink {
 pub struct Accept;
 
 impl LinePeriodSink for Accept {
-    type Error = ();
-    fn write_period(&mut self, _index: u8, _ticks: u32) -> Result<(), ()> {
+    type Error = Infallible;
+    fn write_period(&mut self, _index: u8, _ticks: u32) -> Result<(), Infallible> {
         Ok(())
     }
 }

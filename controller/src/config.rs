@@ -1,0 +1,45 @@
+//! The controller's configuration and the fixed limits it works within: the Earth model
+//! ([`EARTH`], [`EARTH_RATE_RAD_S`]), the settings a host chooses ([`Config`]) and the
+//! largest time tag the clock takes ([`MAX_TIME_TAG_US`]). Everything else in the crate
+//! reads these; this module reads nothing of the crate.
+
+use core_math::Ellipsoid;
+
+/// The Earth of the model: WGS 84, a = 6 378 137 m, f = 1/298.257223563.
+pub const EARTH: Ellipsoid = Ellipsoid::WGS84;
+/// The Earth's rotation rate (rad/s): 7.292 115 9e-5 (IERS), core-math's.
+pub const EARTH_RATE_RAD_S: f64 = core_math::EARTH_RATE_RAD_S;
+
+/// Controller settings (defaults: `Config::default()`; rationale in docs/controller.md).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Config {
+    /// Time between updates (us). Default 20 ms (docs/controller.md, "The update rate").
+    pub update_period_us: u64,
+    /// No valid NAV frame for longer than this (us) is a [`Fault::Stale`](crate::Fault::Stale) and stops
+    /// updates. It is also how far ahead a NAV frame's attitude is propagated when it
+    /// is checked against the scene's envelope.
+    pub stale_after_us: u64,
+    /// Largest step (us) a time tag may take ahead of the controller's clock. A tag
+    /// further ahead is refused ([`Fault::TimeJump`](crate::Fault::TimeJump)) unless the next frame confirms
+    /// the new time line (a re-synchronisation, docs/telemetry.md "Time").
+    pub max_time_jump_us: u64,
+    /// The mission's altitude band above the ellipsoid (m): NAV frames whose |r| is
+    /// outside b + low ..= a + high are refused, and scenes are planned and the period
+    /// guard set for it.
+    pub altitude_range_m: (f64, f64),
+}
+
+impl Default for Config {
+    fn default() -> Self {
+        Config {
+            update_period_us: 20_000,
+            stale_after_us: 1_000_000,
+            max_time_jump_us: 5_000_000,
+            altitude_range_m: (500e3, 800e3),
+        }
+    }
+}
+
+/// Largest time tag the clock takes (us, 2^53: 285 years). Up to it every tag is exact
+/// in f64, and the schedule's sums cannot overflow.
+pub const MAX_TIME_TAG_US: u64 = 1 << 53;

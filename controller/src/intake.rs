@@ -1,0 +1,182 @@
+//! Frame intake: frames to state. Each decoded frame's time tag is checked against the
+//! time window (with re-synchronisation to a new time line), then its content: a NAV
+//! frame against the mission's orbit and the scene's attitude envelope, a SCENE frame by
+//! planning it, a TERRAIN frame against the scene in force. A refused frame leaves the
+//! state as it was and is counted ([`Controller::reject`]).
+
+use core_math::earth::Attitude;
+
+use crate::config::{EARTH, MAX_TIME_TAG_US};
+use crate::control::{Controller, NavState};
+use crate::fault::Fault;
+use crate::frame::{kind, Frame};
+use crate::nav::{Nav, Propagator};
+use crate::plan::{MAX_SPEED2_RATIO, MIN_SPEED2_RATIO};
+use crate::scene::{AttitudeEnvelope, Scene, Terrain};
+
+impl Controller {
+    /// One decoded frame. Its time tag moves the controller's clock forward.
+    ///
+    /// The time window (docs/telemetry.md "Time"): a tag is taken when it is after the
+    /// last accepted one and at most `max_time_jump_us` ahead of the clock (any tag up
+    /// to [`MAX_TIME_TAG_US`] before the first frame). A tag outside it is refused, but
+    /// remembered: if the very next frame is valid and lies after it by at most the
+    /// jump, the two agree on a new time line and the clock re-synchronises to it.
+    pub fn on_frame(&mut self, frame: &Frame<'_>) {
+        let t = frame.time_us;
+        let candidate = self.resync_candidate_us.take();
+        let resync = match self.time_check(t) {
+            Ok(()) => false,
+            Err(f) => {
+                let confirms = candidate.is_some_and(|c| {
+                    t > c && t - c <= self.config.max_time_jump_us && t <= MAX_TIME_TAG_US
+                });
+                if !confirms {
+                    // A tag the clock can never take cannot start a new time line.
+                    if t <= MAX_TIME_TAG_US {
+                        self.resync_candidate_us = Some(t);
+                    }
+                    return self.reject(f);
+                }
+                true
+            }
+        };
+        if resync {
+            // Content first: a frame refused for its content re-synchronises nothing.
+            if let Err(f) = self.check_content(frame) {
+                return self.reject(f);
+            }
+            self.resynchronise(t);
+        }
+        let result = self.apply(frame);
+        match result {
+            Ok(()) => {
+                self.frames_accepted = self.frames_accepted.saturating_add(1);
+                self.last_time_us = Some(t);
+                self.now_us = self.now_us.max(t);
+            }
+            Err(f) => self.reject(f),
+        }
+    }
+
+    /// Whether `t_us` lies in the time window.
+    fn time_check(&self, t_us: u64) -> Result<(), Fault> {
+        if t_us > MAX_TIME_TAG_US {
+            return Err(Fault::TimeJump);
+        }
+        let Some(last) = self.last_time_us else {
+            return Ok(());
+        };
+        if t_us <= last {
+            return Err(Fault::TimeWentBackwards);
+        }
+        // `now_us` <= MAX_TIME_TAG_US, but the jump is configuration: saturate.
+        if t_us > self.now_us.saturating_add(self.config.max_time_jump_us) {
+            return Err(Fault::TimeJump);
+        }
+        Ok(())
+    }
+
+    /// The checks `apply` makes, without their effect (a SCENE's plan is built in the
+    /// spare plan, which only a successful `set_scene` puts in force).
+    fn check_content(&mut self, frame: &Frame<'_>) -> Result<(), Fault> {
+        match frame.kind {
+            kind::NAV => self.check_nav(frame).map(|_| ()),
+            kind::SCENE => {
+                let scene = Scene::decode(frame.payload)?;
+                self.spare_plan.build_into(&scene, &self.config, false)
+            }
+            kind::TERRAIN => Terrain::decode(frame.payload, &self.scene).map(|_| ()),
+            kind::TIME if frame.payload.is_empty() => Ok(()),
+            kind::TIME => Err(Fault::BadLength),
+            _ => Err(Fault::UnknownKind),
+        }
+    }
+
+    /// A new time line from `t_us` on: the NAV state of the old one cannot be
+    /// propagated across the discontinuity, so it is dropped (mode waiting for NAV, the
+    /// periods in force held), and the next update is the one due at the new clock.
+    fn resynchronise(&mut self, t_us: u64) {
+        self.time_resyncs = self.time_resyncs.saturating_add(1);
+        self.last_time_us = None;
+        self.now_us = t_us;
+        self.next_update_us = 0;
+        self.nav = None;
+        self.hold_all();
+    }
+
+    fn apply(&mut self, frame: &Frame<'_>) -> Result<(), Fault> {
+        match frame.kind {
+            kind::NAV => self.accept_nav(frame),
+            kind::SCENE => self.accept_scene(frame.payload),
+            kind::TERRAIN => {
+                let terrain = Terrain::decode(frame.payload, &self.scene)?;
+                self.heights_m = terrain.heights_m;
+                Ok(())
+            }
+            kind::TIME if frame.payload.is_empty() => Ok(()),
+            kind::TIME => Err(Fault::BadLength),
+            _ => Err(Fault::UnknownKind),
+        }
+    }
+
+    fn accept_nav(&mut self, frame: &Frame<'_>) -> Result<(), Fault> {
+        self.nav = Some(self.check_nav(frame)?);
+        Ok(())
+    }
+
+    /// A NAV frame's checks: finite; an orbital frame; |r| in the altitude band and a
+    /// speed of an imaging orbit ([`MIN_SPEED2_RATIO`]..[`MAX_SPEED2_RATIO`] of the
+    /// circular speed squared) (`out_of_range`); the attitude inside the scene's
+    /// envelope at the frame's instant and propagated at its rates over every update it
+    /// may serve, one update period back (an update instant precedes the frame's tag by
+    /// up to that) to `stale_after` ahead (`attitude_outside_model`).
+    fn check_nav(&self, frame: &Frame<'_>) -> Result<NavState, Fault> {
+        let nav = Nav::decode(frame.payload)?;
+        let r_m = nav.check_state()?;
+        let (h_lo, h_hi) = self.config.altitude_range_m;
+        if !(r_m >= EARTH.b_m() + h_lo && r_m <= EARTH.a_m + h_hi) {
+            return Err(Fault::OutOfRange);
+        }
+        let v = nav.state.velocity_mps;
+        let speed2_ratio = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) * r_m / core_math::GM_M3_S2;
+        if !(MIN_SPEED2_RATIO..=MAX_SPEED2_RATIO).contains(&speed2_ratio) {
+            return Err(Fault::OutOfRange);
+        }
+        let back_s = self.config.update_period_us as f32 * 1e-6;
+        let ahead_s = self.config.stale_after_us as f32 * 1e-6;
+        if !inside_envelope(&nav.attitude, &self.plan.envelope, back_s, ahead_s) {
+            return Err(Fault::AttitudeOutsideModel);
+        }
+        // Any yaw is allowed: wrapped once here (in f64: an f32 yaw of any size), the
+        // per-update trigonometry then works near zero.
+        let yaw = libm::remainder(f64::from(nav.attitude.yaw_rad), 2.0 * core::f64::consts::PI);
+        Ok(NavState {
+            time_us: frame.time_us,
+            propagator: Propagator::new(&nav.state),
+            attitude: Attitude {
+                yaw_rad: yaw as f32,
+                ..nav.attitude
+            },
+        })
+    }
+
+    fn accept_scene(&mut self, payload: &[u8]) -> Result<(), Fault> {
+        self.set_scene(Scene::decode(payload)?)
+    }
+}
+
+/// Whether `a` and its propagation at its rates `back_s` before and `ahead_s` after its
+/// instant stay inside `env` (linear in time: the ends are the extremes).
+fn inside_envelope(a: &Attitude<f32>, env: &AttitudeEnvelope, back_s: f32, ahead_s: f32) -> bool {
+    let rates = [a.roll_rate_rad_s, a.pitch_rate_rad_s, a.yaw_rate_rad_s];
+    let angle_ok = |x: f32, rate: f32, max: f32| {
+        [x, x - rate * back_s, x + rate * ahead_s]
+            .iter()
+            .all(|y| y.abs() <= max)
+    };
+    // Yaw is free (finite: `Nav::check_state`).
+    rates.iter().all(|r| r.abs() <= env.max_rate_rad_s)
+        && angle_ok(a.roll_rad, a.roll_rate_rad_s, env.max_roll_rad)
+        && angle_ok(a.pitch_rad, a.pitch_rate_rad_s, env.max_pitch_rad)
+}

@@ -1,0 +1,426 @@
+//! The update: state to periods. At every update instant, the NAV state propagated to
+//! it, each active segment's line period, its MTF (mismatch times drift smear) and TDI
+//! stage limit, its drift angles, and the yaw steering request; the periods written
+//! through a [`LinePeriodSink`]. A refused computation leaves that segment's last good
+//! period in force, and nothing outside the physically possible period range is ever
+//! written. Which parts are out of line, and why: docs/controller.md.
+
+use core_math::earth::{GeneralRowMotion, GeneralUpdate};
+use core_math::ImageMotion;
+use core_math::{nearest_ticks, sinc, Backend, Real, GENERAL_F32};
+
+use crate::config::{EARTH, EARTH_RATE_RAD_S, MAX_TIME_TAG_US};
+use crate::control::{Controller, Mode, SegmentOutput};
+use crate::fault::Fault;
+use crate::nav::attitude_at;
+use crate::plan::SegmentPlan;
+use crate::sink::LinePeriodSink;
+
+impl Controller {
+    /// Moves the clock to `now_us` (from the time source) and runs the update that is due,
+    /// if any, writing periods to `sink`. Returns true when an update ran.
+    pub fn advance<S: LinePeriodSink>(&mut self, now_us: u64, sink: &mut S) -> bool {
+        // The clock never passes the largest tag, whatever the time source says: past
+        // it no frame could be accepted again.
+        self.now_us = self.now_us.max(now_us.min(MAX_TIME_TAG_US));
+        if self.now_us < self.next_update_us {
+            return false;
+        }
+        // Only the latest due instant is computed: after a gap, catching up on missed
+        // updates would only delay the current one.
+        let period = self.config.update_period_us.max(1);
+        // The instant due is the one scheduled, unless the clock has passed the next one
+        // too or the period was changed: a 64-bit division (a software call here) only
+        // then.
+        let t = if period == self.scheduled_period_us && self.now_us - self.next_update_us < period
+        {
+            self.next_update_us
+        } else {
+            self.now_us - self.now_us % period
+        };
+        self.scheduled_period_us = period;
+        // t <= MAX_TIME_TAG_US; saturating all the same, for any configured period.
+        self.next_update_us = t.saturating_add(period);
+        self.last_update_us = Some(t);
+        self.updates = self.updates.saturating_add(1);
+        let previous = self.update_mode;
+        self.update_mode = self.mode_at(t);
+        // One stale episode is a run of updates in mode stale: so the counter equals
+        // the PERIODS frames in mode stale whose predecessor was not.
+        if self.update_mode == Mode::Stale && previous != Mode::Stale {
+            self.reject(Fault::Stale);
+        }
+        self.update_at(t, sink);
+        true
+    }
+
+    fn update_at<S: LinePeriodSink>(&mut self, t_us: u64, sink: &mut S) {
+        self.yaw_request_rad = None;
+        let Some(nav) = self.nav else { return };
+        if self.update_mode == Mode::Stale {
+            self.hold_all();
+            return;
+        }
+        // Not stale: t - t_nav lies in [-update period, stale_after], both < 2^53 us:
+        // the difference is exact in i64 and small in f32. Converted from i32 when it
+        // fits (one instruction; from i64 it is a software call), to the same f32.
+        let dt_us = (t_us as i64).wrapping_sub(nav.time_us as i64);
+        let dt_s = match i32::try_from(dt_us) {
+            Ok(dt) => dt as f32,
+            Err(_) => i64_to_f32(dt_us),
+        } * 1e-6;
+        let state = nav.propagator.parts_at(dt_s);
+        let attitude = attitude_at(&nav.attitude, dt_s);
+        let instant = match GENERAL_F32.instant_parts(
+            state.position_m,
+            state.velocity_mps,
+            state.r2_minus_a2_m2,
+            &attitude,
+            EARTH_RATE_RAD_S as f32,
+        ) {
+            Ok(i) => i,
+            Err(e) => {
+                self.reject(Fault::from(e));
+                self.hold_all();
+                return;
+            }
+        };
+        // The yaw steering request: at the boresight a turn about it turns (v1, v2) by
+        // the turn and changes nothing else, so atan(v2/v1) there zeroes its drift.
+        let boresight_h = self.height(self.plan.boresight_segment);
+        let steer = GENERAL_F32
+            .ground(&instant, &EARTH, boresight_h)
+            .and_then(|u| GENERAL_F32.motion(&u, &self.plan.boresight))
+            .ok()
+            .and_then(|m| {
+                let speed = Real::sqrt(m.v1_mps * m.v1_mps + m.v2_mps * m.v2_mps);
+                let sign = if m.v1_mps < 0.0 { -1.0 } else { 1.0 };
+                let (sin, cos) = (sign * m.v2_mps / speed, sign * m.v1_mps / speed);
+                (sin.is_finite() && cos.is_finite())
+                    .then(|| (sin, cos, drift_angle_rad(m.v2_mps / m.v1_mps)))
+            });
+        self.yaw_request_rad = steer.map(|(_, _, rad)| rad);
+        // Output slots by `get` (`index` < MAX_SEGMENTS by construction of the plan): no
+        // panic path (docs/no-panic.md).
+        // Segments over the same ground height share its update: made once per height
+        // in a row (a flat scene makes one, terrain one per segment). It stays in one
+        // place in memory, which the out-of-line `segment` and `extremes` read.
+        let mut ground_h_m = f32::NAN;
+        let mut ground: Result<GeneralUpdate<f32>, Fault> = Err(Fault::OutOfRange);
+        for k in 0..self.plan.segments.len() {
+            let Some(seg) = self.plan.segments.get(k) else {
+                break;
+            };
+            let index = seg.index;
+            let height_m = self.height(index);
+            // NaN never equals: the first segment makes the first ground.
+            if height_m != ground_h_m {
+                ground = GENERAL_F32
+                    .ground(&instant, &EARTH, height_m)
+                    .map_err(Fault::from);
+                ground_h_m = height_m;
+            }
+            let result = match &ground {
+                Ok(update) => self.segment(update, seg, steer),
+                Err(f) => Err(*f),
+            };
+            let slot = usize::from(index);
+            match result {
+                Ok(out) => {
+                    // Only a period inside the physical range reaches a register.
+                    if sink.write_period(index, out.ticks).is_ok() {
+                        if let (Some(o), Some(h)) =
+                            (self.outputs.get_mut(slot), self.has_output.get_mut(slot))
+                        {
+                            *o = out;
+                            *h = true;
+                        }
+                    } else if let Some(o) = self.outputs.get_mut(slot) {
+                        // The register kept its old period: report it as held, not as
+                        // the new value.
+                        o.held = true;
+                    }
+                }
+                Err(f) => {
+                    self.reject(f);
+                    if let Some(o) = self.outputs.get_mut(slot) {
+                        o.held = true;
+                    }
+                }
+            }
+        }
+    }
+
+    fn height(&self, index: u8) -> f32 {
+        self.heights_m
+            .get(usize::from(index))
+            .copied()
+            .unwrap_or(0.0)
+    }
+
+    /// Out of line, so that the plan's values it reads are loaded where they are used:
+    /// inlined into the update's loop, they were hoisted out of it into registers that
+    /// every call in the segment's work then saved and restored (the counts:
+    /// docs/controller.md, "What it costs").
+    #[inline(never)]
+    fn segment(
+        &self,
+        update: &GeneralUpdate<f32>,
+        seg: &SegmentPlan,
+        steer: Option<(f32, f32, f32)>,
+    ) -> Result<SegmentOutput, Fault> {
+        // |v1| extremes and the largest |v2/v1| over the samples and the centre; every
+        // one must move the same way along P1 (one transfer direction per segment). In
+        // forward flight the image moves towards -P1 (the ground runs backwards under
+        // the camera); towards +P1 is the reversed transfer.
+        // The samples and the centre lie on the segment's row: its constants once, then
+        // about twenty operations a pixel.
+        let Extremes {
+            centre,
+            lo,
+            hi,
+            drift_v2,
+            drift_v1,
+        } = extremes(update, seg)?;
+        let reversed = centre.v1_mps > 0.0;
+        let tan_centre = centre.v2_mps / centre.v1_mps;
+        // v1's extremes are tracked signed, and its sign checked once after the loop;
+        // the largest |v2/v1| as the pair (|v2|, |v1|) that gives it, compared by
+        // cross-multiplying (|v1| > 0): one division at the end, not one a pixel. The loop
+        // keeps no error exit of its own, so none of the exit's work is hoisted into it.
+        // Every sample must move the same way as the centre (one transfer direction per
+        // segment).
+        let (v_min, v_max) = if reversed { (lo, hi) } else { (-hi, -lo) };
+        if !(v_min > 0.0) {
+            return Err(Fault::PeriodOutOfRange);
+        }
+        let tan_max = drift_v2 / drift_v1;
+        // The period minimising the worst relative mismatch over [v_min, v_max]: the
+        // line speed equal to the harmonic mean of the extremes, i.e. the mean of the
+        // extremes' periods.
+        let a = self.plan.pixel_m;
+        let period_s = 0.5 * (a / v_min + a / v_max);
+        let (lo, hi) = self.plan.period_bounds_s;
+        if !(period_s >= lo && period_s <= hi) {
+            return Err(Fault::PeriodOutOfRange);
+        }
+        // The clock was checked when the scene arrived and the period just above:
+        // only the rounding to whole ticks is left (`line_period_ticks` less its input
+        // checks, a tenth of a segment's work).
+        let ticks = nearest_ticks(period_s * self.plan.line_clock_hz).map_err(Fault::from)?;
+        // The mismatch of the period actually programmed, rounding to ticks included,
+        // against the range v1 may take between the samples.
+        let v_line = a * self.plan.line_clock_hz / ticks as f32;
+        let (v_lo, v_hi) = (v_min - seg.interpolation_mps, v_max + seg.interpolation_mps);
+        let stages = u32::from(seg.tdi_stages);
+        let (worst_mismatch, mtf, max_stages) = if v_lo > 0.0 {
+            let (below, above) = ((v_line / v_lo - 1.0).abs(), (1.0 - v_line / v_hi).abs());
+            let worst = if below > above { below } else { above };
+            let half_pi_m = core::f32::consts::FRAC_PI_2 * stages as f32;
+            // Past the sinc's first zero no contrast is left; its negative lobe is a
+            // phase reversal, not an MTF below 0. Never above 1: the polynomial's
+            // (sinc(x) - 1) / x^2 part is negative on its whole range, and past pi
+            // |sinc| < 1/pi.
+            let contrast = |x: f32| {
+                let s = sinc(x);
+                if s > 0.0 {
+                    s
+                } else {
+                    0.0
+                }
+            };
+            let mtf = contrast(half_pi_m * worst) * contrast(half_pi_m * tan_max);
+            let m = self
+                .plan
+                .stage_rule
+                .max_stages_with_drift(worst, tan_max, u32::from(self.plan.max_stages))
+                .map_err(Fault::from)?;
+            (worst, mtf, m as u16)
+        } else {
+            // The image is slower than the interpolation bound: no bound on the
+            // mismatch, no contrast promised.
+            (f32::MAX, 0.0, 0)
+        };
+        let tan_residual = match steer {
+            Some((sin, cos, _)) => {
+                let m = steered_centre(update, seg, sin, cos)?;
+                m.v2_mps / m.v1_mps
+            }
+            None => tan_centre,
+        };
+        let [drift_rad, worst_drift_rad, residual_drift_rad] =
+            drift_angles_rad(tan_centre, tan_max, tan_residual);
+        Ok(SegmentOutput {
+            index: seg.index,
+            ticks,
+            worst_mismatch,
+            mtf,
+            max_stages,
+            drift_rad,
+            worst_drift_rad,
+            residual_drift_rad,
+            reversed,
+            held: false,
+        })
+    }
+}
+
+/// `x as f32` out of line: inline, LLVM evaluated it (a software call) beside the
+/// one-instruction i32 conversion on every update, then picked one.
+#[cold]
+#[inline(never)]
+fn i64_to_f32(x: i64) -> f32 {
+    x as f32
+}
+
+/// What a segment's samples show: v1's signed extremes, and the (|v2|, |v1|) of the
+/// largest |v2/v1| over the samples and the centre.
+struct Extremes {
+    centre: ImageMotion<f32>,
+    lo: f32,
+    hi: f32,
+    drift_v2: f32,
+    drift_v1: f32,
+}
+
+/// The segment's row at this update, its centre, and the samples' [`Extremes`] (the
+/// centre's drift included).
+///
+/// Its own function, never inlined: the loop's square root is a call
+/// (`core_math::sqrt`), which clobbers s0-s15; inlined into `segment`, whose values
+/// then live across it, every sample reloaded many of them. Here the row's constants
+/// and the running extremes nearly fit the callee-saved s16-s31. The row is formed here
+/// from the update in memory: formed by the caller and passed by reference, its
+/// constants went through the stack. The steered centre stays out of here: computed in
+/// here too, it made the update's values reload across the calls. (The counts:
+/// docs/controller.md, "What it costs".)
+#[inline(never)]
+fn extremes(update: &GeneralUpdate<f32>, seg: &SegmentPlan) -> Result<Extremes, Fault> {
+    let row = GENERAL_F32.row_motion(update, &seg.row);
+    // The samples run from the segment's first pixel to its last, the centre between:
+    // when both ends face the ground, every pixel does, and each one costs one check
+    // instead of three (`GeneralRowMotion::motion_at_facing`: the same results and
+    // errors). Otherwise some pixel misses, and the checked route finds which first.
+    let ends = (seg.samples.get(1), seg.samples.last());
+    match ends {
+        (Some(a), Some(b)) if row.faces_ground_over(a.p2_m, b.p2_m) => {
+            sweep(seg, |p2| row.motion_at_facing(p2))
+        }
+        _ => sweep_checked(&row, seg),
+    }
+}
+
+#[cold]
+#[inline(never)]
+fn sweep_checked(row: &GeneralRowMotion<f32>, seg: &SegmentPlan) -> Result<Extremes, Fault> {
+    sweep(seg, |p2| row.motion_at(p2))
+}
+
+/// The centre's motion, then the extremes over the centre and the samples, by
+/// `motion_at` (`SegmentPlan::samples`: the centre first).
+#[inline(always)]
+fn sweep(
+    seg: &SegmentPlan,
+    motion_at: impl Fn(f32) -> Result<ImageMotion<f32>, core_math::ModelError>,
+) -> Result<Extremes, Fault> {
+    let Some((first, samples)) = seg.samples.split_first() else {
+        return Err(Fault::InvalidScene);
+    };
+    let centre = motion_at(first.p2_m)?;
+    // Comparisons, not f32::min/max: those are software calls on this core
+    // (fminf/fmaxf, NaN handling). `motion_at` refuses a NaN v1.
+    let mut e = Extremes {
+        centre,
+        lo: centre.v1_mps,
+        hi: centre.v1_mps,
+        drift_v2: centre.v2_mps.abs(),
+        drift_v1: centre.v1_mps.abs(),
+    };
+    for sample in samples {
+        let m = motion_at(sample.p2_m)?;
+        if m.v1_mps < e.lo {
+            e.lo = m.v1_mps;
+        }
+        if m.v1_mps > e.hi {
+            e.hi = m.v1_mps;
+        }
+        let (v1, v2) = (m.v1_mps.abs(), m.v2_mps.abs());
+        if v2 * e.drift_v1 > e.drift_v2 * v1 {
+            (e.drift_v2, e.drift_v1) = (v2, v1);
+        }
+    }
+    Ok(e)
+}
+
+/// The segment's centre pixel seen by the camera turned by the yaw request
+/// (`General::motion_yawed`).
+#[inline(always)]
+fn steered_centre(
+    update: &GeneralUpdate<f32>,
+    seg: &SegmentPlan,
+    sin: f32,
+    cos: f32,
+) -> Result<ImageMotion<f32>, core_math::ModelError> {
+    GENERAL_F32.motion_yawed(update, &seg.centre, sin, cos)
+}
+
+/// A segment's drift angles from their tangents: at the centre, the worst (`tan_max`
+/// >= |`tan_centre`|), and the steered centre's.
+///
+/// The worst is the centre's magnitude plus atan of the tangent of their difference,
+/// (tan_max - |t|) / (1 + tan_max |t|): a small tangent, which `atan_f32` takes without
+/// reduction, where the worst drift itself (0.8 rad in a roll slew) needs one; and the
+/// sum is never below the centre's.
+#[inline(always)]
+fn drift_angles_rad(tan_centre: f32, tan_max: f32, tan_residual: f32) -> [f32; 3] {
+    let centre_rad = drift_angle_rad(tan_centre);
+    let t = tan_centre.abs();
+    let beyond_rad = drift_angle_rad((tan_max - t) / (1.0 + tan_max * t));
+    [
+        centre_rad,
+        centre_rad.abs() + beyond_rad,
+        drift_angle_rad(tan_residual),
+    ]
+}
+
+/// The drift angle atan(t) (rad) of a drift tangent t = v2/v1: `core_math::trig::atan_f32`
+/// (accurate to a few ulp, and cheaper than libm's `atanf`: docs/controller.md), which
+/// the drift smear of keystoned outer segments (|t| up to 0.3 at 20 deg of pitch) needs
+/// beyond any short series.
+#[inline(always)]
+pub fn drift_angle_rad(t: f32) -> f32 {
+    core_math::trig::atan_f32(t)
+}
+
+#[cfg(test)]
+mod tests {
+    extern crate std;
+    use super::drift_angles_rad;
+
+    /// The three drift angles against atan in f64: the worst one by its difference form
+    /// within 4 f32 ulp of 1 rad, never below the centre's magnitude.
+    #[test]
+    fn drift_angles_match_atan() {
+        let mut rng = core_math::sample::SplitMix64(0x5EED_2026_1124);
+        let mut next = || rng.uniform(0.0, 1.0);
+        let mut worst_err = 0f64;
+        for _ in 0..200_000 {
+            // Tangents over drifts of 0 to 1.5 rad, either sign.
+            let c = libm::tan(1.5 * next()) * if next() < 0.5 { -1.0 } else { 1.0 };
+            let m = libm::fabs(c) + libm::tan(1.5 * next()) * next();
+            let r = libm::tan(0.3 * next() - 0.15);
+            let (c, m, r) = (c as f32, (m as f32).max((c as f32).abs()), r as f32);
+            let [dc, dm, dr] = drift_angles_rad(c, m, r);
+            for (got, t) in [(dc, c), (dm, m), (dr, r)] {
+                let want = libm::atan(f64::from(t));
+                worst_err = worst_err.max(libm::fabs(f64::from(got) - want));
+            }
+            assert!(dm >= dc.abs(), "{c} {m}: {dm} < |{dc}|");
+        }
+        assert!(
+            worst_err <= 4.0 * f64::from(f32::EPSILON) / 2.0,
+            "{worst_err:e}"
+        );
+        std::eprintln!("drift angles: worst error {worst_err:.2e} rad");
+    }
+}
