@@ -42,6 +42,10 @@ pub enum Param {
     Longitude,
     /// A geodetic height above the ellipsoid.
     Height,
+    /// The camera's axes in I (the matrix B of an [`crate::earth::InertialAttitude`]).
+    CameraAxes,
+    /// The camera's angular velocity relative to I, in camera coordinates.
+    AngularVelocity,
 }
 
 impl Param {
@@ -78,6 +82,8 @@ impl Param {
             Param::Latitude => "latitude",
             Param::Longitude => "longitude",
             Param::Height => "height",
+            Param::CameraAxes => "camera_axes",
+            Param::AngularVelocity => "angular_velocity",
         }
     }
 }
