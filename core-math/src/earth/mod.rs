@@ -25,6 +25,7 @@ use crate::orbit::StateVector;
 use crate::real::{Real, Scalar};
 use crate::vector::{cross, dot};
 
+pub mod bus;
 pub mod frames;
 pub mod general;
 #[cfg(feature = "reference")]
@@ -267,8 +268,8 @@ impl EarthGeometry<f64> {
 }
 
 /// [`EarthGeometry`] with Part II's attitude: the camera's axes in I and its angular
-/// velocity ([`InertialAttitude`]: what a star tracker's quaternion and the gyros'
-/// rates give). Everything else as in Part I. The backends take it through
+/// velocity ([`InertialAttitude`], from the bus's quaternion and gyro rates by
+/// [`bus::bus_geometry`]). Everything else as in Part I. The backends take it through
 /// their own entry points (`EarthReference::chain_inertial`,
 /// `General::update_inertial`), whose update is the same type as Part I's: the
 /// per-pixel work does not change.
