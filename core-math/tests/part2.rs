@@ -5,20 +5,24 @@
 //!
 //! - Part I's attitudes re-expressed as axes and angular velocity give Part I's motion
 //!   (reference, general f64 and f32);
+//! - the independent goldens of `tools/goldens/part2_motion.py`
+//!   (`tests/data/part2_motion.csv`: mpmath, its own quaternions and intersection, ERFA's
+//!   C2T) against the reference and the general forms, first with ERFA's C2T from the
+//!   row, then with the crate's own C2T within the effect of its documented error;
 //! - the typed refusals.
 //!
 //! `cargo test --release -p core-math --test part2 -- --nocapture` prints the measured
-//! maxima.
+//! maxima quoted in `docs/earth-model.md`, "Part II: bus inputs".
 
 use core_math::accuracy::{
     earth_kappa, EARTH_F32_KAPPA_LIMIT, EARTH_F32_REL_TOLERANCE, EARTH_F64_REL_TOLERANCE,
 };
 use core_math::dual::Dual;
 use core_math::earth::bus::{
-    bus_geometry, dps_to_rad_s, needs_c2t, quaternion_matrix, AttitudeFrame, BusAttitude, BusState,
-    BusTime, StateFrame, IDENTITY_QUATERNION,
+    bus_geometry, bus_geometry_with_c2t, dps_to_rad_s, needs_c2t, quaternion_matrix, AttitudeFrame,
+    BusAttitude, BusState, BusTime, StateFrame, IDENTITY_QUATERNION,
 };
-use core_math::earth::frames::{Mat3, TimeScales};
+use core_math::earth::frames::{Mat3, TimeScales, C2T_TOLERANCE_RAD};
 use core_math::earth::reference::{EarthRefPixel, ReferenceGeometry};
 use core_math::earth::{limb_margin_rad, InertialAttitude, InertialGeometry, MAX_AXES_ERROR};
 use core_math::sample::SplitMix64;
@@ -26,6 +30,14 @@ use core_math::{
     Backend, EarthCamera, EarthReference, Ellipsoid, ImageMotion, ModelError, Param, StateVector,
     EARTH_RATE_RAD_S, GENERAL_F32, GENERAL_F64,
 };
+
+const CSV: &str = include_str!("data/part2_motion.csv");
+
+/// Tolerances of the golden comparison (relative, |dv| / |v|): the reference and the
+/// general f64 form against the independent evaluation, and the f32 form (its update
+/// computed in f32 from the f64 axes rounded).
+const GOLDEN_F64_REL: f64 = 1.0e-9;
+const GOLDEN_F32_REL: f64 = 2.0e-6;
 
 fn rel(m: &ImageMotion<f64>, r: &ImageMotion<f64>) -> f64 {
     libm::hypot(m.v1_mps - r.v1_mps, m.v2_mps - r.v2_mps) / libm::hypot(r.v1_mps, r.v2_mps)
@@ -131,6 +143,198 @@ fn part_one_attitudes_as_axes_give_part_one_motion() {
          >= 1 deg inside the limb)"
     );
     assert!(n > 3_000 && n_f32 > 1_000);
+}
+
+/// One golden row.
+struct Golden {
+    case: u32,
+    state: BusState,
+    attitude: BusAttitude,
+    time: BusTime,
+    ground_h_m: f64,
+    ellipsoid: Ellipsoid,
+    earth_rate_rad_s: f64,
+    camera: EarthCamera,
+    n_px: f64,
+    c2t_erfa: Option<Mat3>,
+    motion: ImageMotion<f64>,
+}
+
+fn goldens() -> Vec<Golden> {
+    let mut lines = CSV.lines();
+    let head: Vec<&str> = lines.next().unwrap().split(',').collect();
+    lines
+        .map(|line| {
+            let fields: Vec<&str> = line.split(',').collect();
+            let s = |name: &str| fields[head.iter().position(|h| *h == name).expect(name)];
+            let f = |name: &str| s(name).parse::<f64>().expect(name);
+            let opt = |name: &str| (!s(name).is_empty()).then(|| f(name));
+            let v3 = |a: &str, b: &str, c: &str| [f(a), f(b), f(c)];
+            let q4 = |p: &str| {
+                [
+                    f(&format!("{p}qw")),
+                    f(&format!("{p}qx")),
+                    f(&format!("{p}qy")),
+                    f(&format!("{p}qz")),
+                ]
+            };
+            let c2t_erfa = opt("c2t_00").map(|_| {
+                core::array::from_fn(|i| core::array::from_fn(|j| f(&format!("c2t_{i}{j}"))))
+            });
+            Golden {
+                case: f("case") as u32,
+                state: BusState {
+                    frame: match s("frame") {
+                        "inertial" => StateFrame::Inertial,
+                        "itrf" => StateFrame::Itrf,
+                        "gcrf" => StateFrame::Gcrf,
+                        x => panic!("frame {x}"),
+                    },
+                    position_m: v3("x_m", "y_m", "z_m"),
+                    velocity_mps: v3("vx_mps", "vy_mps", "vz_mps"),
+                },
+                attitude: BusAttitude {
+                    q: q4(""),
+                    frame: match s("attitude_frame") {
+                        "gcrf" => AttitudeFrame::Gcrf,
+                        "itrf" => AttitudeFrame::Itrf,
+                        x => panic!("attitude_frame {x}"),
+                    },
+                    body_rate_rad_s: dps_to_rad_s(v3("wx_dps", "wy_dps", "wz_dps")),
+                    camera_q: q4("cam_"),
+                },
+                time: BusTime {
+                    gps_s: opt("gps_s"),
+                    scales: TimeScales {
+                        gps_utc_s: f("gps_utc_s"),
+                        dut1_s: f("dut1_s"),
+                    },
+                },
+                ground_h_m: f("ground_h_m"),
+                ellipsoid: Ellipsoid {
+                    a_m: f("a_m"),
+                    flattening: f("flattening"),
+                },
+                earth_rate_rad_s: f("earth_rate_rad_s"),
+                camera: EarthCamera {
+                    focal_m: f("f_m"),
+                    pixel_m: f("pixel_m"),
+                    p1_m: f("p1_m"),
+                },
+                n_px: f("n_px"),
+                c2t_erfa,
+                motion: ImageMotion {
+                    v1_mps: f("v1_mps"),
+                    v2_mps: f("v2_mps"),
+                },
+            }
+        })
+        .collect()
+}
+
+impl Golden {
+    fn geometry_with(&self, c2t: Option<&Mat3>) -> Result<InertialGeometry<f64>, ModelError> {
+        bus_geometry_with_c2t(
+            &self.state,
+            &self.attitude,
+            c2t,
+            self.ground_h_m,
+            self.ellipsoid,
+            self.earth_rate_rad_s,
+        )
+    }
+}
+
+/// R(angle about axis k) C: C2T turned by `angle` about I's axis k.
+fn turned(c2t: &Mat3, k: usize, angle: f64) -> Mat3 {
+    let (s, c) = libm::sincos(angle);
+    let (i, j) = ((k + 1) % 3, (k + 2) % 3);
+    let mut out = *c2t;
+    for col in 0..3 {
+        out[i][col] = c * c2t[i][col] - s * c2t[j][col];
+        out[j][col] = s * c2t[i][col] + c * c2t[j][col];
+    }
+    out
+}
+
+/// The independent goldens: with ERFA's C2T from the row, the reference and the general
+/// f64 form within 1e-9 and the f32 form within 2e-6 of the mpmath evaluation; with the
+/// crate's own C2T ([`core_math::earth::frames::c2t`]), the reference within 1e-9 plus
+/// the effect of C2T's documented error [`C2T_TOLERANCE_RAD`] on that row (the largest
+/// change of the reference's motion when ERFA's C2T is turned by that angle about
+/// either sense of each axis of I).
+#[test]
+fn the_independent_goldens() {
+    let rows = goldens();
+    assert!(rows.len() >= 300);
+    let mut worst = [0f64; 3];
+    let (mut worst_own, mut worst_allowance, mut worst_own_excess, mut n_c2t) =
+        (0f64, 0f64, 0f64, 0);
+    for row in &rows {
+        assert_eq!(needs_c2t(&row.state, &row.attitude), row.c2t_erfa.is_some());
+        let g = row.geometry_with(row.c2t_erfa.as_ref()).unwrap();
+        let results = eval_all(&row.camera, &g, row.n_px);
+        for (k, (res, tol)) in results
+            .iter()
+            .zip([GOLDEN_F64_REL, GOLDEN_F64_REL, GOLDEN_F32_REL])
+            .enumerate()
+        {
+            let m = res.unwrap_or_else(|e| panic!("case {}: backend {k}: {e}", row.case));
+            let e = rel(&m, &row.motion);
+            assert!(e <= tol, "case {}: backend {k}: {e:e}", row.case);
+            worst[k] = worst[k].max(e);
+        }
+
+        // The whole bus path, C2T the crate's own.
+        let own = bus_geometry(
+            &row.state,
+            &row.attitude,
+            &row.time,
+            row.ground_h_m,
+            row.ellipsoid,
+            row.earth_rate_rad_s,
+        )
+        .unwrap();
+        let [r_own, g_own, _] = eval_all(&row.camera, &own, row.n_px);
+        let (r_own, g_own) = (r_own.unwrap(), g_own.unwrap());
+        let e_own = rel(&r_own, &row.motion);
+        let allowance = match &row.c2t_erfa {
+            None => 0.0,
+            Some(c2t) => {
+                n_c2t += 1;
+                let mut a = 0f64;
+                for k in 0..3 {
+                    for sign in [-1.0, 1.0] {
+                        let g = row.geometry_with(Some(&turned(c2t, k, sign * C2T_TOLERANCE_RAD)));
+                        let [r, _, _] = eval_all(&row.camera, &g.unwrap(), row.n_px);
+                        a = a.max(rel(&r.unwrap(), &results[0].unwrap()));
+                    }
+                }
+                a
+            }
+        };
+        assert!(
+            e_own <= GOLDEN_F64_REL + allowance,
+            "case {}: own C2T {e_own:e}, allowance {allowance:e}",
+            row.case
+        );
+        assert!(rel(&g_own, &r_own) <= EARTH_F64_REL_TOLERANCE);
+        worst_own = worst_own.max(e_own);
+        worst_allowance = worst_allowance.max(allowance);
+        worst_own_excess = worst_own_excess.max(e_own - GOLDEN_F64_REL);
+    }
+    println!(
+        "Part II goldens ({} rows, {n_c2t} with C2T), ERFA's C2T: reference {:.2e}, \
+         general f64 {:.2e}, general f32 {:.2e}",
+        rows.len(),
+        worst[0],
+        worst[1],
+        worst[2]
+    );
+    println!(
+        "Part II goldens, the crate's C2T: reference {worst_own:.2e} (allowance for C2T's \
+         {C2T_TOLERANCE_RAD:.0e} rad: up to {worst_allowance:.2e})"
+    );
 }
 
 fn default_bus() -> (BusState, BusAttitude, BusTime) {
