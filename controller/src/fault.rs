@@ -108,6 +108,7 @@ impl From<ModelError> for Fault {
             | ModelError::NonPositivePixelPitch
             | ModelError::OutOfDomain(_)
             | ModelError::InvalidInput(_)
+            | ModelError::InvalidQuaternion(_)
             | ModelError::DegenerateState
             | ModelError::SatelliteNotAboveGround => Fault::OutOfRange,
         }

@@ -42,6 +42,16 @@ pub enum Param {
     Longitude,
     /// A geodetic height above the ellipsoid.
     Height,
+    /// The camera's axes in I (the matrix B of an [`crate::earth::InertialAttitude`]).
+    CameraAxes,
+    /// The camera's angular velocity relative to I, in camera coordinates.
+    AngularVelocity,
+    /// The bus's attitude quaternion `q` (Part II).
+    Quaternion,
+    /// The camera's mounting quaternion `cam_q` (Part II).
+    CameraQuaternion,
+    /// The body rates measured by the gyros (Part II).
+    BodyRate,
 }
 
 impl Param {
@@ -78,6 +88,11 @@ impl Param {
             Param::Latitude => "latitude",
             Param::Longitude => "longitude",
             Param::Height => "height",
+            Param::CameraAxes => "camera_axes",
+            Param::AngularVelocity => "angular_velocity",
+            Param::Quaternion => "quaternion",
+            Param::CameraQuaternion => "camera_quaternion",
+            Param::BodyRate => "body_rate",
         }
     }
 }
@@ -113,6 +128,9 @@ pub enum ModelError {
     /// Real-Earth model: v1 = 0 (no motion along the TDI direction: no line period, no
     /// drift angle).
     NoAlongTrackMotion,
+    /// Part II: a quaternion (the attitude `q` or the mounting `cam_q`, named by the
+    /// parameter) whose norm is not within 1e-3 of 1.
+    InvalidQuaternion(Param),
 }
 
 impl ModelError {
@@ -132,15 +150,17 @@ impl ModelError {
             ModelError::DegenerateState => "degenerate_state",
             ModelError::SatelliteNotAboveGround => "satellite_not_above_ground",
             ModelError::NoAlongTrackMotion => "no_along_track_motion",
+            ModelError::InvalidQuaternion(_) => "invalid_quaternion",
         }
     }
 
     /// The parameter concerned, where there is one.
     pub const fn param(self) -> Option<Param> {
         match self {
-            ModelError::NonFinite(p) | ModelError::OutOfDomain(p) | ModelError::InvalidInput(p) => {
-                Some(p)
-            }
+            ModelError::NonFinite(p)
+            | ModelError::OutOfDomain(p)
+            | ModelError::InvalidInput(p)
+            | ModelError::InvalidQuaternion(p) => Some(p),
             _ => None,
         }
     }

@@ -32,7 +32,8 @@
 use core::marker::PhantomData;
 
 use crate::earth::{
-    check_altitude, check_state, Attitude, Earth, EarthCamera, EarthGeometry, Ellipsoid, MIN_V1_MPS,
+    check_altitude, check_state, Attitude, Earth, EarthCamera, EarthGeometry, Ellipsoid,
+    InertialAttitude, InertialGeometry, MIN_V1_MPS,
 };
 use crate::error::ModelError;
 use crate::model::{Backend, ImageMotion};
@@ -192,6 +193,74 @@ impl<T: Real> General<T> {
             w_b_rad_s: [w_b0[0] + w_a[0], w_b0[1] + w_a[1], w_b0[2] + w_a[2]],
             v_b_mps: at_mul(&cols, v_l),
         })
+    }
+
+    /// [`General::instant`] for an attitude given by the camera's axes B in I and its
+    /// angular velocity Omega (Part II, [`InertialAttitude`]), with the same state checks
+    /// and |r|^2 - a^2 formed in f64 alike.
+    pub fn instant_inertial(
+        &self,
+        state: &StateVector,
+        attitude: &InertialAttitude<T>,
+        ellipsoid: &Ellipsoid,
+        earth_rate_rad_s: f64,
+    ) -> Result<GeneralInstant<T>, ModelError> {
+        let (r64, v64) = (state.position_m, state.velocity_mps);
+        let a_m = ellipsoid.a_m;
+        let r2_minus_a2 =
+            T::from_f64((r64[0] * r64[0] + r64[1] * r64[1] + r64[2] * r64[2]) - a_m * a_m);
+        self.instant_inertial_parts(
+            r64.map(T::from_f64),
+            v64.map(T::from_f64),
+            r2_minus_a2,
+            attitude,
+            T::from_f64(earth_rate_rad_s),
+        )
+    }
+
+    /// [`General::instant_inertial`] from the state already in `T` (as
+    /// [`General::instant_parts`]). No orbital frame and no trigonometry: with B the
+    /// camera's axes in I, n_B = B^T z (B's third row), rho0_B = B^T r,
+    /// W_B = Omega - omega n_B and V_B = B^T (v - omega z x r); 36 multiplications.
+    pub fn instant_inertial_parts(
+        &self,
+        r: [T; 3],
+        v: [T; 3],
+        r2_minus_a2: T,
+        attitude: &InertialAttitude<T>,
+        earth_rate_rad_s: T,
+    ) -> Result<GeneralInstant<T>, ModelError> {
+        let (r2, _) = check_state(r, v)?;
+        let w = earth_rate_rad_s;
+        let m = &attitude.camera_to_inertial;
+        // B^T x: each column of B (an axis of the camera) dotted with x.
+        let bt = |x: [T; 3]| -> [T; 3] {
+            core::array::from_fn(|j| m[0][j] * x[0] + m[1][j] * x[1] + m[2][j] * x[2])
+        };
+        let n_b = m[2];
+        // v - omega z x r = (v_x + omega r_y, v_y - omega r_x, v_z).
+        let v_rel = [v[0] + w * r[1], v[1] - w * r[0], v[2]];
+        let om = attitude.omega_rad_s;
+        Ok(GeneralInstant {
+            n_b,
+            rho0_b_m: bt(r),
+            r_z_m: r[2],
+            r2_m2: r2,
+            r2_minus_a2_m2: r2_minus_a2,
+            w_b_rad_s: [om[0] - w * n_b[0], om[1] - w * n_b[1], om[2] - w * n_b[2]],
+            v_b_mps: bt(v_rel),
+        })
+    }
+
+    /// [`Backend::update`] for Part II's attitude: the checks of
+    /// [`InertialGeometry::check_inputs`], [`General::instant_inertial`], then
+    /// [`General::ground`]. The update is Part I's type: [`Backend::motion`] and every
+    /// per-pixel path take it unchanged.
+    pub fn update_inertial(&self, g: &InertialGeometry<T>) -> Result<GeneralUpdate<T>, ModelError> {
+        g.check_inputs()?;
+        let inst =
+            self.instant_inertial(&g.state, &g.attitude, &g.ellipsoid, g.earth_rate_rad_s)?;
+        self.ground(&inst, &g.ellipsoid, T::from_f64(g.ground_h_m))
     }
 
     /// The update for the ground ellipsoid raised by `ground_h_m` (semi-axes A = a + h,

@@ -25,6 +25,7 @@ use crate::orbit::StateVector;
 use crate::real::{Real, Scalar};
 use crate::vector::{cross, dot};
 
+pub mod bus;
 pub mod frames;
 pub mod general;
 #[cfg(feature = "reference")]
@@ -129,6 +130,117 @@ impl<T: Scalar> Attitude<T> {
     }
 }
 
+/// Attitude of the camera frame B given directly in I (Part II): B's axes and its
+/// angular velocity relative to I. B(t) = B0 (I + \[Omega\]x t + ...), so
+/// dB/dt = B0 \[Omega\]x at t = 0.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct InertialAttitude<T> {
+    /// B0, row-major: its columns are x_B, y_B, z_B in I (x_I = B0 x_B). Orthonormal and
+    /// right-handed within [`MAX_AXES_ERROR`].
+    pub camera_to_inertial: [[T; 3]; 3],
+    /// Omega (rad/s): the camera's angular velocity relative to I, in B.
+    pub omega_rad_s: [T; 3],
+}
+
+/// Largest |B^T B - 1| (any entry) and |det B - 1| accepted for an [`InertialAttitude`]:
+/// f32 rounding of a rotation leaves about 2e-7; anything beyond 1e-5 is not a rotation.
+pub const MAX_AXES_ERROR: f64 = 1.0e-5;
+
+impl InertialAttitude<f64> {
+    /// The same attitude rounded to another scalar type.
+    pub fn to<T: Real>(&self) -> InertialAttitude<T> {
+        InertialAttitude {
+            camera_to_inertial: self.camera_to_inertial.map(|row| row.map(T::from_f64)),
+            omega_rad_s: self.omega_rad_s.map(T::from_f64),
+        }
+    }
+}
+
+impl<T: Scalar> InertialAttitude<T> {
+    /// The attitude widened to f64 (exact for f32).
+    pub fn to_f64(&self) -> InertialAttitude<f64> {
+        InertialAttitude {
+            camera_to_inertial: self.camera_to_inertial.map(|row| row.map(|x| x.to_f64())),
+            omega_rad_s: self.omega_rad_s.map(|x| x.to_f64()),
+        }
+    }
+}
+
+/// The checks of one kind of attitude, in its own scalar: what
+/// [`EarthGeometry::check_inputs`] asks of it (finiteness first, with the other inputs'
+/// finiteness; the domain after the Earth's).
+pub trait AttitudeChecks {
+    /// Every value finite, else [`ModelError::NonFinite`] naming it.
+    fn check_finite(&self) -> Result<(), ModelError>;
+    /// Within the model's domain (and, for axes, a rotation).
+    fn check_domain(&self) -> Result<(), ModelError>;
+}
+
+impl<T: Real> AttitudeChecks for Attitude<T> {
+    fn check_finite(&self) -> Result<(), ModelError> {
+        for (x, p) in self.values() {
+            if !x.is_finite() {
+                return Err(ModelError::NonFinite(p));
+            }
+        }
+        Ok(())
+    }
+
+    fn check_domain(&self) -> Result<(), ModelError> {
+        let max_angle = T::from_f64(domain::MAX_ANGLE_RAD);
+        let max_rate = T::from_f64(domain::MAX_RATE_RAD_S);
+        for (i, (x, p)) in self.values().into_iter().enumerate() {
+            let max = if i < 3 { max_angle } else { max_rate };
+            if !(x.abs() <= max) {
+                return Err(ModelError::OutOfDomain(p));
+            }
+        }
+        Ok(())
+    }
+}
+
+impl<T: Real> AttitudeChecks for InertialAttitude<T> {
+    fn check_finite(&self) -> Result<(), ModelError> {
+        if !self
+            .camera_to_inertial
+            .iter()
+            .flatten()
+            .all(|x| x.is_finite())
+        {
+            return Err(ModelError::NonFinite(Param::CameraAxes));
+        }
+        if !self.omega_rad_s.iter().all(|x| x.is_finite()) {
+            return Err(ModelError::NonFinite(Param::AngularVelocity));
+        }
+        Ok(())
+    }
+
+    /// |Omega| components within the domain's rate; B orthonormal and right-handed
+    /// within [`MAX_AXES_ERROR`] ([`ModelError::InvalidInput`]`(CameraAxes)` otherwise).
+    fn check_domain(&self) -> Result<(), ModelError> {
+        let max_rate = T::from_f64(domain::MAX_RATE_RAD_S);
+        if !self.omega_rad_s.iter().all(|x| x.abs() <= max_rate) {
+            return Err(ModelError::OutOfDomain(Param::AngularVelocity));
+        }
+        let m = &self.camera_to_inertial;
+        let col = |j: usize| [m[0][j], m[1][j], m[2][j]];
+        let cols = [col(0), col(1), col(2)];
+        let tol = T::from_f64(MAX_AXES_ERROR);
+        for i in 0..3 {
+            for j in 0..3 {
+                let want = if i == j { T::ONE } else { T::ZERO };
+                if !((dot(cols[i], cols[j]) - want).abs() <= tol) {
+                    return Err(ModelError::InvalidInput(Param::CameraAxes));
+                }
+            }
+        }
+        if !((dot(cols[0], cross(cols[1], cols[2])) - T::ONE).abs() <= tol) {
+            return Err(ModelError::InvalidInput(Param::CameraAxes));
+        }
+        Ok(())
+    }
+}
+
 /// Everything of one instant: the satellite's inertial state (f64 whatever the backend:
 /// a position in f32 would carry 0.5 m of rounding, 2.5e-6 of a 200 km altitude), the
 /// attitude in the backend's scalar, the ground and the Earth's rate.
@@ -148,6 +260,48 @@ impl EarthGeometry<f64> {
         EarthGeometry {
             state: self.state,
             attitude: self.attitude.to(),
+            ground_h_m: self.ground_h_m,
+            ellipsoid: self.ellipsoid,
+            earth_rate_rad_s: self.earth_rate_rad_s,
+        }
+    }
+}
+
+/// [`EarthGeometry`] with Part II's attitude: the camera's axes in I and its angular
+/// velocity ([`InertialAttitude`], from the bus's quaternion and gyro rates by
+/// [`bus::bus_geometry`]). Everything else as in Part I. The backends take it through
+/// their own entry points (`EarthReference::chain_inertial`,
+/// `General::update_inertial`), whose update is the same type as Part I's: the
+/// per-pixel work does not change.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct InertialGeometry<T> {
+    pub state: StateVector,
+    pub attitude: InertialAttitude<T>,
+    /// Height of the imaged ground above the ellipsoid (m).
+    pub ground_h_m: f64,
+    pub ellipsoid: Ellipsoid,
+    pub earth_rate_rad_s: f64,
+}
+
+impl InertialGeometry<f64> {
+    /// The same geometry with the attitude rounded to another scalar type.
+    pub fn to<T: Real>(&self) -> InertialGeometry<T> {
+        InertialGeometry {
+            state: self.state,
+            attitude: self.attitude.to(),
+            ground_h_m: self.ground_h_m,
+            ellipsoid: self.ellipsoid,
+            earth_rate_rad_s: self.earth_rate_rad_s,
+        }
+    }
+}
+
+impl<T: Scalar> InertialGeometry<T> {
+    /// The geometry with the attitude widened to f64.
+    pub fn to_f64(&self) -> InertialGeometry<f64> {
+        InertialGeometry {
+            state: self.state,
+            attitude: self.attitude.to_f64(),
             ground_h_m: self.ground_h_m,
             ellipsoid: self.ellipsoid,
             earth_rate_rad_s: self.earth_rate_rad_s,
@@ -257,6 +411,60 @@ impl<T: Real> EarthGeometry<T> {
     /// the ground (definition and domain), the Earth's rate, the attitude (in `T`: no
     /// soft-f64 work for it on the target). Returns (A, B) = (a + h, b + h).
     pub fn check_inputs(&self) -> Result<(f64, f64), ModelError> {
+        self.parts().check_inputs()
+    }
+
+    /// Every check of the definition's error table and the model's domain, all in f64,
+    /// and the ground ellipsoid. The reference and the host tools use it; the general
+    /// form makes the same state checks in its own scalar ([`check_state`]).
+    pub fn validate(&self) -> Result<Ground, ModelError> {
+        self.parts().validate()
+    }
+
+    fn parts(&self) -> GeometryParts<'_, Attitude<T>> {
+        GeometryParts {
+            state: &self.state,
+            attitude: &self.attitude,
+            ground_h_m: self.ground_h_m,
+            ellipsoid: &self.ellipsoid,
+            earth_rate_rad_s: self.earth_rate_rad_s,
+        }
+    }
+}
+
+impl<T: Real> InertialGeometry<T> {
+    /// [`EarthGeometry::check_inputs`] with Part II's attitude ([`AttitudeChecks`]).
+    pub fn check_inputs(&self) -> Result<(f64, f64), ModelError> {
+        self.parts().check_inputs()
+    }
+
+    /// [`EarthGeometry::validate`] with Part II's attitude.
+    pub fn validate(&self) -> Result<Ground, ModelError> {
+        self.parts().validate()
+    }
+
+    fn parts(&self) -> GeometryParts<'_, InertialAttitude<T>> {
+        GeometryParts {
+            state: &self.state,
+            attitude: &self.attitude,
+            ground_h_m: self.ground_h_m,
+            ellipsoid: &self.ellipsoid,
+            earth_rate_rad_s: self.earth_rate_rad_s,
+        }
+    }
+}
+
+/// The fields both geometries share, with either attitude: the checks written once.
+struct GeometryParts<'a, A> {
+    state: &'a StateVector,
+    attitude: &'a A,
+    ground_h_m: f64,
+    ellipsoid: &'a Ellipsoid,
+    earth_rate_rad_s: f64,
+}
+
+impl<A: AttitudeChecks> GeometryParts<'_, A> {
+    fn check_inputs(&self) -> Result<(f64, f64), ModelError> {
         let (r, v) = (self.state.position_m, self.state.velocity_mps);
         if !finite3(r) {
             return Err(ModelError::NonFinite(Param::Position));
@@ -274,11 +482,7 @@ impl<T: Real> EarthGeometry<T> {
                 return Err(ModelError::NonFinite(p));
             }
         }
-        for (x, p) in self.attitude.values() {
-            if !x.is_finite() {
-                return Err(ModelError::NonFinite(p));
-            }
-        }
+        self.attitude.check_finite()?;
         let a = self.ellipsoid.a_m;
         let fl = self.ellipsoid.flattening;
         if !(a > 0.0) {
@@ -306,21 +510,11 @@ impl<T: Real> EarthGeometry<T> {
         if !(self.earth_rate_rad_s.abs() <= domain::MAX_RATE_RAD_S) {
             return Err(ModelError::OutOfDomain(Param::EarthRate));
         }
-        let max_angle = T::from_f64(domain::MAX_ANGLE_RAD);
-        let max_rate = T::from_f64(domain::MAX_RATE_RAD_S);
-        for (i, (x, p)) in self.attitude.values().into_iter().enumerate() {
-            let max = if i < 3 { max_angle } else { max_rate };
-            if !(x.abs() <= max) {
-                return Err(ModelError::OutOfDomain(p));
-            }
-        }
+        self.attitude.check_domain()?;
         Ok((a + self.ground_h_m, b + self.ground_h_m))
     }
 
-    /// Every check of the definition's error table and the model's domain, all in f64,
-    /// and the ground ellipsoid. The reference and the host tools use it; the general
-    /// form makes the same state checks in its own scalar ([`check_state`]).
-    pub fn validate(&self) -> Result<Ground, ModelError> {
+    fn validate(&self) -> Result<Ground, ModelError> {
         let (eq_m, polar_m) = self.check_inputs()?;
         let (r, v) = (self.state.position_m, self.state.velocity_mps);
         let (r2, _) = check_state(r, v)?;

@@ -13,9 +13,12 @@
 //! closed-form range): agreement between the two is the proof of that derivation.
 
 use crate::dual::Dual;
-use crate::earth::{Earth, EarthCamera, EarthGeometry};
+use crate::earth::{
+    Attitude, Earth, EarthCamera, EarthGeometry, Ground, InertialAttitude, InertialGeometry,
+};
 use crate::error::ModelError;
 use crate::model::{Backend, ImageMotion, GM_M3_S2};
+use crate::orbit::StateVector;
 use crate::vector::{cross, unit};
 
 type V3 = [Dual; 3];
@@ -70,19 +73,59 @@ fn rot_z(t: Dual) -> M3 {
     [[k, -s, z], [s, k, z], [z, z, o]]
 }
 
-impl EarthReference {
-    /// The line of sight (p1, p2, -f) of a pixel in I at t = 0 (not normalised): the
-    /// camera axes from the state vector and the angles, in plain f64.
-    pub fn line_of_sight(g: &EarthGeometry<f64>, p1_m: f64, p2_m: f64, focal_m: f64) -> [f64; 3] {
-        let m = Self::axes(g, Dual::constant(0.0));
-        let u = [p1_m, p2_m, -focal_m];
-        core::array::from_fn(|i| m[i][0].re * u[0] + m[i][1].re * u[1] + m[i][2].re * u[2])
-    }
+/// An attitude the reference can evaluate: the camera's axes in I as a function of a
+/// dual-number time.
+pub trait ReferenceAttitude {
+    /// M(t): the columns are B's axes in I at time t.
+    fn axes(&self, state: &StateVector, t: Dual) -> M3;
+}
 
+/// A geometry the reference can evaluate: Part I's [`EarthGeometry`] or Part II's
+/// [`InertialGeometry`] (f64).
+pub trait ReferenceGeometry {
+    /// The geometry's own checks (`validate`) and its ground ellipsoid.
+    fn ground(&self) -> Result<Ground, ModelError>;
+    fn state(&self) -> &StateVector;
+    fn earth_rate_rad_s(&self) -> f64;
+    /// M(t), the camera's axes in I at time t.
+    fn axes(&self, t: Dual) -> M3;
+}
+
+impl ReferenceGeometry for EarthGeometry<f64> {
+    fn ground(&self) -> Result<Ground, ModelError> {
+        self.validate()
+    }
+    fn state(&self) -> &StateVector {
+        &self.state
+    }
+    fn earth_rate_rad_s(&self) -> f64 {
+        self.earth_rate_rad_s
+    }
+    fn axes(&self, t: Dual) -> M3 {
+        self.attitude.axes(&self.state, t)
+    }
+}
+
+impl ReferenceGeometry for InertialGeometry<f64> {
+    fn ground(&self) -> Result<Ground, ModelError> {
+        self.validate()
+    }
+    fn state(&self) -> &StateVector {
+        &self.state
+    }
+    fn earth_rate_rad_s(&self) -> f64 {
+        self.earth_rate_rad_s
+    }
+    fn axes(&self, t: Dual) -> M3 {
+        self.attitude.axes(&self.state, t)
+    }
+}
+
+impl ReferenceAttitude for Attitude<f64> {
     /// M(t) = [x_L y_L z_L] A(t): the columns are B's axes in I, with r(t) = r + v t,
     /// v(t) = v + a t (two-body a) and the angles moving at their rates.
-    fn axes(g: &EarthGeometry<f64>, t: Dual) -> M3 {
-        let (r0, v0) = (g.state.position_m, g.state.velocity_mps);
+    fn axes(&self, state: &StateVector, t: Dual) -> M3 {
+        let (r0, v0) = (state.position_m, state.velocity_mps);
         let r0n = libm::sqrt(r0[0] * r0[0] + r0[1] * r0[1] + r0[2] * r0[2]);
         let acc = r0.map(|x| -GM_M3_S2 * x / (r0n * r0n * r0n));
         let r: V3 = core::array::from_fn(|i| c(r0[i]) + c(v0[i]) * t);
@@ -92,7 +135,7 @@ impl EarthReference {
         let y_l = unit(cross(r, v));
         let x_l = cross(y_l, z_l);
         let e: M3 = core::array::from_fn(|i| [x_l[i], y_l[i], z_l[i]]);
-        let at = &g.attitude;
+        let at = self;
         let angle = |x: f64, rate: f64| c(x) + c(rate) * t;
         let a = mat_mul(
             &mat_mul(
@@ -103,14 +146,54 @@ impl EarthReference {
         );
         mat_mul(&e, &a)
     }
+}
+
+impl ReferenceAttitude for InertialAttitude<f64> {
+    /// M(t) = B0 exp(\[Omega\]x t), literally: the rotation by the angle |Omega| t about
+    /// Omega (Rodrigues' formula on dual numbers), applied in B. The state plays no part.
+    fn axes(&self, _state: &StateVector, t: Dual) -> M3 {
+        let w = self.omega_rad_s;
+        let wn = libm::sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+        let b0: M3 = self.camera_to_inertial.map(|row| row.map(c));
+        if wn == 0.0 {
+            return b0;
+        }
+        let k = w.map(|x| x / wn);
+        let angle = c(wn) * t;
+        let (s, one_minus_cos) = (angle.sin(), c(1.0) - angle.cos());
+        // exp([k]x angle) = 1 + sin [k]x + (1 - cos) [k]x^2, [k]x^2 = k k^T - 1.
+        let kx = [[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]];
+        let rot: M3 = core::array::from_fn(|i| {
+            core::array::from_fn(|j| {
+                let delta = if i == j { 1.0 } else { 0.0 };
+                c(delta) + s * c(kx[i][j]) + one_minus_cos * c(k[i] * k[j] - delta)
+            })
+        });
+        mat_mul(&b0, &rot)
+    }
+}
+
+impl EarthReference {
+    /// The line of sight (p1, p2, -f) of a pixel in I at t = 0 (not normalised): the
+    /// camera axes from the state vector and the attitude, in plain f64.
+    pub fn line_of_sight<G: ReferenceGeometry>(
+        g: &G,
+        p1_m: f64,
+        p2_m: f64,
+        focal_m: f64,
+    ) -> [f64; 3] {
+        let m = g.axes(Dual::constant(0.0));
+        let u = [p1_m, p2_m, -focal_m];
+        core::array::from_fn(|i| m[i][0].re * u[0] + m[i][1].re * u[1] + m[i][2].re * u[2])
+    }
 
     /// The whole construction for the pixel at (p1, p2) on the focal plane.
-    pub fn chain(g: &EarthGeometry<f64>, p: &EarthRefPixel) -> Result<EarthChain, ModelError> {
-        let ground = g.validate()?;
+    pub fn chain<G: ReferenceGeometry>(g: &G, p: &EarthRefPixel) -> Result<EarthChain, ModelError> {
+        let ground = g.ground()?;
         let t = Dual::new(0.0, 1.0);
-        let (r0, v0) = (g.state.position_m, g.state.velocity_mps);
+        let (r0, v0) = (g.state().position_m, g.state().velocity_mps);
         let r: V3 = core::array::from_fn(|i| c(r0[i]) + c(v0[i]) * t);
-        let m = Self::axes(g, t);
+        let m = g.axes(t);
 
         // Line of sight in I at t = 0.
         let u = [p.p1_m, p.p2_m, -p.focal_m];
@@ -148,7 +231,7 @@ impl EarthReference {
 
         // The ground point is fixed to the Earth, which turns about z.
         let gt = {
-            let wt = c(g.earth_rate_rad_s) * t;
+            let wt = c(g.earth_rate_rad_s()) * t;
             let (sw, cw) = (wt.sin(), wt.cos());
             [
                 cw * c(g0[0]) - sw * c(g0[1]),
@@ -198,6 +281,17 @@ impl Backend<Earth> for EarthReference {
     fn motion(
         &self,
         g: &EarthGeometry<f64>,
+        p: &EarthRefPixel,
+    ) -> Result<ImageMotion<f64>, ModelError> {
+        EarthReference::motion_of(g, p)
+    }
+}
+
+impl EarthReference {
+    /// [`Backend::motion`] for either geometry: Part II's attitude
+    /// ([`InertialGeometry`]) as well as Part I's.
+    pub fn motion_of<G: ReferenceGeometry>(
+        g: &G,
         p: &EarthRefPixel,
     ) -> Result<ImageMotion<f64>, ModelError> {
         let chain = EarthReference::chain(g, p)?;
