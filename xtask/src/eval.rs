@@ -3,7 +3,8 @@
 //! ground. `sphere` (the default) is the paper's round Earth; `earth` the real-Earth
 //! model, with the columns `shared/EARTH-MODEL.md` ("Eval CSV") specifies. One generic
 //! path serves both: a model names its columns ([`Columns`]) and any [`Backend`] of it
-//! is evaluated the same way.
+//! is evaluated the same way. An earth file with a `frame` or quaternion column is
+//! Part II's ("Eval CSV, Part II", without the DEM): [`eval_bus_rows`].
 
 use std::fmt::Display;
 
