@@ -241,7 +241,8 @@ enum RowError {
     Model(ModelError),
     Unparsable,
     /// A Part II input the contract refuses as `invalid_input` that core-math has no
-    /// parameter for (an unknown `frame` or `attitude_frame`, a partial quaternion).
+    /// parameter for (an unknown `frame` or `attitude_frame`, a quaternion with some
+    /// but not all of its four cells, a row with neither a quaternion nor the angles).
     Invalid,
 }
 
@@ -469,7 +470,9 @@ fn bus_case(cells: &RowCells) -> Result<BusCase, RowError> {
     let camera_q = cells
         .all(CAMERA_QUATERNION_COLUMNS)?
         .unwrap_or(IDENTITY_QUATERNION);
-    let body_rate_dps = cells.all(BODY_RATE_COLUMNS)?.unwrap_or([0.0; 3]);
+    // Body rates default to 0 one by one (a missing or empty cell is 0 deg/s).
+    let [wx, wy, wz] = BODY_RATE_COLUMNS.map(|n| cells.or(n, 0.0));
+    let body_rate_dps = [wx?, wy?, wz?];
     let frame = match cells.text("frame") {
         None | Some("inertial") => StateFrame::Inertial,
         Some("itrf") => StateFrame::Itrf,
@@ -590,11 +593,11 @@ fn ground_point(case: &BusCase) -> Result<[f64; 3], RowError> {
 
 /// The Part II output: as [`eval_rows`], with `ground_lat_deg,ground_lon_deg,
 /// ground_height_m` after `error` when the header has `frame`. A row's checks, in
-/// order: its numbers (`unparsable_input`); a partial quaternion or body rate, an
-/// unknown `frame` or `attitude_frame` (`invalid_input`); the quaternions
+/// order: its numbers (`unparsable_input`); a partial quaternion (some of its four
+/// cells), an unknown `frame` or `attitude_frame` (`invalid_input`); the quaternions
 /// (`invalid_quaternion`); a missing `gps_s` where the contract needs it
-/// (`invalid_input`); the time scales; then core-math's own checks. A row is
-/// refused if the backend refuses it or the reference finds no ground point for it.
+/// (`invalid_input`); the time scales; then core-math's own checks. A row is refused
+/// if the backend refuses it or the reference finds no ground point for it.
 fn eval_bus_rows(
     text: &str,
     eval: impl Fn(&BusCase) -> Result<Vec<String>, RowError>,
@@ -796,6 +799,8 @@ gcrf_no_time,gcrf,,,7016137,0,0,0,-1046.6,7464.5,0,0,0,0,0,0,,,,,,,,,,,,,0,0.555
 q_no_time,inertial,,,7016137,0,0,0,-1046.6,7464.5,,,,,,,0.70710678,0,0.70710678,0,gcrf,,,,,,,,0,0.555,13e-6,0
 itrf_no_time,itrf,,,7016137,0,0,0,-1046.6,7464.5,0,0,0,0,0,0,,,,,,,,,,,,,0,0.555,13e-6,0
 bad_frame,ecef,1388000000,,7016137,0,0,0,-1046.6,7464.5,0,0,0,0,0,0,,,,,,,,,,,,,0,0.555,13e-6,0
+partial_q,itrf,1388000000,,7016137,0,0,0,-1046.6,7464.5,,,,,,,1,0,,0,itrf,,,,,,,,0,0.555,13e-6,0
+one_rate,itrf,1388000000,,7016137,0,0,0,-1558.2,7464.5,,,,,,,0.70710678,0,0.70710678,0,itrf,,-0.06,,,,,,0,0.555,13e-6,0
 ";
 
     /// Rows 0..4 of [`BUS_CASES`] as core-math's own inputs. The quaternion is the CSV's
@@ -932,7 +937,7 @@ bad_frame,ecef,1388000000,,7016137,0,0,0,-1046.6,7464.5,0,0,0,0,0,0,,,,,,,,,,,,,
     fn bus_rows_typed_errors() {
         for backend in ["reference", "f64", "f32"] {
             let out = Out::of(Model::Earth, backend, BUS_CASES);
-            assert_eq!(out.rows(), 10);
+            assert_eq!(out.rows(), 12);
             assert_eq!(out.field(4, "error"), "invalid_quaternion");
             assert_eq!(out.field(5, "error"), "invalid_quaternion");
             assert_eq!(out.field(6, "error"), "invalid_input", "gcrf without gps_s");
@@ -943,7 +948,13 @@ bad_frame,ecef,1388000000,,7016137,0,0,0,-1046.6,7464.5,0,0,0,0,0,0,,,,,,,,,,,,,
             );
             assert_eq!(out.field(8, "error"), "invalid_input", "itrf without gps_s");
             assert_eq!(out.field(9, "error"), "invalid_input", "unknown frame");
-            for row in 4..10 {
+            assert_eq!(
+                out.field(10, "error"),
+                "invalid_input",
+                "partial quaternion"
+            );
+            assert_eq!(out.field(11, "error"), "", "missing body rates are 0");
+            for row in 4..11 {
                 assert_eq!(out.field(row, "v1_mps"), "");
                 assert_eq!(out.field(row, "ground_lat_deg"), "");
             }
