@@ -3,19 +3,26 @@
 //! ground. `sphere` (the default) is the paper's round Earth; `earth` the real-Earth
 //! model, with the columns `shared/EARTH-MODEL.md` ("Eval CSV") specifies. One generic
 //! path serves both: a model names its columns ([`Columns`]) and any [`Backend`] of it
-//! is evaluated the same way.
+//! is evaluated the same way. An earth file with a `frame` or quaternion column is
+//! Part II's ("Eval CSV, Part II", without the DEM): [`eval_bus_rows`].
 
 use std::fmt::Display;
 
 use anyhow::{bail, Context, Result};
-use core_math::earth::{Attitude, EarthCamera, EarthGeometry};
+use core_math::earth::bus::{
+    bus_geometry, dps_to_rad_s, inertial_state, quaternion_matrix, AttitudeFrame, BusAttitude,
+    BusState, BusTime, StateFrame, IDENTITY_QUATERNION,
+};
+use core_math::earth::frames::{geodetic_from_itrf, TimeScales};
+use core_math::earth::{Attitude, EarthCamera, EarthGeometry, InertialGeometry};
 use core_math::sphere::fixed_point::{geometry_from_f64, motion_to_f64};
 use core_math::sphere::{
     speed_line_period_s, Geometry, Reference, Sphere, CLOSED_F32, CLOSED_F64, FIXED,
 };
 use core_math::{
-    line_period_s, Backend, Camera, Earth, EarthReference, Ellipsoid, ImageMotion,
-    Model as MathModel, ModelError, Real, StateVector, EARTH_RATE_RAD_S, GENERAL_F32, GENERAL_F64,
+    line_period_s, Backend, Camera, Earth, EarthReference, Ellipsoid, General, ImageMotion,
+    Model as MathModel, ModelError, Param, Real, StateVector, EARTH_RATE_RAD_S, GENERAL_F32,
+    GENERAL_F64,
 };
 
 use crate::csv::{Table, Writer};
@@ -61,6 +68,11 @@ pub fn eval_csv(model: Model, backend: &str, text: &str) -> Result<String> {
         (Model::Sphere, "f32") => eval_rows(text, |c| evaluate(&CLOSED_F32, c, |g| g.to())),
         (Model::Sphere, "fixed") => eval_rows(text, evaluate_fixed),
         (Model::Sphere, other) => bail!("unknown backend `{other}` (reference|f64|f32|fixed)"),
+        (Model::Earth, "reference" | "f64" | "f32") if is_part2(text)? => match backend {
+            "reference" => eval_bus_rows(text, evaluate_bus_reference),
+            "f64" => eval_bus_rows(text, |c| evaluate_bus_general(&GENERAL_F64, c)),
+            _ => eval_bus_rows(text, |c| evaluate_bus_general(&GENERAL_F32, c)),
+        },
         (Model::Earth, "reference") => eval_rows(text, |c| evaluate(&EarthReference, c, |g| g)),
         (Model::Earth, "f64") => eval_rows(text, |c| evaluate(&GENERAL_F64, c, |g| g)),
         (Model::Earth, "f32") => eval_rows(text, |c| evaluate(&GENERAL_F32, c, |g| g.to())),
@@ -228,6 +240,20 @@ impl Columns for Earth {
 enum RowError {
     Model(ModelError),
     Unparsable,
+    /// A Part II input the contract refuses as `invalid_input` that core-math has no
+    /// parameter for (an unknown `frame` or `attitude_frame`, a quaternion with some
+    /// but not all of its four cells, a row with neither a quaternion nor the angles).
+    Invalid,
+}
+
+impl RowError {
+    fn name(&self) -> &'static str {
+        match self {
+            RowError::Model(e) => e.name(),
+            RowError::Unparsable => "unparsable_input",
+            RowError::Invalid => "invalid_input",
+        }
+    }
 }
 
 impl From<ModelError> for RowError {
@@ -262,8 +288,7 @@ fn eval_rows<M: Columns>(
             .and_then(|v| eval(&M::case(&v)))
         {
             Ok(nums) => (nums, ""),
-            Err(RowError::Model(e)) => (blank.clone(), e.name()),
-            Err(RowError::Unparsable) => (blank.clone(), "unparsable_input"),
+            Err(e) => (blank.clone(), e.name()),
         };
         let fields: Vec<&str> = row
             .iter()
@@ -320,6 +345,313 @@ fn evaluate_fixed(case: &Case<Sphere>) -> Result<Vec<String>, RowError> {
     let g = geometry_from_f64(&case.geometry)?;
     let m = motion_to_f64(&FIXED.evaluate(&case.camera, &g, case.n_px)?);
     Ok(Sphere::numbers(&case.camera, &m)?)
+}
+
+// Part II (`shared/EARTH-MODEL.md`, "Eval CSV, Part II"): the bus's frames, time and
+// quaternion attitude, and the ground point's geodetic coordinates. A file takes this
+// path only when its header has a `frame` column or a quaternion column; any other file
+// is Part I's, through `eval_rows` exactly as before.
+
+/// Part I's state columns, read in the bus's `frame`.
+const STATE_COLUMNS: [&str; 6] = ["x_m", "y_m", "z_m", "vx_mps", "vy_mps", "vz_mps"];
+/// Part I's attitude columns, replaced by the quaternion where a row has one.
+const ANGLE_COLUMNS: [&str; 6] = [
+    "roll_deg",
+    "pitch_deg",
+    "yaw_deg",
+    "roll_rate_dps",
+    "pitch_rate_dps",
+    "yaw_rate_dps",
+];
+/// Columns every row needs.
+const COMMON_COLUMNS: [&str; 4] = ["ground_h_m", "f_m", "pixel_m", "n_px"];
+const QUATERNION_COLUMNS: [&str; 4] = ["qw", "qx", "qy", "qz"];
+const CAMERA_QUATERNION_COLUMNS: [&str; 4] = ["cam_qw", "cam_qx", "cam_qy", "cam_qz"];
+const BODY_RATE_COLUMNS: [&str; 3] = ["wx_dps", "wy_dps", "wz_dps"];
+/// Added after `error` whenever the input has a `frame` column.
+const GROUND_OUTPUTS: [&str; 3] = ["ground_lat_deg", "ground_lon_deg", "ground_height_m"];
+
+/// Whether a CSV text is evaluated as Part II: its header has `frame` or a quaternion
+/// column.
+fn is_part2(text: &str) -> Result<bool> {
+    let table = Table::parse(text)?;
+    Ok(table
+        .header
+        .iter()
+        .any(|h| h == "frame" || QUATERNION_COLUMNS.contains(&h.as_str())))
+}
+
+/// A row's geometry: Part I's angles (the state converted to I) or the bus quaternion.
+enum BusRowGeometry {
+    Angles(EarthGeometry<f64>),
+    Quaternion(InertialGeometry<f64>),
+}
+
+/// One Part II case: optics, geometry in I at t (f64), pixel.
+struct BusCase {
+    camera: EarthCamera,
+    geometry: BusRowGeometry,
+    n_px: f64,
+}
+
+/// A row's cells by column name; an empty cell is a missing column.
+struct RowCells<'a> {
+    header: &'a [String],
+    row: &'a [String],
+}
+
+impl RowCells<'_> {
+    fn text(&self, name: &str) -> Option<&str> {
+        let c = self.header.iter().position(|h| h == name)?;
+        self.row
+            .get(c)
+            .map(String::as_str)
+            .filter(|t| !t.is_empty())
+    }
+
+    fn number(&self, name: &str) -> Result<Option<f64>, RowError> {
+        self.text(name)
+            .map(|t| t.parse::<f64>().map_err(|_| RowError::Unparsable))
+            .transpose()
+    }
+
+    /// A required number (a missing or empty cell cannot be read, as in Part I).
+    fn required(&self, name: &str) -> Result<f64, RowError> {
+        self.number(name)?.ok_or(RowError::Unparsable)
+    }
+
+    fn or(&self, name: &str, default: f64) -> Result<f64, RowError> {
+        Ok(self.number(name)?.unwrap_or(default))
+    }
+
+    /// All of `names` (`Some`), none of them (`None`), or some: `invalid_input`.
+    fn all<const N: usize>(&self, names: [&str; N]) -> Result<Option<[f64; N]>, RowError> {
+        let v = names.map(|n| self.number(n));
+        let mut out = [0.0; N];
+        let mut given = 0;
+        for (o, x) in out.iter_mut().zip(v) {
+            if let Some(x) = x? {
+                *o = x;
+                given += 1;
+            }
+        }
+        match given {
+            0 => Ok(None),
+            g if g == N => Ok(Some(out)),
+            _ => Err(RowError::Invalid),
+        }
+    }
+}
+
+/// The case of a Part II row (see [`eval_bus_rows`] for the order of the checks).
+fn bus_case(cells: &RowCells) -> Result<BusCase, RowError> {
+    let [x, y, z, vx, vy, vz] = STATE_COLUMNS.map(|n| cells.required(n));
+    let (position_m, velocity_mps) = ([x?, y?, z?], [vx?, vy?, vz?]);
+    let [ground_h_m, focal_m, pixel_m, n_px] = COMMON_COLUMNS.map(|n| cells.required(n));
+    let (ground_h_m, focal_m, pixel_m, n_px) = (ground_h_m?, focal_m?, pixel_m?, n_px?);
+    let camera = EarthCamera {
+        focal_m,
+        pixel_m,
+        p1_m: cells.or("p1_m", 0.0)?,
+    };
+    let ellipsoid = Ellipsoid {
+        a_m: cells.or("a_m", Ellipsoid::WGS84.a_m)?,
+        flattening: cells.or("flattening", Ellipsoid::WGS84.flattening)?,
+    };
+    let earth_rate_rad_s = cells.or("earth_rate_rad_s", EARTH_RATE_RAD_S)?;
+    let time = BusTime {
+        gps_s: cells.number("gps_s")?,
+        scales: TimeScales {
+            gps_utc_s: cells.or("gps_utc_s", TimeScales::DEFAULT.gps_utc_s)?,
+            dut1_s: cells.or("dut1_s", TimeScales::DEFAULT.dut1_s)?,
+        },
+    };
+    let quaternion = cells.all(QUATERNION_COLUMNS)?;
+    let camera_q = cells
+        .all(CAMERA_QUATERNION_COLUMNS)?
+        .unwrap_or(IDENTITY_QUATERNION);
+    // Body rates default to 0 one by one (a missing or empty cell is 0 deg/s).
+    let [wx, wy, wz] = BODY_RATE_COLUMNS.map(|n| cells.or(n, 0.0));
+    let body_rate_dps = [wx?, wy?, wz?];
+    let frame = match cells.text("frame") {
+        None | Some("inertial") => StateFrame::Inertial,
+        Some("itrf") => StateFrame::Itrf,
+        Some("gcrf") => StateFrame::Gcrf,
+        Some(_) => return Err(RowError::Invalid),
+    };
+    let attitude_frame = match cells.text("attitude_frame") {
+        None | Some("gcrf") => AttitudeFrame::Gcrf,
+        Some("itrf") => AttitudeFrame::Itrf,
+        Some(_) => return Err(RowError::Invalid),
+    };
+    if let Some(q) = quaternion {
+        quaternion_matrix(q, Param::Quaternion)?;
+        quaternion_matrix(camera_q, Param::CameraQuaternion)?;
+    }
+    // The contract: `frame` itrf or gcrf, or a quaternion in gcrf, need `gps_s` (for an
+    // ITRF state the time is that of "I = the ITRF at t", even if no C2T is needed).
+    let needs_time = frame != StateFrame::Inertial
+        || (quaternion.is_some() && attitude_frame == AttitudeFrame::Gcrf);
+    if needs_time && time.gps_s.is_none() {
+        return Err(ModelError::InvalidInput(Param::GpsTime).into());
+    }
+    if time.gps_s.is_some() {
+        time.scales.validate()?;
+    }
+    let state = BusState {
+        frame,
+        position_m,
+        velocity_mps,
+    };
+    let geometry = match quaternion {
+        Some(q) => {
+            let attitude = BusAttitude {
+                q,
+                frame: attitude_frame,
+                body_rate_rad_s: dps_to_rad_s(body_rate_dps),
+                camera_q,
+            };
+            BusRowGeometry::Quaternion(bus_geometry(
+                &state,
+                &attitude,
+                &time,
+                ground_h_m,
+                ellipsoid,
+                earth_rate_rad_s,
+            )?)
+        }
+        None => {
+            let [roll, pitch, yaw, roll_rate, pitch_rate, yaw_rate] = ANGLE_COLUMNS.map(|n| {
+                match cells.header.iter().any(|h| h == n) {
+                    // Neither a quaternion nor the angles: the attitude is missing.
+                    false => Err(RowError::Invalid),
+                    true => cells.required(n).map(f64::to_radians),
+                }
+            });
+            BusRowGeometry::Angles(EarthGeometry {
+                state: inertial_state(&state, &time, earth_rate_rad_s)?,
+                attitude: Attitude {
+                    roll_rad: roll?,
+                    pitch_rad: pitch?,
+                    yaw_rad: yaw?,
+                    roll_rate_rad_s: roll_rate?,
+                    pitch_rate_rad_s: pitch_rate?,
+                    yaw_rate_rad_s: yaw_rate?,
+                },
+                ground_h_m,
+                ellipsoid,
+                earth_rate_rad_s,
+            })
+        }
+    };
+    Ok(BusCase {
+        camera,
+        geometry,
+        n_px,
+    })
+}
+
+/// The reference's numbers for a Part II case.
+fn evaluate_bus_reference(case: &BusCase) -> Result<Vec<String>, RowError> {
+    let m = match &case.geometry {
+        BusRowGeometry::Angles(g) => EarthReference.evaluate(&case.camera, g, case.n_px)?,
+        BusRowGeometry::Quaternion(g) => {
+            let p = EarthReference.pixel(&case.camera, case.n_px)?;
+            EarthReference::motion_of(g, &p)?
+        }
+    };
+    Ok(Earth::numbers(&case.camera, &m)?)
+}
+
+/// The general form's numbers for a Part II case, in its own precision: Part I's
+/// geometry or the quaternion's (`General::update_inertial`), rounded to `T` once.
+fn evaluate_bus_general<T: Real + Display>(
+    backend: &General<T>,
+    case: &BusCase,
+) -> Result<Vec<String>, RowError> {
+    let p = backend.pixel(&case.camera, case.n_px)?;
+    let up = match &case.geometry {
+        BusRowGeometry::Angles(g) => backend.update(&g.to::<T>())?,
+        BusRowGeometry::Quaternion(g) => backend.update_inertial(&g.to::<T>())?,
+    };
+    let m = backend.motion(&up, &p)?;
+    Ok(Earth::numbers(&case.camera, &m)?)
+}
+
+/// G's geodetic latitude and longitude (deg) and height (m) on the row's ellipsoid, for
+/// every backend from the f64 reference's chain (`EarthChain::ground_m`): I at t is the
+/// ITRF at t, so G's coordinates in I are its ITRF coordinates.
+fn ground_point(case: &BusCase) -> Result<[f64; 3], RowError> {
+    let p = EarthReference.pixel(&case.camera, case.n_px)?;
+    let (chain, ellipsoid) = match &case.geometry {
+        BusRowGeometry::Angles(g) => (EarthReference::chain(g, &p)?, g.ellipsoid),
+        BusRowGeometry::Quaternion(g) => (EarthReference::chain(g, &p)?, g.ellipsoid),
+    };
+    let (lat, lon, h) = geodetic_from_itrf(chain.ground_m, &ellipsoid)?;
+    Ok([lat.to_degrees(), lon.to_degrees(), h])
+}
+
+/// The Part II output: as [`eval_rows`], with `ground_lat_deg,ground_lon_deg,
+/// ground_height_m` after `error` when the header has `frame`. A row's checks, in
+/// order: its numbers (`unparsable_input`); a partial quaternion (some of its four
+/// cells), an unknown `frame` or `attitude_frame` (`invalid_input`); the quaternions
+/// (`invalid_quaternion`); a missing `gps_s` where the contract needs it
+/// (`invalid_input`); the time scales; then core-math's own checks. A row is refused
+/// if the backend refuses it or the reference finds no ground point for it.
+fn eval_bus_rows(
+    text: &str,
+    eval: impl Fn(&BusCase) -> Result<Vec<String>, RowError>,
+) -> Result<String> {
+    let table = Table::parse(text)?;
+    table.columns(&STATE_COLUMNS)?;
+    table.columns(&COMMON_COLUMNS)?;
+    if !table
+        .header
+        .iter()
+        .any(|h| QUATERNION_COLUMNS.contains(&h.as_str()))
+    {
+        table.columns(&ANGLE_COLUMNS)?;
+    }
+    let with_ground = table.header.iter().any(|h| h == "frame");
+    let extra: &[&str] = if with_ground { &GROUND_OUTPUTS } else { &[] };
+    let header: Vec<&str> = table
+        .header
+        .iter()
+        .map(String::as_str)
+        .chain(Earth::OUTPUTS.iter().copied())
+        .chain(extra.iter().copied())
+        .collect();
+    let mut out = Writer::new("", &header)?;
+    let blank = vec![String::new(); Earth::OUTPUTS.len() - 1];
+    let blank_ground = vec![String::new(); extra.len()];
+    for row in &table.rows {
+        let cells = RowCells {
+            header: &table.header,
+            row,
+        };
+        let result = bus_case(&cells).and_then(|case| {
+            let nums = eval(&case)?;
+            let ground = if with_ground {
+                ground_point(&case)?.map(|x| x.to_string()).to_vec()
+            } else {
+                Vec::new()
+            };
+            Ok((nums, ground))
+        });
+        let (nums, ground, error) = match result {
+            Ok((nums, ground)) => (nums, ground, ""),
+            Err(e) => (blank.clone(), blank_ground.clone(), e.name()),
+        };
+        let fields: Vec<&str> = row
+            .iter()
+            .chain(&nums)
+            .map(String::as_str)
+            .chain([error])
+            .chain(ground.iter().map(String::as_str))
+            .collect();
+        out.row(&fields)?;
+    }
+    out.into_string()
 }
 
 #[cfg(test)]
@@ -446,6 +778,238 @@ garbled,7016137,0,0,0,-1046.6,7464.5,x,0,0,0,0,0,0,0.555,13e-6,0,,
             assert!((r.num(row, "drift_rad") - (v2 / v1).atan()).abs() <= 1e-15);
             let d = (f.num(row, "v1_mps") - v1).hypot(f.num(row, "v2_mps") - v2);
             assert!(d / v1.hypot(v2) < 2e-6, "row {row}");
+        }
+    }
+
+    /// Part II rows (shared/EARTH-MODEL.md, "Eval CSV, Part II"), 2024-01-01 or so: Part
+    /// I's angles with the state in the ITRF and the GCRF; a quaternion relative to the
+    /// ITRF and to the GCRF (boresight to nadir, gyro rates, a camera mounting); a bad
+    /// quaternion; a GCRF state and a GCRF quaternion without `gps_s`; an unknown frame.
+    const BUS_CASES: &str = "case,frame,gps_s,dut1_s,x_m,y_m,z_m,vx_mps,vy_mps,vz_mps,\
+roll_deg,pitch_deg,yaw_deg,roll_rate_dps,pitch_rate_dps,yaw_rate_dps,\
+qw,qx,qy,qz,attitude_frame,wx_dps,wy_dps,wz_dps,cam_qw,cam_qx,cam_qy,cam_qz,\
+ground_h_m,f_m,pixel_m,n_px
+itrf_angles,itrf,1388000000,,7016137,0,0,0,-1558.2,7464.5,5,-3,2,0.1,0,0,,,,,,,,,,,,,300,0.555,13e-6,1000
+gcrf_angles,gcrf,1388000000,0.2,7016137,0,0,0,-1046.6,7464.5,5,-3,2,0.1,0,0,,,,,,,,,,,,,300,0.555,13e-6,1000
+itrf_q,itrf,1388000000,,7016137,0,0,0,-1558.2,7464.5,,,,,,,0.70710678,0,0.70710678,0,itrf,0.01,-0.06,0.02,0.9998477,0.0174524,0,0,100,0.555,13e-6,-2000
+gcrf_q,gcrf,1388000000,0.2,7016137,0,0,0,-1046.6,7464.5,,,,,,,0.70710678,0,0.70710678,0,,0.01,-0.06,0.02,,,,,100,0.555,13e-6,-2000
+bad_q,gcrf,1388000000,,7016137,0,0,0,-1046.6,7464.5,,,,,,,0.8,0,0.8,0,gcrf,,,,,,,,0,0.555,13e-6,0
+bad_cam_q,itrf,1388000000,,7016137,0,0,0,-1046.6,7464.5,,,,,,,1,0,0,0,itrf,,,,0.5,0,0,0,0,0.555,13e-6,0
+gcrf_no_time,gcrf,,,7016137,0,0,0,-1046.6,7464.5,0,0,0,0,0,0,,,,,,,,,,,,,0,0.555,13e-6,0
+q_no_time,inertial,,,7016137,0,0,0,-1046.6,7464.5,,,,,,,0.70710678,0,0.70710678,0,gcrf,,,,,,,,0,0.555,13e-6,0
+itrf_no_time,itrf,,,7016137,0,0,0,-1046.6,7464.5,0,0,0,0,0,0,,,,,,,,,,,,,0,0.555,13e-6,0
+bad_frame,ecef,1388000000,,7016137,0,0,0,-1046.6,7464.5,0,0,0,0,0,0,,,,,,,,,,,,,0,0.555,13e-6,0
+partial_q,itrf,1388000000,,7016137,0,0,0,-1046.6,7464.5,,,,,,,1,0,,0,itrf,,,,,,,,0,0.555,13e-6,0
+one_rate,itrf,1388000000,,7016137,0,0,0,-1558.2,7464.5,,,,,,,0.70710678,0,0.70710678,0,itrf,,-0.06,,,,,,0,0.555,13e-6,0
+";
+
+    /// Rows 0..4 of [`BUS_CASES`] as core-math's own inputs. The quaternion is the CSV's
+    /// 8-digit 0.70710678, not 1/sqrt(2): its norm is not exactly 1.
+    #[allow(clippy::approx_constant)]
+    fn bus_inputs(row: usize) -> (BusState, Option<BusAttitude>, BusTime, f64, f64) {
+        let gcrf = row % 2 == 1;
+        let state = BusState {
+            frame: if gcrf {
+                StateFrame::Gcrf
+            } else {
+                StateFrame::Itrf
+            },
+            position_m: [7016137.0, 0.0, 0.0],
+            velocity_mps: [0.0, if gcrf { -1046.6 } else { -1558.2 }, 7464.5],
+        };
+        let attitude = (row >= 2).then(|| BusAttitude {
+            q: [0.70710678, 0.0, 0.70710678, 0.0],
+            frame: if gcrf {
+                AttitudeFrame::Gcrf
+            } else {
+                AttitudeFrame::Itrf
+            },
+            body_rate_rad_s: dps_to_rad_s([0.01, -0.06, 0.02]),
+            camera_q: if gcrf {
+                IDENTITY_QUATERNION
+            } else {
+                [0.9998477, 0.0174524, 0.0, 0.0]
+            },
+        });
+        let time = BusTime {
+            gps_s: Some(1388000000.0),
+            scales: TimeScales {
+                dut1_s: if gcrf { 0.2 } else { 0.0 },
+                ..TimeScales::DEFAULT
+            },
+        };
+        let (ground_h_m, n_px) = if row >= 2 {
+            (100.0, -2000.0)
+        } else {
+            (300.0, 1000.0)
+        };
+        (state, attitude, time, ground_h_m, n_px)
+    }
+
+    /// The geometries core-math makes of rows 0..4, by its own API.
+    fn bus_geometry_direct(row: usize) -> (BusRowGeometry, f64) {
+        let (state, attitude, time, ground_h_m, n_px) = bus_inputs(row);
+        let geometry = match attitude {
+            Some(a) => BusRowGeometry::Quaternion(
+                bus_geometry(
+                    &state,
+                    &a,
+                    &time,
+                    ground_h_m,
+                    Ellipsoid::WGS84,
+                    EARTH_RATE_RAD_S,
+                )
+                .unwrap(),
+            ),
+            None => BusRowGeometry::Angles(EarthGeometry {
+                state: inertial_state(&state, &time, EARTH_RATE_RAD_S).unwrap(),
+                attitude: Attitude {
+                    roll_rad: 5f64.to_radians(),
+                    pitch_rad: (-3f64).to_radians(),
+                    yaw_rad: 2f64.to_radians(),
+                    roll_rate_rad_s: 0.1f64.to_radians(),
+                    pitch_rate_rad_s: 0.0,
+                    yaw_rate_rad_s: 0.0,
+                },
+                ground_h_m,
+                ellipsoid: Ellipsoid::WGS84,
+                earth_rate_rad_s: EARTH_RATE_RAD_S,
+            }),
+        };
+        (geometry, n_px)
+    }
+
+    /// ITRF and GCRF rows, with angles and with quaternions, through eval give exactly
+    /// what core-math gives when called directly (reference and f64 bit for bit, f32
+    /// to its own print), and G on the ground ellipsoid.
+    #[test]
+    fn bus_rows_agree_with_core_math() {
+        let camera = EarthCamera {
+            focal_m: 0.555,
+            pixel_m: 13e-6,
+            p1_m: 0.0,
+        };
+        let r = Out::of(Model::Earth, "reference", BUS_CASES);
+        let f = Out::of(Model::Earth, "f64", BUS_CASES);
+        let s = Out::of(Model::Earth, "f32", BUS_CASES);
+        for row in 0..4 {
+            let (g, n_px) = bus_geometry_direct(row);
+            let p = EarthReference.pixel(&camera, n_px).unwrap();
+            let (chain, m64, m32) = match &g {
+                BusRowGeometry::Angles(g) => (
+                    EarthReference::chain(g, &p).unwrap(),
+                    GENERAL_F64.evaluate(&camera, g, n_px).unwrap(),
+                    GENERAL_F32.evaluate(&camera, &g.to(), n_px).unwrap(),
+                ),
+                BusRowGeometry::Quaternion(g) => {
+                    let up64 = GENERAL_F64.update_inertial(g).unwrap();
+                    let up32 = GENERAL_F32.update_inertial(&g.to()).unwrap();
+                    let p64 = GENERAL_F64.pixel(&camera, n_px).unwrap();
+                    let p32 = GENERAL_F32.pixel(&camera, n_px).unwrap();
+                    (
+                        EarthReference::chain(g, &p).unwrap(),
+                        GENERAL_F64.motion(&up64, &p64).unwrap(),
+                        GENERAL_F32.motion(&up32, &p32).unwrap(),
+                    )
+                }
+            };
+            for out in [&r, &f, &s] {
+                assert_eq!(out.field(row, "error"), "", "row {row}");
+            }
+            assert_eq!(r.num(row, "v1_mps"), chain.motion.v1_mps, "row {row}");
+            assert_eq!(r.num(row, "v2_mps"), chain.motion.v2_mps, "row {row}");
+            assert_eq!(f.num(row, "v1_mps"), m64.v1_mps, "row {row}");
+            assert_eq!(f.num(row, "v2_mps"), m64.v2_mps, "row {row}");
+            assert_eq!(s.field(row, "v1_mps"), m32.v1_mps.to_string(), "row {row}");
+            assert_eq!(s.field(row, "v2_mps"), m32.v2_mps.to_string(), "row {row}");
+            let (lat, lon, h) = geodetic_from_itrf(chain.ground_m, &Ellipsoid::WGS84).unwrap();
+            for out in [&r, &f, &s] {
+                assert_eq!(out.num(row, "ground_lat_deg"), lat.to_degrees());
+                assert_eq!(out.num(row, "ground_lon_deg"), lon.to_degrees());
+                assert_eq!(out.num(row, "ground_height_m"), h);
+            }
+            let ground_h_m = bus_inputs(row).3;
+            assert!((h - ground_h_m).abs() < 1e-6, "row {row}: {h}");
+        }
+    }
+
+    #[test]
+    fn bus_rows_typed_errors() {
+        for backend in ["reference", "f64", "f32"] {
+            let out = Out::of(Model::Earth, backend, BUS_CASES);
+            assert_eq!(out.rows(), 12);
+            assert_eq!(out.field(4, "error"), "invalid_quaternion");
+            assert_eq!(out.field(5, "error"), "invalid_quaternion");
+            assert_eq!(out.field(6, "error"), "invalid_input", "gcrf without gps_s");
+            assert_eq!(
+                out.field(7, "error"),
+                "invalid_input",
+                "gcrf q without gps_s"
+            );
+            assert_eq!(out.field(8, "error"), "invalid_input", "itrf without gps_s");
+            assert_eq!(out.field(9, "error"), "invalid_input", "unknown frame");
+            assert_eq!(
+                out.field(10, "error"),
+                "invalid_input",
+                "partial quaternion"
+            );
+            assert_eq!(out.field(11, "error"), "", "missing body rates are 0");
+            for row in 4..11 {
+                assert_eq!(out.field(row, "v1_mps"), "");
+                assert_eq!(out.field(row, "ground_lat_deg"), "");
+            }
+        }
+    }
+
+    /// The ground columns come with a `frame` column only: not with Part I's columns,
+    /// nor with a quaternion alone.
+    #[test]
+    fn ground_columns_only_with_frame() {
+        let ground = "error,ground_lat_deg,ground_lon_deg,ground_height_m";
+        let q_only = "qw,qx,qy,qz,attitude_frame,x_m,y_m,z_m,vx_mps,vy_mps,vz_mps,\
+ground_h_m,f_m,pixel_m,n_px
+0.70710678,0,0.70710678,0,itrf,7016137,0,0,0,-1558.2,7464.5,0,0.555,13e-6,0
+";
+        for backend in ["reference", "f64", "f32"] {
+            assert!(Out::of(Model::Earth, backend, BUS_CASES)
+                .header()
+                .ends_with(ground));
+            let part1 = Out::of(Model::Earth, backend, EARTH_CASES);
+            assert!(part1.header().ends_with("drift_rad,error"));
+            let q = Out::of(Model::Earth, backend, q_only);
+            assert!(q.header().ends_with("drift_rad,error"));
+            assert_eq!(q.field(0, "error"), "");
+        }
+    }
+
+    /// Part I's rows keep their numbers and errors with a `frame` column (empty or
+    /// `inertial`), and gain the ground columns.
+    #[test]
+    fn part1_rows_unchanged_under_frame_column() {
+        let with_frame: String = EARTH_CASES
+            .lines()
+            .enumerate()
+            .map(|(i, line)| match i {
+                0 => format!("frame,{line}\n"),
+                i if i % 2 == 0 => format!("inertial,{line}\n"),
+                _ => format!(",{line}\n"),
+            })
+            .collect();
+        for backend in ["reference", "f64", "f32"] {
+            let old = Out::of(Model::Earth, backend, EARTH_CASES);
+            let new = Out::of(Model::Earth, backend, &with_frame);
+            assert_eq!(new.rows(), old.rows());
+            for row in 0..old.rows() {
+                for name in Earth::OUTPUTS.iter().chain(&["case"]) {
+                    assert_eq!(new.field(row, name), old.field(row, name), "{row} {name}");
+                }
+                let lat = new.field(row, "ground_lat_deg");
+                assert_eq!(lat.is_empty(), !old.field(row, "error").is_empty());
+            }
+            // The nadir row looks straight down on the equator at longitude 0.
+            assert!(new.num(0, "ground_lat_deg").abs() < 1e-9);
+            assert!(new.num(0, "ground_lon_deg").abs() < 1e-9);
+            assert!(new.num(0, "ground_height_m").abs() < 1e-6);
         }
     }
 }
