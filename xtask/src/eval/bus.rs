@@ -5,19 +5,25 @@
 
 use super::*;
 
+/// `N` of Part I's input columns ([`Columns::INPUTS`] for [`Earth`]) from `start`: the
+/// bus path reads the same columns, named once.
+const fn part1_columns<const N: usize>(start: usize) -> [&'static str; N] {
+    let inputs = <Earth as Columns>::INPUTS;
+    let mut out = [""; N];
+    let mut i = 0;
+    while i < N {
+        out[i] = inputs[start + i];
+        i += 1;
+    }
+    out
+}
+
 /// Part I's state columns, read in the bus's `frame`.
-pub(super) const STATE_COLUMNS: [&str; 6] = ["x_m", "y_m", "z_m", "vx_mps", "vy_mps", "vz_mps"];
+pub(super) const STATE_COLUMNS: [&str; 6] = part1_columns(0);
 /// Part I's attitude columns, replaced by the quaternion where a row has one.
-pub(super) const ANGLE_COLUMNS: [&str; 6] = [
-    "roll_deg",
-    "pitch_deg",
-    "yaw_deg",
-    "roll_rate_dps",
-    "pitch_rate_dps",
-    "yaw_rate_dps",
-];
+pub(super) const ANGLE_COLUMNS: [&str; 6] = part1_columns(6);
 /// Columns every row needs.
-pub(super) const COMMON_COLUMNS: [&str; 4] = ["ground_h_m", "f_m", "pixel_m", "n_px"];
+pub(super) const COMMON_COLUMNS: [&str; 4] = part1_columns(12);
 pub(super) const QUATERNION_COLUMNS: [&str; 4] = ["qw", "qx", "qy", "qz"];
 pub(super) const CAMERA_QUATERNION_COLUMNS: [&str; 4] = ["cam_qw", "cam_qx", "cam_qy", "cam_qz"];
 pub(super) const BODY_RATE_COLUMNS: [&str; 3] = ["wx_dps", "wy_dps", "wz_dps"];
