@@ -104,6 +104,18 @@ pub struct GeneralInstant<T> {
     pub v_b_mps: [T; 3],
 }
 
+/// The f64 state rounded to `T`, with |r|^2 - a^2: the one difference of nearly equal
+/// terms (a factor up to 16 at 200 km), so it is formed in f64 from the f64 state (soft
+/// f64 on the target), then rounded. Everything else is a product or a sum of like signs.
+#[inline(always)]
+fn state_in<T: Real>(state: &StateVector, ellipsoid: &Ellipsoid) -> ([T; 3], [T; 3], T) {
+    let (r64, v64) = (state.position_m, state.velocity_mps);
+    let a_m = ellipsoid.a_m;
+    let r2_minus_a2 =
+        T::from_f64((r64[0] * r64[0] + r64[1] * r64[1] + r64[2] * r64[2]) - a_m * a_m);
+    (r64.map(T::from_f64), v64.map(T::from_f64), r2_minus_a2)
+}
+
 impl<T: Real> General<T> {
     /// The per-instant half of [`Backend::update`]: the state checks of [`check_state`]
     /// in `T`, the orbital frame, the attitude, W_B and V_B. It makes none of the f64
@@ -116,20 +128,8 @@ impl<T: Real> General<T> {
         ellipsoid: &Ellipsoid,
         earth_rate_rad_s: f64,
     ) -> Result<GeneralInstant<T>, ModelError> {
-        let (r64, v64) = (state.position_m, state.velocity_mps);
-        // |r|^2 - a^2 is the one difference of nearly equal terms (a factor up to 16 at
-        // 200 km): formed in f64 from the f64 state (eight soft-f64 operations on the
-        // target), then rounded. Everything else is a product or a sum of like signs.
-        let a_m = ellipsoid.a_m;
-        let r2_minus_a2 =
-            T::from_f64((r64[0] * r64[0] + r64[1] * r64[1] + r64[2] * r64[2]) - a_m * a_m);
-        self.instant_parts(
-            r64.map(T::from_f64),
-            v64.map(T::from_f64),
-            r2_minus_a2,
-            attitude,
-            T::from_f64(earth_rate_rad_s),
-        )
+        let (r, v, r2_minus_a2) = state_in(state, ellipsoid);
+        self.instant_parts(r, v, r2_minus_a2, attitude, T::from_f64(earth_rate_rad_s))
     }
 
     /// [`General::instant`] from the state already in `T`: the position and velocity
@@ -205,17 +205,8 @@ impl<T: Real> General<T> {
         ellipsoid: &Ellipsoid,
         earth_rate_rad_s: f64,
     ) -> Result<GeneralInstant<T>, ModelError> {
-        let (r64, v64) = (state.position_m, state.velocity_mps);
-        let a_m = ellipsoid.a_m;
-        let r2_minus_a2 =
-            T::from_f64((r64[0] * r64[0] + r64[1] * r64[1] + r64[2] * r64[2]) - a_m * a_m);
-        self.instant_inertial_parts(
-            r64.map(T::from_f64),
-            v64.map(T::from_f64),
-            r2_minus_a2,
-            attitude,
-            T::from_f64(earth_rate_rad_s),
-        )
+        let (r, v, r2_minus_a2) = state_in(state, ellipsoid);
+        self.instant_inertial_parts(r, v, r2_minus_a2, attitude, T::from_f64(earth_rate_rad_s))
     }
 
     /// [`General::instant_inertial`] from the state already in `T` (as
