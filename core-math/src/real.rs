@@ -54,6 +54,13 @@ pub trait Real:
     /// (sin x, cos x) for |x| <= 0.15 by truncated Taylor series, to this type's
     /// precision: no call, a handful of multiply-adds. Used per pixel near the limb.
     fn small_sin_cos(x: Self) -> (Self, Self);
+    /// Cube root (libm's `cbrt`, `cbrtf`): the geodetic conversion's one root of its
+    /// cubic resolvent, once per call.
+    fn cbrt(self) -> Self;
+    /// atan2(self, x) in [-pi, pi] (libm's `atan2`, `atan2f`).
+    fn atan2(self, x: Self) -> Self;
+    /// sqrt(self^2 + y^2) without intermediate overflow (libm's `hypot`, `hypotf`).
+    fn hypot(self, y: Self) -> Self;
 }
 
 impl Scalar for f64 {
@@ -110,6 +117,18 @@ impl Real for f64 {
     fn atan(self) -> Self {
         libm::atan(self)
     }
+    #[inline(always)]
+    fn cbrt(self) -> Self {
+        libm::cbrt(self)
+    }
+    #[inline(always)]
+    fn atan2(self, x: Self) -> Self {
+        libm::atan2(self, x)
+    }
+    #[inline(always)]
+    fn hypot(self, y: Self) -> Self {
+        libm::hypot(self, y)
+    }
     /// Terms to x^9 and x^10: the first omitted ones are below 1.2e-17 x and 2.7e-19.
     #[inline(always)]
     fn small_sin_cos(x: Self) -> (Self, Self) {
@@ -165,6 +184,18 @@ impl Real for f32 {
     #[inline(always)]
     fn atan(self) -> Self {
         libm::atanf(self)
+    }
+    #[inline(always)]
+    fn cbrt(self) -> Self {
+        libm::cbrtf(self)
+    }
+    #[inline(always)]
+    fn atan2(self, x: Self) -> Self {
+        libm::atan2f(self, x)
+    }
+    #[inline(always)]
+    fn hypot(self, y: Self) -> Self {
+        libm::hypotf(self, y)
     }
     /// Terms to x^5 and x^4: the first omitted ones are below 3.5e-10 x and 1.6e-8,
     /// both under f32's unit roundoff (6e-8) relative to the results.

@@ -96,4 +96,17 @@ impl Real for MicroF32 {
         let (s, c) = <f32 as Real>::small_sin_cos(x.0);
         (MicroF32(s), MicroF32(c))
     }
+    /// The round-Earth model needs no geodetic conversion: libm's, as f32.
+    #[inline(always)]
+    fn cbrt(self) -> Self {
+        MicroF32(<f32 as Real>::cbrt(self.0))
+    }
+    #[inline(always)]
+    fn atan2(self, x: Self) -> Self {
+        MicroF32(<f32 as Real>::atan2(self.0, x.0))
+    }
+    #[inline(always)]
+    fn hypot(self, y: Self) -> Self {
+        MicroF32(<f32 as Real>::hypot(self.0, y.0))
+    }
 }
