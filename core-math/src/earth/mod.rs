@@ -26,6 +26,7 @@ use crate::real::{Real, Scalar};
 use crate::vector::{cross, dot};
 
 pub mod bus;
+pub mod dem;
 pub mod frames;
 pub mod general;
 #[cfg(feature = "reference")]
