@@ -4,7 +4,7 @@
 
 Writes core-math/tests/data/dem_tile.csv (the contract's DEM CSV: a 128 x 128 tile at
 0.001 deg, a broad mountain, a knife-edge ridge two rows wide, a cliff and seeded noise,
-heights 1 200..7 100 m in whole metres as a bus would upload them) and
+heights 1 275..4 310 m in whole metres as a bus would upload them) and
 core-math/tests/data/dem_cases.csv: Part II eval rows (state and attitude in the ITRF,
 so no C2T enters) with the expected outcome, the ground point and the image motion.
 
