@@ -542,3 +542,38 @@ fn tile_refusals() {
         (100.0, 100.0)
     );
 }
+
+/// The search's cost on the golden rays, in points of the ray evaluated (each a
+/// geodetic conversion and, inside the tile, a bilinear height): printed for
+/// `docs/earth-model.md`, and bounded so that a change that slows it shows.
+#[test]
+fn search_cost_on_the_golden_rays() {
+    let (grid, heights) = tile_data();
+    let tile = DemTile::new(grid, &heights).unwrap();
+    let (mut n, mut sum, mut max) = (0u32, [0u32; 2], [0u32; 2]);
+    for c in cases().iter().filter(|c| c.error.is_empty()) {
+        let g = &c.geometry;
+        let pix = <_ as Backend<Earth>>::pixel(&GENERAL_F64, &c.camera, c.n_px).unwrap();
+        let m = &g.attitude.camera_to_inertial;
+        let d: [f64; 3] = core::array::from_fn(|i| (0..3).map(|j| m[i][j] * pix.u_m[j]).sum());
+        let r = g.state.position_m;
+        let (found, s64) = tile.first_crossing_counted(&g.ellipsoid, r, d);
+        assert!(found.is_ok());
+        let (found, s32) =
+            tile.first_crossing_counted(&g.ellipsoid, r.map(|x| x as f32), d.map(|x| x as f32));
+        assert!(found.is_ok());
+        for (k, s) in [s64, s32].into_iter().enumerate() {
+            sum[k] += s;
+            max[k] = max[k].max(s);
+        }
+        n += 1;
+    }
+    println!(
+        "dem search cost over {n} golden hits: f64 mean {:.0}, max {} points; f32 mean {:.0}, max {}",
+        sum[0] as f64 / n as f64,
+        max[0],
+        sum[1] as f64 / n as f64,
+        max[1]
+    );
+    assert!(max[0] <= 5_000 && max[1] <= 5_000, "{max:?}");
+}

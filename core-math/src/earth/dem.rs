@@ -200,11 +200,24 @@ impl<'a, H: Copy + Into<f64>> DemTile<'a, H> {
         r_m: [T; 3],
         d: [T; 3],
     ) -> Result<T, ModelError> {
+        self.first_crossing_counted(ellipsoid, r_m, d).0
+    }
+
+    /// [`DemTile::first_crossing`] with the number of points of the ray it evaluated
+    /// (march steps and polish): the search's cost, for tests and benchmarks.
+    pub fn first_crossing_counted<T: Real>(
+        &self,
+        ellipsoid: &Ellipsoid,
+        r_m: [T; 3],
+        d: [T; 3],
+    ) -> (Result<T, ModelError>, u32) {
         if !(ellipsoid.flattening >= 0.0 && ellipsoid.flattening <= GEODETIC_MAX_FLATTENING) {
-            return Err(ModelError::OutOfDomain(Param::Flattening));
+            return (Err(ModelError::OutOfDomain(Param::Flattening)), 0);
         }
         let search = Search::<T>::new(self, ellipsoid, d);
-        search.run(self, r_m, d)
+        let mut steps = 0;
+        let found = search.run(self, r_m, d, &mut steps);
+        (found, steps)
     }
 }
 
@@ -367,6 +380,7 @@ impl<T: Real> Search<T> {
         tile: &DemTile<'_, H>,
         r: [T; 3],
         d: [T; 3],
+        steps: &mut u32,
     ) -> Result<T, ModelError> {
         let margin = T::from_f64(BAND_MARGIN_M);
         if !(self.dn > T::ZERO) {
@@ -397,6 +411,7 @@ impl<T: Real> Search<T> {
         // The last point of the box seen above the surface, for the final polish.
         let mut last_above: Option<(T, T)> = None;
         for _ in 0..MAX_DEM_STEPS {
+            *steps += 1;
             if !(s <= top_out) {
                 return Err(outcome());
             }
@@ -432,7 +447,7 @@ impl<T: Real> Search<T> {
                 let f = h - tile.bilinear(&self.box_, lat, lon);
                 if f <= self.tolerance_m {
                     if above {
-                        return Ok(self.polish(tile, r, d, last_above, (s, f)));
+                        return Ok(self.polish(tile, r, d, last_above, (s, f), steps));
                     }
                 } else {
                     above = true;
@@ -471,6 +486,7 @@ impl<T: Real> Search<T> {
         d: [T; 3],
         before: Option<(T, T)>,
         at: (T, T),
+        steps: &mut u32,
     ) -> T {
         let Some(mut p) = before else { return at.0 };
         if !(T::EPSILON < T::from_f64(1e-10)) {
@@ -491,6 +507,7 @@ impl<T: Real> Search<T> {
                 break;
             }
             let x = [r[0] + next * d[0], r[1] + next * d[1], r[2] + next * d[2]];
+            *steps += 1;
             let (lat, lon, h) = geodetic_in(x, self.a_m, self.e2);
             if !self.box_.contains(lat, lon) {
                 break;
