@@ -300,12 +300,26 @@ impl EarthReference {
         g: &G,
         p: &EarthRefPixel,
     ) -> Result<ImageMotion<f64>, ModelError> {
-        let chain = EarthReference::chain(g, p)?;
-        if !(chain.motion.v1_mps.abs() >= super::MIN_V1_MPS) {
-            return Err(ModelError::NoAlongTrackMotion);
-        }
-        Ok(chain.motion)
+        along_track(EarthReference::chain(g, p)?)
     }
+
+    /// [`EarthReference::motion_of`] with the ground a DEM tile
+    /// ([`EarthReference::chain_on_dem`]).
+    pub fn motion_on_dem<G: ReferenceGeometry, H: Copy + Into<f64>>(
+        g: &G,
+        p: &EarthRefPixel,
+        tile: &DemTile<'_, H>,
+    ) -> Result<ImageMotion<f64>, ModelError> {
+        along_track(EarthReference::chain_on_dem(g, p, tile)?)
+    }
+}
+
+/// The chain's motion, refused when v1 is too slow to clock (as the general form).
+fn along_track(chain: EarthChain) -> Result<ImageMotion<f64>, ModelError> {
+    if !(chain.motion.v1_mps.abs() >= super::MIN_V1_MPS) {
+        return Err(ModelError::NoAlongTrackMotion);
+    }
+    Ok(chain.motion)
 }
 
 /// The first intersection s of r0 + s d with the ground ellipsoid
