@@ -577,3 +577,131 @@ fn search_cost_on_the_golden_rays() {
     );
     assert!(max[0] <= 5_000 && max[1] <= 5_000, "{max:?}");
 }
+
+/// A smooth tile of 128 x 128 nodes at 0.005 deg (555 m x 455 m cells) at 35 N 100 E:
+/// rolling relief 1 300..3 700 m, slopes up to about 0.3, as a 15 arc-second DEM of
+/// mountains shows them.
+fn smooth_tile() -> (DemGrid, Vec<f64>) {
+    let grid = DemGrid {
+        lat0_deg: 35.0,
+        lon0_deg: 100.0,
+        dlat_deg: 0.005,
+        dlon_deg: 0.005,
+        nrows: 128,
+        ncols: 128,
+    };
+    let tau = core::f64::consts::TAU;
+    let heights = (0..128 * 128)
+        .map(|k| {
+            let (i, j) = ((k / 128) as f64, (k % 128) as f64);
+            (2_500.0 + 900.0 * (tau * i / 128.0).sin() * (tau * j / 100.0).cos()
+                + 300.0 * (tau * (i + j) / 60.0).sin())
+            .round()
+        })
+        .collect();
+    (grid, heights)
+}
+
+/// A seeded ray from `alt` above a point of the tile at `inc` from its vertical.
+fn ray_at(
+    grid: &DemGrid,
+    rng: &mut SplitMix64,
+    inc_max_rad: f64,
+    inner: f64,
+) -> ([f64; 3], [f64; 3]) {
+    let e = Ellipsoid::WGS84;
+    let lat1 = grid.lat_deg(grid.nrows - 1);
+    let lon1 = grid.lon_deg(grid.ncols - 1);
+    let tlat = grid.lat0_deg + rng.uniform(inner, 1.0 - inner) * (lat1 - grid.lat0_deg);
+    let tlon = grid.lon0_deg + rng.uniform(inner, 1.0 - inner) * (lon1 - grid.lon0_deg);
+    let target = itrf_from_geodetic(tlat.to_radians(), tlon.to_radians(), 2_500.0, &e).unwrap();
+    let (la, lo) = (tlat.to_radians(), tlon.to_radians());
+    let up = [la.cos() * lo.cos(), la.cos() * lo.sin(), la.sin()];
+    let east = [-lo.sin(), lo.cos(), 0.0];
+    let north = [
+        up[1] * east[2] - up[2] * east[1],
+        up[2] * east[0] - up[0] * east[2],
+        up[0] * east[1] - up[1] * east[0],
+    ];
+    let alt = rng.uniform(500e3, 800e3);
+    let az = rng.uniform(0.0, core::f64::consts::TAU);
+    let off = alt * rng.uniform(0.0, inc_max_rad).tan();
+    let r: [f64; 3] = core::array::from_fn(|k| {
+        target[k] + alt * up[k] + off * (az.cos() * north[k] + az.sin() * east[k])
+    });
+    (r, core::array::from_fn(|k| target[k] - r[k]))
+}
+
+/// The height search against the march on a smooth tile, rays up to 40 deg from the
+/// vertical well inside the tile: the same ground point (f64 within its certified
+/// bound and 0.01 m; f32 within 2 m of height), cold and warm started, with the
+/// evaluations it took; on the knife-edge golden tile it declines (`Steep`) instead.
+#[test]
+fn height_search_agrees_with_the_march_where_it_applies() {
+    use core_math::earth::dem::HeightRefusal;
+    let (grid, heights) = smooth_tile();
+    let tile = DemTile::new(grid, &heights).unwrap();
+    let e = Ellipsoid::WGS84;
+    let mut rng = SplitMix64(0x4E16_2026_1126);
+    let (mut n, mut steep, mut worst64, mut worst32) = (0, 0, 0f64, 0f64);
+    let (mut cold, mut warm, mut cold32, mut warm32, mut max_warm32) = (0, 0, 0, 0, 0);
+    for _ in 0..400 {
+        let (r, d) = ray_at(&grid, &mut rng, 40f64.to_radians(), 0.3);
+        let exact = tile.first_crossing(&e, r, d).unwrap();
+        let dn = libm::sqrt(d.iter().map(|x| x * x).sum());
+        let g = core::array::from_fn(|k| r[k] + exact * d[k]);
+        let (_, _, h_exact) = geodetic_from_itrf(g, &e).unwrap();
+        let found = match tile.crossing_by_height(&e, r, d, None, 1e-3) {
+            Err(HeightRefusal::Steep) => {
+                steep += 1;
+                continue;
+            }
+            other => other.unwrap(),
+        };
+        let off_m = (found.s - exact).abs() * dn;
+        assert!(found.error_bound_m <= 1e-3, "{found:?}");
+        assert!(off_m <= 0.01, "height search {off_m} m from the march: {found:?}");
+        worst64 = worst64.max(off_m);
+        cold += found.evaluations;
+        // Warm: the hint is the height 300 m off the answer, as after an update's motion
+        // over terrain of slope 0.3 (700 m along the ground at 10 Hz, say).
+        let warm64 = tile
+            .crossing_by_height(&e, r, d, Some(h_exact + 300.0 * rng.uniform(-1.0, 1.0)), 1e-3)
+            .unwrap();
+        warm += warm64.evaluations;
+        let (r32, d32) = (r.map(|x| x as f32), d.map(|x| x as f32));
+        for (hint, tally) in [(None, &mut cold32), (Some(h_exact as f32 + 200.0), &mut warm32)] {
+            let f = tile.crossing_by_height(&e, r32, d32, hint, 0.5f32).unwrap();
+            let dh = (f.h_m as f64 - h_exact).abs();
+            assert!(dh <= 2.0, "f32 height {dh} m off: {f:?}");
+            worst32 = worst32.max(dh);
+            *tally += f.evaluations;
+            if hint.is_some() {
+                max_warm32 = max_warm32.max(f.evaluations);
+            }
+        }
+        n += 1;
+    }
+    assert!(n >= 300, "{n} rays taken, {steep} steep");
+    let mean = |x: u32| x as f64 / n as f64;
+    println!(
+        "height search, smooth tile, {n} rays (of 400; {steep} declined as steep): f64 within \
+         {worst64:.1e} m of the march, {:.2} evaluations cold, {:.2} warm (300 m hint); f32 \
+         heights within {worst32:.2} m, {:.2} cold, {:.2} warm (200 m hint, at most {max_warm32})",
+        mean(cold),
+        mean(warm),
+        mean(cold32),
+        mean(warm32)
+    );
+    // The knife-edge tile: a slope of 18 makes every oblique ray steep.
+    let (grid, heights) = tile_data();
+    let ridge = DemTile::new(grid, &heights).unwrap();
+    let mut declined = 0;
+    for _ in 0..50 {
+        let (r, d) = ray_at(&grid, &mut rng, 40f64.to_radians(), 0.3);
+        if let Err(HeightRefusal::Steep) = ridge.crossing_by_height(&e, r, d, None, 1e-3) {
+            declined += 1;
+        }
+    }
+    assert!(declined >= 45, "{declined} of 50 declined on the knife-edge tile");
+}

@@ -37,6 +37,10 @@ use crate::earth::Ellipsoid;
 use crate::error::{ModelError, Param};
 use crate::real::Real;
 
+pub mod height;
+
+pub use height::{HeightCrossing, HeightRefusal, MAX_CONTRACTION, MAX_HEIGHT_EVALUATIONS};
+
 /// Lowest node height a tile may hold (m; the Dead Sea's shore is at -430 m).
 pub const MIN_DEM_HEIGHT_M: f64 = -500.0;
 /// Highest node height a tile may hold (m; Everest is 8 849 m).
