@@ -594,7 +594,8 @@ fn smooth_tile() -> (DemGrid, Vec<f64>) {
     let heights = (0..128 * 128)
         .map(|k| {
             let (i, j) = ((k / 128) as f64, (k % 128) as f64);
-            (2_500.0 + 900.0 * (tau * i / 128.0).sin() * (tau * j / 100.0).cos()
+            (2_500.0
+                + 900.0 * (tau * i / 128.0).sin() * (tau * j / 100.0).cos()
                 + 300.0 * (tau * (i + j) / 60.0).sin())
             .round()
         })
@@ -660,17 +661,29 @@ fn height_search_agrees_with_the_march_where_it_applies() {
         };
         let off_m = (found.s - exact).abs() * dn;
         assert!(found.error_bound_m <= 1e-3, "{found:?}");
-        assert!(off_m <= 0.01, "height search {off_m} m from the march: {found:?}");
+        assert!(
+            off_m <= 0.01,
+            "height search {off_m} m from the march: {found:?}"
+        );
         worst64 = worst64.max(off_m);
         cold += found.evaluations;
         // Warm: the hint is the height 300 m off the answer, as after an update's motion
         // over terrain of slope 0.3 (700 m along the ground at 10 Hz, say).
         let warm64 = tile
-            .crossing_by_height(&e, r, d, Some(h_exact + 300.0 * rng.uniform(-1.0, 1.0)), 1e-3)
+            .crossing_by_height(
+                &e,
+                r,
+                d,
+                Some(h_exact + 300.0 * rng.uniform(-1.0, 1.0)),
+                1e-3,
+            )
             .unwrap();
         warm += warm64.evaluations;
         let (r32, d32) = (r.map(|x| x as f32), d.map(|x| x as f32));
-        for (hint, tally) in [(None, &mut cold32), (Some(h_exact as f32 + 200.0), &mut warm32)] {
+        for (hint, tally) in [
+            (None, &mut cold32),
+            (Some(h_exact as f32 + 200.0), &mut warm32),
+        ] {
             let f = tile.crossing_by_height(&e, r32, d32, hint, 0.5f32).unwrap();
             let dh = (f.h_m as f64 - h_exact).abs();
             assert!(dh <= 2.0, "f32 height {dh} m off: {f:?}");
@@ -703,5 +716,48 @@ fn height_search_agrees_with_the_march_where_it_applies() {
             declined += 1;
         }
     }
-    assert!(declined >= 45, "{declined} of 50 declined on the knife-edge tile");
+    assert!(
+        declined >= 45,
+        "{declined} of 50 declined on the knife-edge tile"
+    );
+}
+
+/// The height search's latitude and longitude about the tile's centre (series, the
+/// raised ellipsoid's normal) against the exact geodetic coordinates: points of the
+/// smooth tile at heights across the band, in f64 and f32, in grid cells.
+#[test]
+fn height_search_grid_coordinates_match_geodetic() {
+    let (grid, heights) = smooth_tile();
+    let tile = DemTile::new(grid, &heights).unwrap();
+    let e = Ellipsoid::WGS84;
+    let s64 = tile.height_search::<f64>(&e);
+    let s32 = tile.height_search::<f32>(&e);
+    let mut rng = SplitMix64(0x9E0_2026_1126);
+    let (mut worst64, mut worst32) = (0f64, 0f64);
+    let lat1 = grid.lat_deg(grid.nrows - 1);
+    let lon1 = grid.lon_deg(grid.ncols - 1);
+    for _ in 0..20_000 {
+        // A hundredth of a cell inside the edges, which rounding may otherwise cross.
+        let lat = rng.uniform(grid.lat0_deg + 5e-5, lat1 - 5e-5);
+        let lon = rng.uniform(grid.lon0_deg + 5e-5, lon1 - 5e-5);
+        let h = rng.uniform(-500.0, 9_000.0);
+        let x = itrf_from_geodetic(lat.to_radians(), lon.to_radians(), h, &e).unwrap();
+        let want = ((lat - grid.lat0_deg) / grid.dlat_deg, (lon - grid.lon0_deg) / grid.dlon_deg);
+        // x lies at geodetic height h; the search's points lie on the raised ellipsoid,
+        // within 1.41e-6 |h| of it, so give it the height it has.
+        let (r, c) = s64.grid_at(h, x).unwrap();
+        worst64 = worst64.max((r - want.0).abs().max((c - want.1).abs()));
+        let (r, c) = s32.grid_at(h as f32, x.map(|v| v as f32)).unwrap();
+        worst32 = worst32.max((r as f64 - want.0).abs().max((c as f64 - want.1).abs()));
+    }
+    // In metres: a cell is 455-555 m.
+    println!(
+        "height search grid coordinates: f64 within {worst64:.1e} cells, f32 within {worst32:.1e} cells"
+    );
+    // f64: the raised ellipsoid's normal, about 1e-8 rad from the geodetic one at 9 000 m
+    // (a few centimetres); f32: the rounding of ITRF coordinates (0.5 m at 6 400 km).
+    assert!(worst64 <= 1e-4 && worst32 <= 3e-3, "{worst64:e} {worst32:e}");
+    // Outside the tile: none.
+    let far = itrf_from_geodetic(40f64.to_radians(), 100.2f64.to_radians(), 0.0, &e).unwrap();
+    assert_eq!(s64.grid_at(0.0, far), None);
 }

@@ -39,7 +39,9 @@ use crate::real::Real;
 
 pub mod height;
 
-pub use height::{HeightCrossing, HeightRefusal, MAX_CONTRACTION, MAX_HEIGHT_EVALUATIONS};
+pub use height::{
+    HeightCrossing, HeightRefusal, HeightSearch, MAX_CONTRACTION, MAX_HEIGHT_EVALUATIONS,
+};
 
 /// Lowest node height a tile may hold (m; the Dead Sea's shore is at -430 m).
 pub const MIN_DEM_HEIGHT_M: f64 = -500.0;
@@ -175,15 +177,18 @@ impl<'a, H: Copy + Into<f64>> DemTile<'a, H> {
 
     /// The bilinear height at a point of the closed box.
     fn bilinear<T: Real>(&self, b: &GridBox<T>, lat_rad: T, lon_rad: T) -> T {
-        let g = &self.grid;
-        let (u, i) = cell(
+        self.bilinear_grid(
             (lat_rad - b.lat0_rad) * b.inv_dlat_per_rad,
-            g.nrows as u32 - 2,
-        );
-        let (v, j) = cell(
             (lon_rad - b.lon0_rad) * b.inv_dlon_per_rad,
-            g.ncols as u32 - 2,
-        );
+        )
+    }
+
+    /// The bilinear height at grid coordinates (x, y) = (row, column) in
+    /// [0, nrows - 1] x [0, ncols - 1], fractions included.
+    fn bilinear_grid<T: Real>(&self, x: T, y: T) -> T {
+        let g = &self.grid;
+        let (u, i) = cell(x, g.nrows as u32 - 2);
+        let (v, j) = cell(y, g.ncols as u32 - 2);
         let (i, j) = (i as usize, j as usize);
         let at = |i: usize, j: usize| -> T { T::from_f64(self.heights_m[i * g.ncols + j].into()) };
         let (h00, h01, h10, h11) = (at(i, j), at(i, j + 1), at(i + 1, j), at(i + 1, j + 1));
