@@ -48,6 +48,10 @@ pub trait Real:
     /// Conversion to u32, saturating at 0 and `u32::MAX` (NaN gives 0), as Rust's `as`.
     fn to_u32(self) -> u32;
     fn from_u32(n: u32) -> Self;
+    /// An i16 exactly (a DEM node height in metres).
+    fn from_i16(n: i16) -> Self;
+    /// An f32 exactly (f64) or as is (f32).
+    fn from_f32(x: f32) -> Self;
     /// atan(x) (f32: libm's `atanf`, pure f32, 0.85 ulp; used once per segment, never
     /// per pixel).
     fn atan(self) -> Self;
@@ -112,6 +116,14 @@ impl Real for f64 {
     #[inline(always)]
     fn from_u32(n: u32) -> Self {
         n as f64
+    }
+    #[inline(always)]
+    fn from_i16(n: i16) -> Self {
+        f64::from(n)
+    }
+    #[inline(always)]
+    fn from_f32(x: f32) -> Self {
+        f64::from(x)
     }
     #[inline(always)]
     fn atan(self) -> Self {
@@ -180,6 +192,14 @@ impl Real for f32 {
     #[inline(always)]
     fn from_u32(n: u32) -> Self {
         n as f32
+    }
+    #[inline(always)]
+    fn from_i16(n: i16) -> Self {
+        f32::from(n)
+    }
+    #[inline(always)]
+    fn from_f32(x: f32) -> Self {
+        x
     }
     #[inline(always)]
     fn atan(self) -> Self {

@@ -742,7 +742,10 @@ fn height_search_grid_coordinates_match_geodetic() {
         let lon = rng.uniform(grid.lon0_deg + 5e-5, lon1 - 5e-5);
         let h = rng.uniform(-500.0, 9_000.0);
         let x = itrf_from_geodetic(lat.to_radians(), lon.to_radians(), h, &e).unwrap();
-        let want = ((lat - grid.lat0_deg) / grid.dlat_deg, (lon - grid.lon0_deg) / grid.dlon_deg);
+        let want = (
+            (lat - grid.lat0_deg) / grid.dlat_deg,
+            (lon - grid.lon0_deg) / grid.dlon_deg,
+        );
         // x lies at geodetic height h; the search's points lie on the raised ellipsoid,
         // within 1.41e-6 |h| of it, so give it the height it has.
         let (r, c) = s64.grid_at(h, x).unwrap();
@@ -756,7 +759,10 @@ fn height_search_grid_coordinates_match_geodetic() {
     );
     // f64: the raised ellipsoid's normal, about 1e-8 rad from the geodetic one at 9 000 m
     // (a few centimetres); f32: the rounding of ITRF coordinates (0.5 m at 6 400 km).
-    assert!(worst64 <= 1e-4 && worst32 <= 3e-3, "{worst64:e} {worst32:e}");
+    assert!(
+        worst64 <= 1e-4 && worst32 <= 3e-3,
+        "{worst64:e} {worst32:e}"
+    );
     // Outside the tile: none.
     let far = itrf_from_geodetic(40f64.to_radians(), 100.2f64.to_radians(), 0.0, &e).unwrap();
     assert_eq!(s64.grid_at(0.0, far), None);

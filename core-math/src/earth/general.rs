@@ -31,7 +31,7 @@
 
 use core::marker::PhantomData;
 
-use crate::earth::dem::DemTile;
+use crate::earth::dem::{DemHeight, DemTile};
 use crate::earth::{
     check_altitude, check_state, Attitude, Earth, EarthCamera, EarthGeometry, Ellipsoid,
     InertialAttitude, InertialGeometry, MIN_V1_MPS,
@@ -355,7 +355,7 @@ impl<T: Real> General<T> {
     /// r + s d of the tile's surface ([`DemTile::first_crossing`], in `T`), d = B u the
     /// pixel's line of sight in I (I is the ITRF at the instant). What
     /// [`General::motion_at_inv_range`] takes in place of the ellipsoid's root.
-    pub fn dem_inv_range<H: Copy + Into<f64>>(
+    pub fn dem_inv_range<H: DemHeight>(
         &self,
         g: &InertialGeometry<T>,
         px: &GeneralPixel<T>,

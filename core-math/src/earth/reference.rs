@@ -13,7 +13,7 @@
 //! closed-form range): agreement between the two is the proof of that derivation.
 
 use crate::dual::Dual;
-use crate::earth::dem::DemTile;
+use crate::earth::dem::{DemHeight, DemTile};
 use crate::earth::{
     Attitude, Earth, EarthCamera, EarthGeometry, Ellipsoid, Ground, InertialAttitude,
     InertialGeometry,
@@ -207,7 +207,7 @@ impl EarthReference {
     /// [`EarthReference::chain`] with the ground a DEM tile (Part II): the ground point
     /// is the tile's [`DemTile::first_crossing`] (whose independent check is
     /// `tools/goldens/dem_crossing.py`); the construction from it on is the same.
-    pub fn chain_on_dem<G: ReferenceGeometry, H: Copy + Into<f64>>(
+    pub fn chain_on_dem<G: ReferenceGeometry, H: DemHeight>(
         g: &G,
         p: &EarthRefPixel,
         tile: &DemTile<'_, H>,
@@ -305,7 +305,7 @@ impl EarthReference {
 
     /// [`EarthReference::motion_of`] with the ground a DEM tile
     /// ([`EarthReference::chain_on_dem`]).
-    pub fn motion_on_dem<G: ReferenceGeometry, H: Copy + Into<f64>>(
+    pub fn motion_on_dem<G: ReferenceGeometry, H: DemHeight>(
         g: &G,
         p: &EarthRefPixel,
         tile: &DemTile<'_, H>,

@@ -86,6 +86,14 @@ impl Real for MicroF32 {
     fn from_u32(n: u32) -> Self {
         MicroF32(<f32 as Real>::from_u32(n))
     }
+    #[inline(always)]
+    fn from_i16(n: i16) -> Self {
+        MicroF32(f32::from(n))
+    }
+    #[inline(always)]
+    fn from_f32(x: f32) -> Self {
+        MicroF32(x)
+    }
     /// micromath's atan (2.8e-3, EMBEDDED-NOTES.md), consistent with the variant.
     #[inline(always)]
     fn atan(self) -> Self {

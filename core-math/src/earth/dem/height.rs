@@ -22,7 +22,7 @@
 //! band does not lie in the tile's box, and the model's own (a ray that misses the
 //! band).
 
-use super::{DemTile, BAND_MARGIN_M};
+use super::{DemHeight, DemTile, BAND_MARGIN_M};
 use crate::earth::Ellipsoid;
 use crate::error::ModelError;
 use crate::real::Real;
@@ -88,7 +88,7 @@ pub struct HeightSearch<'t, 'a, H, T> {
     last_col: T,
 }
 
-impl<'a, H: Copy + Into<f64>> DemTile<'a, H> {
+impl<'a, H: DemHeight> DemTile<'a, H> {
     /// The height search's constants for this tile on ellipsoid `e`, in `T`.
     pub fn height_search<T: Real>(&self, e: &Ellipsoid) -> HeightSearch<'_, 'a, H, T> {
         let g = &self.grid;
@@ -143,7 +143,7 @@ impl<'a, H: Copy + Into<f64>> DemTile<'a, H> {
     }
 }
 
-impl<H: Copy + Into<f64>, T: Real> HeightSearch<'_, '_, H, T> {
+impl<H: DemHeight, T: Real> HeightSearch<'_, '_, H, T> {
     /// The ground point of r + s d (r, d in the ITRF) by the search in height (see the
     /// module), starting from `hint_h_m` (the previous update's height for this pixel;
     /// `None`: the middle of the band), to within `tolerance_m` of height.

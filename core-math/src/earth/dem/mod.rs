@@ -64,6 +64,49 @@ pub const POLISH_REACH_M: f64 = 1.0;
 /// a long way, and then [`DemTile::first_crossing`] refuses (`OutOfDomain(DemGrid)`).
 pub const MAX_DEM_STEPS: u32 = 200_000;
 
+/// A node height as a tile may store it: `i16` metres (as the protocol uploads them),
+/// `f32` or `f64`. Its conversion to the search's scalar is direct (one `vcvt` for
+/// `i16` to f32 on the target: no detour through soft f64).
+pub trait DemHeight: Copy {
+    /// The height (m) as an f64, for the tile's checks and bounds.
+    fn to_f64(self) -> f64;
+    /// The height (m) in the search's scalar.
+    fn to_real<T: Real>(self) -> T;
+}
+
+impl DemHeight for i16 {
+    #[inline(always)]
+    fn to_f64(self) -> f64 {
+        f64::from(self)
+    }
+    #[inline(always)]
+    fn to_real<T: Real>(self) -> T {
+        T::from_i16(self)
+    }
+}
+
+impl DemHeight for f32 {
+    #[inline(always)]
+    fn to_f64(self) -> f64 {
+        f64::from(self)
+    }
+    #[inline(always)]
+    fn to_real<T: Real>(self) -> T {
+        T::from_f32(self)
+    }
+}
+
+impl DemHeight for f64 {
+    #[inline(always)]
+    fn to_f64(self) -> f64 {
+        self
+    }
+    #[inline(always)]
+    fn to_real<T: Real>(self) -> T {
+        T::from_f64(self)
+    }
+}
+
 /// The grid of a tile: node (i, j) at latitude lat0 + i dlat, longitude lon0 + j dlon
 /// (geodetic, ITRF, degrees), i < nrows (from the south), j < ncols (from the west).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -77,7 +120,7 @@ pub struct DemGrid {
 }
 
 /// A checked tile: the grid, its heights (m above the ellipsoid, row-major, row 0 the
-/// southernmost), and the bounds the search needs, found once.
+/// southernmost; any [`DemHeight`]), and the bounds the search needs, found once.
 #[derive(Clone, Copy, Debug)]
 pub struct DemTile<'a, H> {
     grid: DemGrid,
@@ -90,7 +133,7 @@ pub struct DemTile<'a, H> {
     slope_lon_m_per_rad: f64,
 }
 
-impl<'a, H: Copy + Into<f64>> DemTile<'a, H> {
+impl<'a, H: DemHeight> DemTile<'a, H> {
     /// The tile of `grid` with `heights_m` (nrows x ncols, row-major). Refusals:
     /// - `InvalidInput(DemGrid)`: fewer than 2 or more than [`MAX_DEM_NODES`] nodes along
     ///   a side, spacings not positive, or a height count other than nrows x ncols;
@@ -124,7 +167,7 @@ impl<'a, H: Copy + Into<f64>> DemTile<'a, H> {
         }
         let (mut min_m, mut max_m) = (f64::INFINITY, f64::NEG_INFINITY);
         for &h in heights_m {
-            let h: f64 = h.into();
+            let h = h.to_f64();
             if !h.is_finite() {
                 return Err(ModelError::NonFinite(Param::DemHeight));
             }
@@ -134,7 +177,7 @@ impl<'a, H: Copy + Into<f64>> DemTile<'a, H> {
             min_m = min_m.min(h);
             max_m = max_m.max(h);
         }
-        let at = |i: usize, j: usize| -> f64 { heights_m[i * g.ncols + j].into() };
+        let at = |i: usize, j: usize| -> f64 { heights_m[i * g.ncols + j].to_f64() };
         let (mut step_lat_m, mut step_lon_m) = (0.0f64, 0.0f64);
         for i in 0..g.nrows {
             for j in 0..g.ncols {
@@ -190,7 +233,7 @@ impl<'a, H: Copy + Into<f64>> DemTile<'a, H> {
         let (u, i) = cell(x, g.nrows as u32 - 2);
         let (v, j) = cell(y, g.ncols as u32 - 2);
         let (i, j) = (i as usize, j as usize);
-        let at = |i: usize, j: usize| -> T { T::from_f64(self.heights_m[i * g.ncols + j].into()) };
+        let at = |i: usize, j: usize| -> T { self.heights_m[i * g.ncols + j].to_real() };
         let (h00, h01, h10, h11) = (at(i, j), at(i, j + 1), at(i + 1, j), at(i + 1, j + 1));
         let south = h00 + (h01 - h00) * v;
         let north = h10 + (h11 - h10) * v;
@@ -338,7 +381,7 @@ struct Search<T> {
 }
 
 impl<T: Real> Search<T> {
-    fn new<H: Copy + Into<f64>>(tile: &DemTile<'_, H>, e: &Ellipsoid, d: [T; 3]) -> Self {
+    fn new<H: DemHeight>(tile: &DemTile<'_, H>, e: &Ellipsoid, d: [T; 3]) -> Self {
         let (a, f) = (e.a_m, e.flattening);
         let e2 = f * (2.0 - f);
         let g = &tile.grid;
@@ -384,7 +427,7 @@ impl<T: Real> Search<T> {
         roots(self.a_m + h_m, self.b_m + h_m, r, d)
     }
 
-    fn run<H: Copy + Into<f64>>(
+    fn run<H: DemHeight>(
         &self,
         tile: &DemTile<'_, H>,
         r: [T; 3],
@@ -488,7 +531,7 @@ impl<T: Real> Search<T> {
     /// motion), and a few secant steps on f reach the zero it approaches, each kept
     /// within [`POLISH_REACH_M`] of path of the march's point. Only where the scalar resolves the surface far
     /// better than the tolerance (f64); in f32 the march's point is the answer.
-    fn polish<H: Copy + Into<f64>>(
+    fn polish<H: DemHeight>(
         &self,
         tile: &DemTile<'_, H>,
         r: [T; 3],
