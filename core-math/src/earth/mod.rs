@@ -313,7 +313,7 @@ impl EarthGeometry<f64> {
 /// [`EarthGeometry`] with Part II's attitude: the camera's axes in I and its angular
 /// velocity ([`InertialAttitude`], from the bus's quaternion and gyro rates by
 /// [`bus::bus_geometry`]). Everything else as in Part I. The backends take it through
-/// their own entry points (`EarthReference::chain_inertial`,
+/// their own entry points (`EarthReference::chain` and `motion_of`,
 /// `General::update_inertial`), whose update is the same type as Part I's: the
 /// per-pixel work does not change.
 #[derive(Clone, Copy, Debug, PartialEq)]
