@@ -46,64 +46,35 @@ const NEAR_LIMB_DEG: f64 = 1.0;
 /// Pixels in the bench's loop regions (firmware/src/bin/bench.rs, `LOOP_PX`).
 const LOOP_PX: u64 = 32;
 
-/// One backend of the report: its name (also its `--cfg footprint` value) and its bench
-/// regions: `motion` over `LOOP_PX` pixels in a loop, and one full update of the default
-/// scene (`update`, then `motion` at each of its planned sample points).
-struct Variant {
-    name: &'static str,
-    loop_label: &'static str,
-    full_update_label: &'static str,
+/// One backend of the report: its name (also its `--cfg footprint` value) and the name
+/// of its bench regions: `<backend> motion, 32 pixels in a loop` (`motion` over
+/// `LOOP_PX` pixels) and `<backend> full update` (one full update of the default scene:
+/// `update`, then `motion` at each of its planned sample points).
+struct Variant(&'static str, &'static str);
+
+impl Variant {
+    fn loop_label(&self) -> String {
+        format!("{} motion, {LOOP_PX} pixels in a loop", self.1)
+    }
+
+    fn full_update_label(&self) -> String {
+        format!("{} full update", self.1)
+    }
 }
 
 /// The round-Earth variants first (`SPHERE_VARIANTS` of them, errors over the round-Earth
 /// sample), then the real-Earth ones (errors over the real-Earth sample).
 const SPHERE_VARIANTS: usize = 6;
 const VARIANTS: [Variant; 9] = [
-    Variant {
-        name: "naive-f32",
-        loop_label: "NaiveF32 motion, 32 pixels in a loop",
-        full_update_label: "NaiveF32 full update",
-    },
-    Variant {
-        name: "reference",
-        loop_label: "Reference motion, 32 pixels in a loop",
-        full_update_label: "Reference full update",
-    },
-    Variant {
-        name: "f64",
-        loop_label: "CLOSED_F64 motion, 32 pixels in a loop",
-        full_update_label: "CLOSED_F64 full update",
-    },
-    Variant {
-        name: "f32",
-        loop_label: "CLOSED_F32 motion, 32 pixels in a loop",
-        full_update_label: "CLOSED_F32 full update",
-    },
-    Variant {
-        name: "f32-micromath",
-        loop_label: "CLOSED_MICROMATH motion, 32 pixels in a loop",
-        full_update_label: "CLOSED_MICROMATH full update",
-    },
-    Variant {
-        name: "fixed",
-        loop_label: "FIXED motion, 32 pixels in a loop",
-        full_update_label: "FIXED full update",
-    },
-    Variant {
-        name: "earth-reference",
-        loop_label: "EarthReference motion, 32 pixels in a loop",
-        full_update_label: "EarthReference full update",
-    },
-    Variant {
-        name: "earth-f64",
-        loop_label: "GENERAL_F64 motion, 32 pixels in a loop",
-        full_update_label: "GENERAL_F64 full update",
-    },
-    Variant {
-        name: "earth-f32",
-        loop_label: "GENERAL_F32 motion, 32 pixels in a loop",
-        full_update_label: "GENERAL_F32 full update",
-    },
+    Variant("naive-f32", "NaiveF32"),
+    Variant("reference", "Reference"),
+    Variant("f64", "CLOSED_F64"),
+    Variant("f32", "CLOSED_F32"),
+    Variant("f32-micromath", "CLOSED_MICROMATH"),
+    Variant("fixed", "FIXED"),
+    Variant("earth-reference", "EarthReference"),
+    Variant("earth-f64", "GENERAL_F64"),
+    Variant("earth-f32", "GENERAL_F32"),
 ];
 
 #[derive(Default)]
@@ -160,7 +131,7 @@ pub fn run(args: &Args) -> Result<()> {
     let seed = args.seed.unwrap_or(DEFAULT_SEED);
     let sample = sweep(seed, cases);
     let (counts, flash) = if bench {
-        let names: Vec<&str> = VARIANTS.iter().map(|v| v.name).collect();
+        let names: Vec<&str> = VARIANTS.iter().map(|v| v.0).collect();
         (
             Some(bench_counts(true)?),
             Some(crate::footprint::variant_bytes(&names)?),
@@ -435,7 +406,7 @@ fn print_table(
     );
     let mut rows = Vec::new();
     for (i, (v, e)) in VARIANTS.iter().zip(&sample.errors).enumerate() {
-        let name = v.name;
+        let name = v.0;
         let mut far = e.far.clone();
         let p99 = percentile(&mut far, 0.99);
         let max = far.last().copied().unwrap_or(0.0);
@@ -448,10 +419,10 @@ fn print_table(
                     .with_context(|| format!("report: no bench region `{label}`")),
             }
         };
-        let per_pixel = count(v.loop_label)?.map_or(String::new(), |n| {
+        let per_pixel = count(&v.loop_label())?.map_or(String::new(), |n| {
             format!("{:.1}", n as f64 / LOOP_PX as f64)
         });
-        let per_update = count(v.full_update_label)?.map_or(String::new(), |n| n.to_string());
+        let per_update = count(&v.full_update_label())?.map_or(String::new(), |n| n.to_string());
         rows.push([
             name.to_string(),
             format!("{max:.2e}"),
