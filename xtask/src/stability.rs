@@ -188,15 +188,16 @@ fn figures(maps: &[Map], quick: bool, secs: f64) -> BTreeMap<String, String> {
     for m in maps {
         let letter = m.spec.letter;
         let a = aggregate(m, |_, _, _| true);
+        let mut put = |what: &str, s: String| put(&format!("{letter}.{what}"), s);
         put(
-            &format!("{letter}.grid"),
+            "grid",
             format!(
                 "{} x {} cells, {} sub-samples each, {} cases",
                 m.nx, m.ny, m.sub, a.n
             ),
         );
-        put(&format!("{letter}.others"), m.spec.others.into());
-        put(&format!("{letter}.key"), m.spec.key.into());
+        put("others", m.spec.others.into());
+        put("key", m.spec.key.into());
         for (what, w) in [
             ("worst_f32", &a.worst_f32),
             ("worst_f32_in", &a.worst_f32_in),
@@ -204,32 +205,20 @@ fn figures(maps: &[Map], quick: bool, secs: f64) -> BTreeMap<String, String> {
             ("max_kappa", &a.max_kappa),
         ] {
             if let Some((p, o)) = w {
-                for (k, s) in sample_figures(&format!("{letter}.{what}"), p, o) {
+                for (k, s) in sample_figures(what, p, o) {
                     put(&k, s);
                 }
             }
         }
-        put(
-            &format!("{letter}.ratio_f32"),
-            format!("{:.2}", a.ratio_f32),
-        );
-        put(
-            &format!("{letter}.ratio_f32_in"),
-            format!("{:.2}", a.ratio_f32_in),
-        );
-        put(
-            &format!("{letter}.ratio_fixed"),
-            format!("{:.2}", a.ratio_fixed),
-        );
-        put(&format!("{letter}.kappa_min"), sig(a.kappa_min));
-        put(&format!("{letter}.kappa_max"), sig(a.kappa_max));
-        put(&format!("{letter}.e_f32"), e2(a.err.f32));
-        put(&format!("{letter}.e_f32_in"), e2(a.err.f32_in));
-        put(&format!("{letter}.e_fixed"), e2(a.err.fixed_worst()));
-        put(
-            &format!("{letter}.max_v1_terms"),
-            format!("{:.4}", a.max_v1_terms),
-        );
+        put("ratio_f32", format!("{:.2}", a.ratio_f32));
+        put("ratio_f32_in", format!("{:.2}", a.ratio_f32_in));
+        put("ratio_fixed", format!("{:.2}", a.ratio_fixed));
+        put("kappa_min", sig(a.kappa_min));
+        put("kappa_max", sig(a.kappa_max));
+        put("e_f32", e2(a.err.f32));
+        put("e_f32_in", e2(a.err.f32_in));
+        put("e_fixed", e2(a.err.fixed_worst()));
+        put("max_v1_terms", format!("{:.4}", a.max_v1_terms));
         rows.push((format!("{letter}: {}", m.spec.title), a.clone()));
         all.push(a);
     }

@@ -561,22 +561,23 @@ pub fn figures(maps: &[GMap], secs: f64) -> std::collections::BTreeMap<String, S
     for m in maps {
         let a = m.aggregate(|_, _| true);
         let l = m.spec.letter.replace('\'', "y");
+        let mut put = |what: &str, s: String| put(&format!("{l}.{what}"), s);
         put(
-            &format!("{l}.grid"),
+            "grid",
             format!(
                 "{} x {} cells, {} sub-samples each, {} cases",
                 m.nx, m.ny, m.sub, a.n
             ),
         );
-        put(&format!("{l}.others"), m.spec.others.into());
-        put(&format!("{l}.key"), m.spec.key.into());
-        put(&format!("{l}.ratio"), format!("{:.2}", a.ratio));
-        put(&format!("{l}.kappa_max"), sig(a.kappa));
-        put(&format!("{l}.err"), e2(a.err));
-        put(&format!("{l}.err_v1"), e2(a.err_v1));
-        put(&format!("{l}.err_tame"), format!("{:.3e}", a.err_tame));
-        put(&format!("{l}.over_tol"), a.over_tol.to_string());
-        put(&format!("{l}.over_tol_kappa"), sig(a.over_tol_kappa_min));
+        put("others", m.spec.others.into());
+        put("key", m.spec.key.into());
+        put("ratio", format!("{:.2}", a.ratio));
+        put("kappa_max", sig(a.kappa));
+        put("err", e2(a.err));
+        put("err_v1", e2(a.err_v1));
+        put("err_tame", format!("{:.3e}", a.err_tame));
+        put("over_tol", a.over_tol.to_string());
+        put("over_tol_kappa", sig(a.over_tol_kappa_min));
         for (what, w) in [
             ("worst", &a.worst),
             ("max_kappa", &a.max_kappa),
@@ -585,12 +586,12 @@ pub fn figures(maps: &[GMap], secs: f64) -> std::collections::BTreeMap<String, S
             ("max_err_v1", &a.max_err_v1),
         ] {
             if let Some((c, o)) = w {
-                put(&format!("{l}.{what}.at"), describe(c, o));
-                put(&format!("{l}.{what}.kappa"), sig(o.kappa));
-                put(&format!("{l}.{what}.err"), e2(o.err));
-                put(&format!("{l}.{what}.ratio"), format!("{:.2}", o.ratio()));
-                put(&format!("{l}.{what}.err_v1"), e2(o.err_v1));
-                put(&format!("{l}.{what}.v"), e2(o.v));
+                put(&format!("{what}.at"), describe(c, o));
+                put(&format!("{what}.kappa"), sig(o.kappa));
+                put(&format!("{what}.err"), e2(o.err));
+                put(&format!("{what}.ratio"), format!("{:.2}", o.ratio()));
+                put(&format!("{what}.err_v1"), e2(o.err_v1));
+                put(&format!("{what}.v"), e2(o.v));
             }
         }
         rows.push(row(&format!("{}: {}", m.spec.letter, m.spec.title), &a));
@@ -615,16 +616,14 @@ pub fn figures(maps: &[GMap], secs: f64) -> std::collections::BTreeMap<String, S
         ("steady", &all.steady),
     ] {
         if let Some((c, o)) = w {
-            put(&format!("G.{what}.at"), describe(c, o));
-            put(&format!("G.{what}.kappa"), sig(o.kappa));
-            put(&format!("G.{what}.err"), e2(o.err));
-            put(&format!("G.{what}.err_v1"), e2(o.err_v1));
-            put(&format!("G.{what}.v"), e2(o.v));
-            put(&format!("G.{what}.v1"), e2(o.v1));
-            put(
-                &format!("G.{what}.period_ms"),
-                sig(1e3 * CAMERA.pixel_m / o.v1.abs()),
-            );
+            let mut put = |x: &str, s: String| put(&format!("G.{what}.{x}"), s);
+            put("at", describe(c, o));
+            put("kappa", sig(o.kappa));
+            put("err", e2(o.err));
+            put("err_v1", e2(o.err_v1));
+            put("v", e2(o.v));
+            put("v1", e2(o.v1));
+            put("period_ms", sig(1e3 * CAMERA.pixel_m / o.v1.abs()));
         }
     }
     put("G.table", table(&TABLE_HEADER, &rows));
