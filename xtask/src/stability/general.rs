@@ -22,7 +22,7 @@ use std::path::Path;
 use crate::markdown::{e2, sig, table};
 
 use super::doc::lg;
-use super::grid::{self, Spec};
+use super::grid::{self, Cell as _, Spec};
 use super::maps::I0_SSO_DEG;
 use super::point::U_F32;
 
@@ -291,6 +291,42 @@ impl grid::Cell for GCell {
     fn n(&self) -> u64 {
         self.n
     }
+
+    fn merge(&mut self, o: &GCell) {
+        if o.n == 0 {
+            self.refused += o.refused;
+            return;
+        }
+        self.n += o.n;
+        self.refused += o.refused;
+        self.kappa_min = self.kappa_min.min(o.kappa_min);
+        self.min_margin_rad = self.min_margin_rad.min(o.min_margin_rad);
+        self.over_tol += o.over_tol;
+        self.over_tol_kappa_min = self.over_tol_kappa_min.min(o.over_tol_kappa_min);
+        if o.err_tame > self.err_tame {
+            self.err_tame = o.err_tame;
+            self.tame = o.tame;
+        }
+        if o.err_v1_steady > self.err_v1_steady {
+            self.err_v1_steady = o.err_v1_steady;
+            self.steady = o.steady;
+        }
+        let take = |best: &mut f64, slot: &mut Option<(EarthCase, GOutcome)>, v: f64, w| {
+            if slot.is_none() || v > *best {
+                *best = v;
+                *slot = w;
+            }
+        };
+        take(&mut self.ratio, &mut self.worst, o.ratio, o.worst);
+        take(&mut self.kappa, &mut self.max_kappa, o.kappa, o.max_kappa);
+        take(&mut self.err, &mut self.max_err, o.err, o.max_err);
+        take(
+            &mut self.err_v1,
+            &mut self.max_err_v1,
+            o.err_v1,
+            o.max_err_v1,
+        );
+    }
 }
 
 impl GCell {
@@ -333,63 +369,10 @@ impl GCell {
         keep(&mut self.err, &mut self.max_err, o.err);
         keep(&mut self.err_v1, &mut self.max_err_v1, o.err_v1);
     }
-
-    /// Folds another cell (or aggregate) into this one.
-    pub fn merge(&mut self, o: &GCell) {
-        if o.n == 0 {
-            self.refused += o.refused;
-            return;
-        }
-        self.n += o.n;
-        self.refused += o.refused;
-        self.kappa_min = self.kappa_min.min(o.kappa_min);
-        self.min_margin_rad = self.min_margin_rad.min(o.min_margin_rad);
-        self.over_tol += o.over_tol;
-        self.over_tol_kappa_min = self.over_tol_kappa_min.min(o.over_tol_kappa_min);
-        if o.err_tame > self.err_tame {
-            self.err_tame = o.err_tame;
-            self.tame = o.tame;
-        }
-        if o.err_v1_steady > self.err_v1_steady {
-            self.err_v1_steady = o.err_v1_steady;
-            self.steady = o.steady;
-        }
-        let take = |best: &mut f64, slot: &mut Option<(EarthCase, GOutcome)>, v: f64, w| {
-            if slot.is_none() || v > *best {
-                *best = v;
-                *slot = w;
-            }
-        };
-        take(&mut self.ratio, &mut self.worst, o.ratio, o.worst);
-        take(&mut self.kappa, &mut self.max_kappa, o.kappa, o.max_kappa);
-        take(&mut self.err, &mut self.max_err, o.err, o.max_err);
-        take(
-            &mut self.err_v1,
-            &mut self.max_err_v1,
-            o.err_v1,
-            o.max_err_v1,
-        );
-    }
 }
 
 /// A swept map of the general model.
 pub type GMap = grid::Map<GCell>;
-
-impl GMap {
-    /// All cells that pass `keep` (by cell centre) merged.
-    pub fn aggregate(&self, keep: impl Fn(f64, f64) -> bool) -> GCell {
-        let mut a = GCell::empty();
-        for iy in 0..self.ny {
-            for ix in 0..self.nx {
-                let (x, y) = self.centre(ix, iy);
-                if keep(x, y) {
-                    a.merge(&self.cells[iy * self.nx + ix]);
-                }
-            }
-        }
-        a
-    }
-}
 
 /// Sweeps every general map: full grids, or every dimension divided by `coarse`.
 pub fn sweep_all(coarse: Option<usize>) -> Vec<GMap> {
