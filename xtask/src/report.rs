@@ -84,6 +84,17 @@ struct Errors {
     refused: u64,
 }
 
+impl Errors {
+    /// One case's relative error (None: the backend refused it).
+    fn push(&mut self, rel: Option<f64>, is_near: bool) {
+        match rel {
+            None => self.refused += 1,
+            Some(rel) if is_near => self.max_near = self.max_near.max(rel),
+            Some(rel) => self.far.push(rel),
+        }
+    }
+}
+
 struct Sample {
     cases: usize,
     near: usize,
@@ -283,16 +294,7 @@ fn sweep(seed: u64, cases: usize) -> Sample {
         ];
         let sp = r.speed_mps();
         for (e, s) in errors.iter_mut().zip(speeds) {
-            let Some(s) = s else {
-                e.refused += 1;
-                continue;
-            };
-            let rel = (s - sp).abs() / sp;
-            if is_near {
-                e.max_near = e.max_near.max(rel);
-            } else {
-                e.far.push(rel);
-            }
+            e.push(s.map(|s| (s - sp).abs() / sp), is_near);
         }
     }
     let (earth_near, earth_f32) = earth_sweep(seed, cases, &mut errors[SPHERE_VARIANTS..]);
@@ -338,18 +340,10 @@ fn earth_sweep(seed: u64, cases: usize, errors: &mut [Errors]) -> (usize, EarthF
                 .map(widen),
         ];
         let sp = r.speed_mps();
-        let f32_err = motions[2].map(|m| (m.v1_mps - r.v1_mps).hypot(m.v2_mps - r.v2_mps) / sp);
+        let rel = |m: ImageMotion<f64>| (m.v1_mps - r.v1_mps).hypot(m.v2_mps - r.v2_mps) / sp;
+        let f32_err = motions[2].map(rel);
         for (e, m) in errors.iter_mut().zip(motions) {
-            let Some(m) = m else {
-                e.refused += 1;
-                continue;
-            };
-            let rel = (m.v1_mps - r.v1_mps).hypot(m.v2_mps - r.v2_mps) / sp;
-            if is_near {
-                e.max_near = e.max_near.max(rel);
-            } else {
-                e.far.push(rel);
-            }
+            e.push(m.map(rel), is_near);
         }
         let (Some(err), true) = (f32_err, margin.to_degrees() >= 0.01) else {
             continue;
@@ -458,11 +452,7 @@ fn print_table(
         print!("{}", out.into_string()?);
     } else {
         println!("{notes}\n");
-        println!("| {} |", HEADER.join(" | "));
-        println!("|{}", "---|".repeat(HEADER.len()));
-        for r in &rows {
-            println!("| {} |", r.join(" | "));
-        }
+        print!("{}", markdown::table(&HEADER, &rows));
     }
     Ok(rows)
 }

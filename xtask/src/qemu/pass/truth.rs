@@ -22,6 +22,7 @@ use super::scenario::AgileTruth;
 const PAPER_EARTH_RADIUS_M: f64 = 6_371_000.0;
 
 /// What the truth checks found.
+#[derive(Default)]
 pub struct Report {
     max_roll_deg: f64,
     max_pitch_deg: f64,
@@ -81,20 +82,10 @@ pub fn check(truth: &AgileTruth, firmware: &Downlink, controller: &Controller) -
     let scene = controller.scene();
     let plan = controller.plan();
     let mut r = Report {
-        max_roll_deg: 0.0,
-        max_pitch_deg: 0.0,
-        max_yaw_deg: 0.0,
         heights_m: (f64::INFINITY, f64::NEG_INFINITY),
         eccentricity: truth.orbit.eccentricity(0.0),
-        paper: (0.0, 0, 0),
-        firmware: (0.0, 0, 0),
-        drift_unsteered: 0.0,
-        drift_steered: 0.0,
-        centre_unsteered: 0.0,
-        centre_steered: 0.0,
         worst_mtf: (f32::INFINITY, 0, 0),
-        updates: 0,
-        holds: 0,
+        ..Report::default()
     };
     // The paper model's pixel constants at each segment's samples, once for the pass.
     let mut paper_pixels = std::collections::BTreeMap::new();
