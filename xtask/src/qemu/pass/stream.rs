@@ -57,18 +57,20 @@ impl Stream {
     }
 }
 
-struct Frames {
+/// Frames encoded in sequence (the sequence number wraps).
+#[derive(Default)]
+pub(super) struct Frames {
     sequence: u16,
 }
 
 impl Frames {
-    fn frame(&mut self, kind: u8, time_us: u64, payload: &[u8]) -> Vec<u8> {
+    pub(super) fn frame(&mut self, kind: u8, time_us: u64, payload: &[u8]) -> Vec<u8> {
         let mut buf = [0u8; MAX_FRAME];
         let n = encode(kind, self.sequence, time_us, payload, &mut buf).unwrap_or(0);
         self.sequence = self.sequence.wrapping_add(1);
         buf[..n].to_vec()
     }
-    fn nav(&mut self, time_us: u64, nav: &Nav) -> Vec<u8> {
+    pub(super) fn nav(&mut self, time_us: u64, nav: &Nav) -> Vec<u8> {
         let mut payload = [0u8; 128];
         let n = nav.encode(&mut payload).unwrap_or(0);
         self.frame(kind::NAV, time_us, &payload[..n])
@@ -84,7 +86,7 @@ pub fn build(pass: &Pass) -> Result<Stream> {
     let slots = schedule(&nav_us, &terrain_us, pass.tick_us, pass.end_us);
     let (mut navs, mut uploads) = (pass.samples.iter(), pass.terrain.iter());
 
-    let mut frames = Frames { sequence: 0 };
+    let mut frames = Frames::default();
     let mut items: Vec<Item> = Vec::with_capacity(slots.len() + 16);
     // Index of the item carrying the NAV frame of each instant.
     let mut nav_item = std::collections::HashMap::new();
