@@ -105,39 +105,55 @@ fn rates(pitch_rate: f64, roll_rate: f64, s: usize) -> Option<EarthCase> {
     Some(case(H0_KM, I0_SSO_DEG, G0_DEG, a, PIXELS[s % 3]))
 }
 
+/// Map D: pitch x roll at yaw 0.
+const PITCH_ROLL: Spec<EarthCase> = Spec {
+    key: "general-pitch-roll",
+    letter: "D",
+    title: "pitch x roll, yaw 0",
+    x_label: "pitch (deg)",
+    y_label: "roll (deg)",
+    x_range: (-45.0, 45.0),
+    y_range: (-45.0, 45.0),
+    y_decades: false,
+    nx: 120,
+    ny: 120,
+    sub: 3,
+    point: |x, y, s| Some(pitch_roll(0.0, x, y, s)),
+    others: "645 km above the WGS 84 equatorial radius, circular, i0 97.98 deg, \
+             g0 45 deg, yaw 0, no rates; n_px = -30 000, 0, 30 000 over the sub-samples",
+    missing: MISSING,
+};
+
+/// Map F: pitch rate x roll rate.
+const RATES: Spec<EarthCase> = Spec {
+    key: "general-rates",
+    letter: "F",
+    title: "pitch rate x roll rate",
+    x_label: "pitch rate (deg/s)",
+    y_label: "roll rate (deg/s)",
+    x_range: (-2.0, 2.0),
+    y_range: (-2.0, 2.0),
+    y_decades: false,
+    nx: 120,
+    ny: 120,
+    sub: 6,
+    point: rates,
+    others: "645 km, circular, i0 97.98 deg, g0 45 deg; n_px = -30 000, 0, 30 000 at \
+             roll = pitch = yaw = 0, then at roll 20, pitch -10 deg; yaw rate 0",
+    missing: MISSING,
+};
+
 pub const GMAPS: [Spec<EarthCase>; 5] = [
-    Spec {
-        key: "general-pitch-roll",
-        letter: "D",
-        title: "pitch x roll, yaw 0",
-        x_label: "pitch (deg)",
-        y_label: "roll (deg)",
-        x_range: (-45.0, 45.0),
-        y_range: (-45.0, 45.0),
-        y_decades: false,
-        nx: 120,
-        ny: 120,
-        sub: 3,
-        point: |x, y, s| Some(pitch_roll(0.0, x, y, s)),
-        others: "645 km above the WGS 84 equatorial radius, circular, i0 97.98 deg, \
-                 g0 45 deg, yaw 0, no rates; n_px = -30 000, 0, 30 000 over the sub-samples",
-        missing: MISSING,
-    },
+    PITCH_ROLL,
     Spec {
         key: "general-pitch-roll-yaw30",
         letter: "D'",
         title: "pitch x roll, yaw 30 deg",
-        x_label: "pitch (deg)",
-        y_label: "roll (deg)",
-        x_range: (-45.0, 45.0),
-        y_range: (-45.0, 45.0),
-        y_decades: false,
         nx: 90,
         ny: 90,
-        sub: 3,
         point: |x, y, s| Some(pitch_roll(30.0, x, y, s)),
         others: "as map D with yaw 30 deg",
-        missing: MISSING,
+        ..PITCH_ROLL
     },
     Spec {
         key: "general-altitude-limb",
@@ -157,38 +173,17 @@ pub const GMAPS: [Spec<EarthCase>; 5] = [
                  (0, 45) and (30, 135) deg, cycling over the sub-samples; no rates",
         missing: MISSING,
     },
-    Spec {
-        key: "general-rates",
-        letter: "F",
-        title: "pitch rate x roll rate",
-        x_label: "pitch rate (deg/s)",
-        y_label: "roll rate (deg/s)",
-        x_range: (-2.0, 2.0),
-        y_range: (-2.0, 2.0),
-        y_decades: false,
-        nx: 120,
-        ny: 120,
-        sub: 6,
-        point: rates,
-        others: "645 km, circular, i0 97.98 deg, g0 45 deg; n_px = -30 000, 0, 30 000 at \
-                 roll = pitch = yaw = 0, then at roll 20, pitch -10 deg; yaw rate 0",
-        missing: MISSING,
-    },
+    RATES,
     Spec {
         key: "general-rates-zoom",
         letter: "F'",
         title: "pitch rate x roll rate, the cancellation",
-        x_label: "pitch rate (deg/s)",
-        y_label: "roll rate (deg/s)",
         x_range: (0.2, 1.0),
         y_range: (-0.2, 0.2),
-        y_decades: false,
         nx: 100,
         ny: 50,
-        sub: 6,
-        point: rates,
         others: "as map F",
-        missing: MISSING,
+        ..RATES
     },
 ];
 
