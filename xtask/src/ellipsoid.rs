@@ -15,7 +15,10 @@ use std::time::Instant;
 use controller::Scene;
 use core_math::sphere::{Geometry, OrbitState, Reference, CLOSED_F32};
 use core_math::vector::norm;
-use core_math::{mtf_mismatch, Backend, Camera, ImageMotion, StageRule, EARTH_RATE_RAD_S};
+use core_math::{
+    mtf_mismatch, Backend, Camera, ImageMotion, ModelError, StageRule, StateVector,
+    EARTH_RATE_RAD_S,
+};
 
 use crate::markdown::{e2, replace_between, signed};
 use motion::{Orbit, Scenario, Spheroid};
@@ -189,25 +192,36 @@ impl EllipsoidSummary {
     }
 }
 
-/// The controller's geometry for a state vector: altitude |r| - R, rates and angles as
-/// `OrbitState::from_state` derives them.
+/// The paper's round-Earth geometry of a state vector, as the firmware derived it
+/// before the real-Earth model: altitude |r| - R over the sphere of radius
+/// `earth_radius_m`, rates and angles as `OrbitState::from_state` derives them, the
+/// camera rolled by `roll_rad`.
+pub(crate) fn round_geometry(
+    state: &StateVector,
+    roll_rad: f64,
+    earth_radius_m: f64,
+) -> Result<Geometry<f64>, ModelError> {
+    let o = OrbitState::from_state(state, earth_radius_m)?;
+    Ok(Geometry {
+        roll_rad,
+        inclination_rad: o.inclination_rad,
+        arg_latitude_rad: o.arg_latitude_rad,
+        altitude_m: o.altitude_m,
+        earth_radius_m,
+        earth_rate_rad_s: EARTH_RATE_RAD_S,
+        orbit_rate_rad_s: o.orbit_rate_rad_s,
+    })
+}
+
+/// [`round_geometry`] on `orbit` at argument of latitude `u_rad`.
 fn model_geometry(
     orbit: &Orbit,
     u_rad: f64,
     roll_rad: f64,
     radius_m: f64,
 ) -> Result<Geometry<f64>> {
-    let o = OrbitState::from_state(&orbit.state(u_rad), radius_m)
-        .map_err(|e| anyhow!("ellipsoid: orbit state: {e:?}"))?;
-    Ok(Geometry {
-        roll_rad,
-        inclination_rad: o.inclination_rad,
-        arg_latitude_rad: o.arg_latitude_rad,
-        altitude_m: o.altitude_m,
-        earth_radius_m: radius_m,
-        earth_rate_rad_s: EARTH_RATE_RAD_S,
-        orbit_rate_rad_s: o.orbit_rate_rad_s,
-    })
+    round_geometry(&orbit.state(u_rad), roll_rad, radius_m)
+        .map_err(|e| anyhow!("ellipsoid: orbit state: {e:?}"))
 }
 
 fn reference(camera: &Camera, g: &Geometry<f64>, n: f64) -> Result<ImageMotion<f64>> {

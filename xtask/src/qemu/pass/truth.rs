@@ -12,11 +12,12 @@ use anyhow::{anyhow, Result};
 use controller::golden::{self, NavInput};
 use controller::Controller;
 use core_math::earth::{Attitude, EarthGeometry};
-use core_math::sphere::{Geometry, OrbitState, Reference};
+use core_math::sphere::Reference;
 use core_math::{Backend, EarthCamera, EarthReference, StateVector, EARTH_RATE_RAD_S};
 
 use super::check::Downlink;
 use super::scenario::AgileTruth;
+use crate::ellipsoid::round_geometry;
 
 /// The round-Earth radius of the paper's model (the controller's before issue 12).
 const PAPER_EARTH_RADIUS_M: f64 = 6_371_000.0;
@@ -130,17 +131,8 @@ pub fn check(truth: &AgileTruth, firmware: &Downlink, controller: &Controller) -
             t_us,
         )
         .map_err(|e| anyhow!("truth at {t_s} s: {}", e.name()))?;
-        let orbit = OrbitState::from_state(&state, PAPER_EARTH_RADIUS_M)
+        let paper = round_geometry(&state, attitude.roll_rad, PAPER_EARTH_RADIUS_M)
             .map_err(|e| anyhow!("paper model at {t_s} s: {}", e.name()))?;
-        let paper = Geometry {
-            roll_rad: attitude.roll_rad,
-            inclination_rad: orbit.inclination_rad,
-            arg_latitude_rad: orbit.arg_latitude_rad,
-            altitude_m: orbit.altitude_m,
-            earth_radius_m: PAPER_EARTH_RADIUS_M,
-            earth_rate_rad_s: EARTH_RATE_RAD_S,
-            orbit_rate_rad_s: orbit.orbit_rate_rad_s,
-        };
         let paper_update = Reference.update(&paper).ok();
         let hold = attitude.roll_rate_rad_s == 0.0 && attitude.pitch_rate_rad_s == 0.0;
         r.holds += usize::from(hold);
