@@ -43,15 +43,9 @@ const CMD: &str = "`cargo xtask ellipsoid`";
 /// Worst case and RMS of one error over a set of cases.
 #[derive(Clone, Copy, Debug, Default)]
 struct Stat {
-    /// The error of largest magnitude (signed).
+    /// The error of largest magnitude (signed), and where.
     worst: f64,
-    /// Where: argument of latitude and geocentric latitude of the sub-satellite point
-    /// (deg), roll (deg), pixel.
-    at_u_deg: f64,
-    at_lat_deg: f64,
-    at_roll_deg: f64,
-    at_n_px: f64,
-    at_ground_lat_deg: f64,
+    at: Where,
     min: f64,
     max: f64,
     sum_sq: f64,
@@ -62,11 +56,7 @@ impl Stat {
     fn push(&mut self, e: f64, c: &Where) {
         if self.count == 0 || e.abs() > self.worst.abs() {
             self.worst = e;
-            self.at_u_deg = c.u_deg;
-            self.at_lat_deg = c.lat_deg;
-            self.at_roll_deg = c.roll_deg;
-            self.at_n_px = c.n_px;
-            self.at_ground_lat_deg = c.ground_lat_deg;
+            self.at = *c;
         }
         if self.count == 0 {
             (self.min, self.max) = (e, e);
@@ -82,7 +72,9 @@ impl Stat {
     }
 }
 
-#[derive(Clone, Copy, Debug)]
+/// Where a case is: argument of latitude and geocentric latitude of the sub-satellite
+/// point (deg), roll (deg), pixel.
+#[derive(Clone, Copy, Debug, Default)]
 struct Where {
     u_deg: f64,
     lat_deg: f64,
@@ -180,9 +172,9 @@ impl EllipsoidSummary {
              (lat {:+.1} deg, roll {:+.0} deg, n {:+.0}), MTF({}) {:.3}; sub-satellite radius \
              {:.1e}, ground-point radius {:.1e}; f32 arithmetic {:.1e} ({CMD})",
             a.round.worst.abs(),
-            a.round.at_lat_deg,
-            a.round.at_roll_deg,
-            a.round.at_n_px,
+            a.round.at.lat_deg,
+            a.round.at.roll_deg,
+            a.round.at.n_px,
             self.stages,
             self.mtf(a.round.worst),
             a.local.worst.abs(),
@@ -437,8 +429,8 @@ fn render(s: &EllipsoidSummary) -> Result<String> {
             r.pixels,
             signed(st.round.min),
             signed(st.round.max),
-            st.round.at_lat_deg,
-            st.round.at_u_deg,
+            st.round.at.lat_deg,
+            st.round.at.u_deg,
             e2(st.round.rms()),
             signed(st.local.worst),
             e2(st.local.rms()),
@@ -473,11 +465,11 @@ fn render(s: &EllipsoidSummary) -> Result<String> {
         e2(all.validation.worst),
         s.cases,
         signed(w),
-        all.round.at_lat_deg,
-        all.round.at_u_deg,
-        all.round.at_roll_deg,
-        all.round.at_n_px,
-        all.round.at_ground_lat_deg,
+        all.round.at.lat_deg,
+        all.round.at.u_deg,
+        all.round.at.roll_deg,
+        all.round.at.n_px,
+        all.round.at.ground_lat_deg,
         signed(all.round.min),
         signed(all.round.max),
         e2(all.round.rms()),
@@ -587,7 +579,7 @@ mod tests {
         assert_eq!(s.cases, ROLLS_DEG.len() * ORBIT_STEPS * 30);
         let a = &s.all;
         assert!(a.validation.worst < 1e-9, "{}", a.validation.worst);
-        let lat = a.round.at_lat_deg;
+        let lat = a.round.at.lat_deg;
         assert!((lat.abs() - 82.0).abs() < 1.0, "{lat}");
         assert!(a.round.worst > 0.023 && a.round.worst < 0.05);
         assert!(a.round.min < -0.01);
