@@ -15,7 +15,10 @@ use std::time::Instant;
 use controller::Scene;
 use core_math::sphere::{Geometry, OrbitState, Reference, CLOSED_F32};
 use core_math::vector::norm;
-use core_math::{mtf_mismatch, Backend, Camera, ImageMotion, StageRule, EARTH_RATE_RAD_S};
+use core_math::{
+    mtf_mismatch, Backend, Camera, ImageMotion, ModelError, StageRule, StateVector,
+    EARTH_RATE_RAD_S,
+};
 
 use crate::markdown::{e2, replace_between, signed};
 use motion::{Orbit, Scenario, Spheroid};
@@ -40,15 +43,9 @@ const CMD: &str = "`cargo xtask ellipsoid`";
 /// Worst case and RMS of one error over a set of cases.
 #[derive(Clone, Copy, Debug, Default)]
 struct Stat {
-    /// The error of largest magnitude (signed).
+    /// The error of largest magnitude (signed), and where.
     worst: f64,
-    /// Where: argument of latitude and geocentric latitude of the sub-satellite point
-    /// (deg), roll (deg), pixel.
-    at_u_deg: f64,
-    at_lat_deg: f64,
-    at_roll_deg: f64,
-    at_n_px: f64,
-    at_ground_lat_deg: f64,
+    at: Where,
     min: f64,
     max: f64,
     sum_sq: f64,
@@ -59,11 +56,7 @@ impl Stat {
     fn push(&mut self, e: f64, c: &Where) {
         if self.count == 0 || e.abs() > self.worst.abs() {
             self.worst = e;
-            self.at_u_deg = c.u_deg;
-            self.at_lat_deg = c.lat_deg;
-            self.at_roll_deg = c.roll_deg;
-            self.at_n_px = c.n_px;
-            self.at_ground_lat_deg = c.ground_lat_deg;
+            self.at = *c;
         }
         if self.count == 0 {
             (self.min, self.max) = (e, e);
@@ -79,7 +72,9 @@ impl Stat {
     }
 }
 
-#[derive(Clone, Copy, Debug)]
+/// Where a case is: argument of latitude and geocentric latitude of the sub-satellite
+/// point (deg), roll (deg), pixel.
+#[derive(Clone, Copy, Debug, Default)]
 struct Where {
     u_deg: f64,
     lat_deg: f64,
@@ -142,37 +137,20 @@ struct Row {
 /// What `cargo xtask ellipsoid` finds; [`EllipsoidSummary::line`] is one line for a report.
 #[derive(Clone, Debug)]
 pub struct EllipsoidSummary {
-    /// Largest |relative error| of |v_P| (and, to first order, of the line period) of the
-    /// firmware's round Earth against WGS 84 over the sweep, signed (> 0: the model's
-    /// image is too fast, its line period too short).
-    pub worst_rel_err: f64,
-    /// Where: geocentric latitude of the sub-satellite point, argument of latitude,
-    /// roll (deg), pixel offset.
-    pub worst_lat_deg: f64,
-    pub worst_arg_lat_deg: f64,
-    pub worst_roll_deg: f64,
-    pub worst_n_px: f64,
-    /// Geocentric latitude of that pixel's ground point (deg).
-    pub worst_ground_lat_deg: f64,
-    /// RMS of the round Earth's relative error over the whole sweep, and its range.
-    pub rms_rel_err: f64,
-    pub range_rel_err: (f64, f64),
-    /// The same with the local geocentric radius at the sub-satellite point.
-    pub local_radius_worst_rel_err: f64,
-    /// The same with each pixel's own ground-point radius (one step).
-    pub pixel_radius_worst_rel_err: f64,
-    /// Worst relative error of the f32 closed form (the firmware's arithmetic) on the
-    /// same cases, for comparison.
-    pub f32_worst_rel_err: f64,
-    /// TDI stages of the default scene, and MTF_mismatch at Nyquist for the worst
-    /// round-Earth error with them.
-    pub stages: u32,
-    pub mtf_at_worst: f64,
-    /// Numerical model on the sphere against `core_math::sphere::Reference` (worst component
-    /// difference / |v_P|): the validation of the ellipsoid model's machinery.
-    pub validation_worst: f64,
+    /// Every error over the whole sweep. `round`: the relative error of |v_P| (and, to
+    /// first order, of the line period) of the firmware's round Earth against WGS 84,
+    /// signed (> 0: the model's image is too fast, its line period too short); `local`
+    /// and `pixel` the same with the local geocentric radius at the sub-satellite point
+    /// and with each pixel's own ground-point radius (one step); `f32_arith` the f32
+    /// closed form (the firmware's arithmetic) on the same cases, for comparison;
+    /// `validation` the numerical model on the sphere against
+    /// `core_math::sphere::Reference` (worst component difference / |v_P|): the
+    /// validation of the ellipsoid model's machinery.
+    all: Stats,
+    /// TDI stages of the default scene.
+    stages: u32,
     /// Cases compared.
-    pub cases: usize,
+    cases: usize,
     rows: Vec<Row>,
     /// Default scene's MTF floor and its mismatch budget at `stages` (largest |dv/v|).
     mtf_floor: f64,
@@ -181,44 +159,61 @@ pub struct EllipsoidSummary {
 }
 
 impl EllipsoidSummary {
+    /// MTF_mismatch at Nyquist with `stages` for a relative error `e` alone.
+    fn mtf(&self, e: f64) -> f64 {
+        mtf_mismatch::<f64>(self.stages, e.abs()).unwrap_or(f64::NAN)
+    }
+
     /// One line for a report.
     pub fn line(&self) -> String {
+        let a = &self.all;
         format!(
             "round Earth (R 6371 km) vs WGS 84, default scene, one orbit: max |dv/v| {:.2e} \
              (lat {:+.1} deg, roll {:+.0} deg, n {:+.0}), MTF({}) {:.3}; sub-satellite radius \
              {:.1e}, ground-point radius {:.1e}; f32 arithmetic {:.1e} ({CMD})",
-            self.worst_rel_err.abs(),
-            self.worst_lat_deg,
-            self.worst_roll_deg,
-            self.worst_n_px,
+            a.round.worst.abs(),
+            a.round.at.lat_deg,
+            a.round.at.roll_deg,
+            a.round.at.n_px,
             self.stages,
-            self.mtf_at_worst,
-            self.local_radius_worst_rel_err.abs(),
-            self.pixel_radius_worst_rel_err.abs(),
-            self.f32_worst_rel_err.abs(),
+            self.mtf(a.round.worst),
+            a.local.worst.abs(),
+            a.pixel.worst.abs(),
+            a.f32_arith.worst.abs(),
         )
     }
 }
 
-/// The controller's geometry for a state vector: altitude |r| - R, rates and angles as
-/// `OrbitState::from_state` derives them.
+/// The paper's round-Earth geometry of a state vector, as the firmware derived it
+/// before the real-Earth model: altitude |r| - R over the sphere of radius
+/// `earth_radius_m`, rates and angles as `OrbitState::from_state` derives them, the
+/// camera rolled by `roll_rad`.
+pub(crate) fn round_geometry(
+    state: &StateVector,
+    roll_rad: f64,
+    earth_radius_m: f64,
+) -> Result<Geometry<f64>, ModelError> {
+    let o = OrbitState::from_state(state, earth_radius_m)?;
+    Ok(Geometry {
+        roll_rad,
+        inclination_rad: o.inclination_rad,
+        arg_latitude_rad: o.arg_latitude_rad,
+        altitude_m: o.altitude_m,
+        earth_radius_m,
+        earth_rate_rad_s: EARTH_RATE_RAD_S,
+        orbit_rate_rad_s: o.orbit_rate_rad_s,
+    })
+}
+
+/// [`round_geometry`] on `orbit` at argument of latitude `u_rad`.
 fn model_geometry(
     orbit: &Orbit,
     u_rad: f64,
     roll_rad: f64,
     radius_m: f64,
 ) -> Result<Geometry<f64>> {
-    let o = OrbitState::from_state(&orbit.state(u_rad), radius_m)
-        .map_err(|e| anyhow!("ellipsoid: orbit state: {e:?}"))?;
-    Ok(Geometry {
-        roll_rad,
-        inclination_rad: o.inclination_rad,
-        arg_latitude_rad: o.arg_latitude_rad,
-        altitude_m: o.altitude_m,
-        earth_radius_m: radius_m,
-        earth_rate_rad_s: EARTH_RATE_RAD_S,
-        orbit_rate_rad_s: o.orbit_rate_rad_s,
-    })
+    round_geometry(&orbit.state(u_rad), roll_rad, radius_m)
+        .map_err(|e| anyhow!("ellipsoid: orbit state: {e:?}"))
 }
 
 fn reference(camera: &Camera, g: &Geometry<f64>, n: f64) -> Result<ImageMotion<f64>> {
@@ -385,22 +380,9 @@ pub fn summary() -> Result<EllipsoidSummary> {
 
     let floor = f64::from(scene.mtf_floor);
     let rule = StageRule::<f64>::new(floor).map_err(|e| anyhow!("ellipsoid: {e:?}"))?;
-    let mtf = |e: f64| mtf_mismatch::<f64>(stages, e.abs()).unwrap_or(f64::NAN);
     Ok(EllipsoidSummary {
-        worst_rel_err: all.round.worst,
-        worst_lat_deg: all.round.at_lat_deg,
-        worst_arg_lat_deg: all.round.at_u_deg,
-        worst_roll_deg: all.round.at_roll_deg,
-        worst_n_px: all.round.at_n_px,
-        worst_ground_lat_deg: all.round.at_ground_lat_deg,
-        rms_rel_err: all.round.rms(),
-        range_rel_err: (all.round.min, all.round.max),
-        local_radius_worst_rel_err: all.local.worst,
-        pixel_radius_worst_rel_err: all.pixel.worst,
-        f32_worst_rel_err: all.f32_arith.worst,
+        all,
         stages,
-        mtf_at_worst: mtf(all.round.worst),
-        validation_worst: all.validation.worst,
         cases,
         rows,
         mtf_floor: floor,
@@ -412,14 +394,15 @@ pub fn summary() -> Result<EllipsoidSummary> {
 /// The markdown block between the doc's markers.
 fn render(s: &EllipsoidSummary) -> Result<String> {
     let stages = s.stages;
-    let mtf = |e: f64| mtf_mismatch::<f64>(stages, e.abs()).unwrap_or(f64::NAN);
+    let mtf = |e: f64| s.mtf(e);
     let rule = StageRule::<f64>::new(s.mtf_floor).map_err(|e| anyhow!("ellipsoid: {e:?}"))?;
     let max_m = |e: f64| rule.max_stages(e.abs(), s.max_stages).unwrap_or(0);
+    let all = &s.all;
     let (w, l, p, a) = (
-        s.worst_rel_err,
-        s.local_radius_worst_rel_err,
-        s.pixel_radius_worst_rel_err,
-        s.f32_worst_rel_err,
+        all.round.worst,
+        all.local.worst,
+        all.pixel.worst,
+        all.f32_arith.worst,
     );
     let mut o = String::new();
     o.push_str(&format!(
@@ -446,8 +429,8 @@ fn render(s: &EllipsoidSummary) -> Result<String> {
             r.pixels,
             signed(st.round.min),
             signed(st.round.max),
-            st.round.at_lat_deg,
-            st.round.at_u_deg,
+            st.round.at.lat_deg,
+            st.round.at.u_deg,
             e2(st.round.rms()),
             signed(st.local.worst),
             e2(st.local.rms()),
@@ -479,17 +462,17 @@ fn render(s: &EllipsoidSummary) -> Result<String> {
          radius {:.2} %, the f32 arithmetic {:.4} % ({CMD}).\n\
          - Largest stage count meeting the floor with that error alone (scene limit {}): \
          round Earth {}, sub-satellite radius {}, ground-point radius {} ({CMD}).\n\n{END}",
-        e2(s.validation_worst),
+        e2(all.validation.worst),
         s.cases,
         signed(w),
-        s.worst_lat_deg,
-        s.worst_arg_lat_deg,
-        s.worst_roll_deg,
-        s.worst_n_px,
-        s.worst_ground_lat_deg,
-        signed(s.range_rel_err.0),
-        signed(s.range_rel_err.1),
-        e2(s.rms_rel_err),
+        all.round.at.lat_deg,
+        all.round.at.u_deg,
+        all.round.at.roll_deg,
+        all.round.at.n_px,
+        all.round.at.ground_lat_deg,
+        signed(all.round.min),
+        signed(all.round.max),
+        e2(all.round.rms()),
         signed(-w / (1.0 + w)),
         signed(l),
         w.abs() / l.abs(),
@@ -594,17 +577,15 @@ mod tests {
     fn sweep_is_complete_and_plausible() {
         let s = summary().unwrap();
         assert_eq!(s.cases, ROLLS_DEG.len() * ORBIT_STEPS * 30);
-        assert!(s.validation_worst < 1e-9, "{}", s.validation_worst);
-        assert!(
-            (s.worst_lat_deg.abs() - 82.0).abs() < 1.0,
-            "{}",
-            s.worst_lat_deg
-        );
-        assert!(s.worst_rel_err > 0.023 && s.worst_rel_err < 0.05);
-        assert!(s.range_rel_err.0 < -0.01);
-        let (l, p) = (s.local_radius_worst_rel_err, s.pixel_radius_worst_rel_err);
-        assert!(l.abs() < s.worst_rel_err / 3.0 && p.abs() < l.abs() / 10.0);
-        assert!(s.f32_worst_rel_err.abs() < 2e-6);
+        let a = &s.all;
+        assert!(a.validation.worst < 1e-9, "{}", a.validation.worst);
+        let lat = a.round.at.lat_deg;
+        assert!((lat.abs() - 82.0).abs() < 1.0, "{lat}");
+        assert!(a.round.worst > 0.023 && a.round.worst < 0.05);
+        assert!(a.round.min < -0.01);
+        let (l, p) = (a.local.worst, a.pixel.worst);
+        assert!(l.abs() < a.round.worst / 3.0 && p.abs() < l.abs() / 10.0);
+        assert!(a.f32_arith.worst.abs() < 2e-6);
         let block = render(&s).unwrap();
         let doc = format!("head\n{BEGIN}\nold\n{END}\ntail\n");
         let new = replace_block(&doc, &block).unwrap();

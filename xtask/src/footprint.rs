@@ -11,12 +11,18 @@ use std::path::Path;
 
 use object::{Object, ObjectSection, SectionFlags};
 
-use crate::qemu::build_bin_with;
+use crate::qemu::{board::Board, build_firmware};
 
 /// Loadable bytes of the footprint binary built for `variant`.
 fn image_bytes(variant: &str) -> Result<u64> {
     let cfg = format!("footprint=\"{variant}\"");
-    let elf = build_bin_with("firmware", "footprint", true, &["bench"], &["--cfg", &cfg])?;
+    let elf = build_firmware(
+        Board::DEFAULT,
+        "footprint",
+        true,
+        &["bench"],
+        &["--cfg", &cfg],
+    )?;
     flash_bytes(&elf)
 }
 

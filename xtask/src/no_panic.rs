@@ -11,13 +11,12 @@
 
 use anyhow::{anyhow, bail, Context, Result};
 use std::collections::{BTreeMap, BTreeSet};
-use std::path::PathBuf;
-use std::process::{Command, Stdio};
+use std::process::Stdio;
 use std::time::Instant;
 
 use object::{Object, ObjectSection, ObjectSymbol, SectionKind, SymbolKind};
 
-use crate::qemu::{workspace_root, TARGET};
+use crate::qemu::{cargo_command as cargo, executable, TARGET};
 
 /// The undefined function the check build's panic handlers call (firmware/src/platform.rs).
 const SYMBOL: &str = "NO_PANIC_CHECK__a_panic_path_is_reachable__see_docs_no_panic_md";
@@ -70,13 +69,6 @@ impl Build {
             "--color=never",
         ]
     }
-}
-
-/// `cargo` as the one that started us, in the workspace root.
-fn cargo() -> Command {
-    let mut cmd = Command::new(std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into()));
-    cmd.current_dir(workspace_root());
-    cmd
 }
 
 /// The proof: an error (naming the panic sites when it can) if a covered build still has
@@ -143,17 +135,7 @@ fn diagnose(build: &Build) -> Result<String> {
         .stderr(Stdio::null())
         .output()
         .context("cannot start cargo")?;
-    let mut elf = None;
-    for line in String::from_utf8_lossy(&out.stdout).lines() {
-        let Ok(msg) = serde_json::from_str::<serde_json::Value>(line) else {
-            continue;
-        };
-        if msg["reason"] == "compiler-artifact" && msg["target"]["name"] == build.bin {
-            if let Some(path) = msg["executable"].as_str() {
-                elf = Some(PathBuf::from(path));
-            }
-        }
-    }
+    let elf = executable(&out.stdout, build.bin);
     let report = match (out.status.success(), elf) {
         (true, Some(elf)) => std::fs::read(&elf)
             .with_context(|| format!("cannot read {}", elf.display()))

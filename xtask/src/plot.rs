@@ -12,9 +12,6 @@
 //!     .save(Path::new("out.png"))?;
 //! ```
 
-// A helper for several commands: not every option is used by every build of them.
-#![allow(dead_code)]
-
 use anyhow::{anyhow, bail, Context, Result};
 use std::ops::Range;
 use std::path::Path;
@@ -141,10 +138,8 @@ impl Series {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Legend {
     TopRight,
-    TopLeft,
     BottomRight,
     BottomLeft,
-    None,
 }
 
 /// A line plot.
@@ -301,13 +296,11 @@ impl Plot {
             }
             let position = match self.legend {
                 Legend::TopRight => SeriesLabelPosition::UpperRight,
-                Legend::TopLeft => SeriesLabelPosition::UpperLeft,
                 Legend::BottomRight => SeriesLabelPosition::LowerRight,
                 Legend::BottomLeft => SeriesLabelPosition::LowerLeft,
-                Legend::None => SeriesLabelPosition::Coordinate(0, 0),
             };
             let labelled = self.series.iter().any(|s| !s.label.is_empty());
-            if labelled && self.legend != Legend::None {
+            if labelled {
                 chart
                     .configure_series_labels()
                     .position(position)

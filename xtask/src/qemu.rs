@@ -15,7 +15,7 @@
 //!   end-to-end pass test ([`e2e_test`]), on every board.
 
 mod bench;
-mod board;
+pub(crate) mod board;
 mod flash;
 mod pass;
 mod profile;
@@ -119,8 +119,9 @@ pub(crate) fn workspace_root() -> PathBuf {
     here.parent().unwrap_or(here).to_path_buf()
 }
 
-/// `cargo` as the one that started us (falls back to the one on PATH).
-fn cargo_command() -> Command {
+/// `cargo` as the one that started us (falls back to the one on PATH), in the workspace
+/// root.
+pub(crate) fn cargo_command() -> Command {
     let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
     let mut cmd = Command::new(cargo);
     cmd.current_dir(workspace_root());
@@ -160,33 +161,12 @@ fn runner_config() -> Result<Vec<String>> {
     ])
 }
 
-/// Builds one binary of `package` for the target and `board` and returns its ELF's path
-/// (taken from cargo's JSON messages, so any target-dir setting is honoured).
-fn build_board_bin(
+/// Builds one binary of the firmware crate for the target and `board`, with `features`
+/// besides the board's and `rustc_args` passed to the compiler for that binary alone
+/// (`cargo rustc ... -- rustc_args`; with none, `cargo build`), and returns its ELF's
+/// path (taken from cargo's JSON messages, so any target-dir setting is honoured).
+pub(crate) fn build_firmware(
     board: Board,
-    package: &str,
-    bin: &str,
-    release: bool,
-    features: &[&str],
-) -> Result<PathBuf> {
-    build_elf(board, package, bin, release, features, &[])
-}
-
-/// [`build_board_bin`] for the default board with `rustc_args` passed to the compiler
-/// for that binary alone (`cargo rustc ... -- rustc_args`; with none, `cargo build`).
-pub(crate) fn build_bin_with(
-    package: &str,
-    bin: &str,
-    release: bool,
-    features: &[&str],
-    rustc_args: &[&str],
-) -> Result<PathBuf> {
-    build_elf(Board::DEFAULT, package, bin, release, features, rustc_args)
-}
-
-fn build_elf(
-    board: Board,
-    package: &str,
     bin: &str,
     release: bool,
     features: &[&str],
@@ -200,7 +180,7 @@ fn build_elf(
     let mut args: Vec<String> = [
         subcommand,
         "--package",
-        package,
+        "firmware",
         "--bin",
         bin,
         "--target",
@@ -226,9 +206,15 @@ fn build_elf(
     if !out.status.success() {
         bail!("building `{bin}` failed ({})", out.status);
     }
-    let stdout = String::from_utf8_lossy(&out.stdout);
+    executable(&out.stdout, bin)
+        .with_context(|| format!("cargo reported no executable for `{bin}`"))
+}
+
+/// The executable of binary `bin` in cargo's JSON messages (`stdout` of a build with
+/// `--message-format=json...`).
+pub(crate) fn executable(stdout: &[u8], bin: &str) -> Option<PathBuf> {
     let mut elf = None;
-    for line in stdout.lines() {
+    for line in String::from_utf8_lossy(stdout).lines() {
         let Ok(msg) = serde_json::from_str::<serde_json::Value>(line) else {
             continue;
         };
@@ -238,7 +224,7 @@ fn build_elf(
             }
         }
     }
-    elf.with_context(|| format!("cargo reported no executable for `{bin}`"))
+    elf
 }
 
 /// Ends the process with the firmware's exit status (0 returns normally).

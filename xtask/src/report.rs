@@ -46,64 +46,35 @@ const NEAR_LIMB_DEG: f64 = 1.0;
 /// Pixels in the bench's loop regions (firmware/src/bin/bench.rs, `LOOP_PX`).
 const LOOP_PX: u64 = 32;
 
-/// One backend of the report: its name (also its `--cfg footprint` value) and its bench
-/// regions: `motion` over `LOOP_PX` pixels in a loop, and one full update of the default
-/// scene (`update`, then `motion` at each of its planned sample points).
-struct Variant {
-    name: &'static str,
-    loop_label: &'static str,
-    full_update_label: &'static str,
+/// One backend of the report: its name (also its `--cfg footprint` value) and the name
+/// of its bench regions: `<backend> motion, 32 pixels in a loop` (`motion` over
+/// `LOOP_PX` pixels) and `<backend> full update` (one full update of the default scene:
+/// `update`, then `motion` at each of its planned sample points).
+struct Variant(&'static str, &'static str);
+
+impl Variant {
+    fn loop_label(&self) -> String {
+        format!("{} motion, {LOOP_PX} pixels in a loop", self.1)
+    }
+
+    fn full_update_label(&self) -> String {
+        format!("{} full update", self.1)
+    }
 }
 
 /// The round-Earth variants first (`SPHERE_VARIANTS` of them, errors over the round-Earth
 /// sample), then the real-Earth ones (errors over the real-Earth sample).
 const SPHERE_VARIANTS: usize = 6;
 const VARIANTS: [Variant; 9] = [
-    Variant {
-        name: "naive-f32",
-        loop_label: "NaiveF32 motion, 32 pixels in a loop",
-        full_update_label: "NaiveF32 full update",
-    },
-    Variant {
-        name: "reference",
-        loop_label: "Reference motion, 32 pixels in a loop",
-        full_update_label: "Reference full update",
-    },
-    Variant {
-        name: "f64",
-        loop_label: "CLOSED_F64 motion, 32 pixels in a loop",
-        full_update_label: "CLOSED_F64 full update",
-    },
-    Variant {
-        name: "f32",
-        loop_label: "CLOSED_F32 motion, 32 pixels in a loop",
-        full_update_label: "CLOSED_F32 full update",
-    },
-    Variant {
-        name: "f32-micromath",
-        loop_label: "CLOSED_MICROMATH motion, 32 pixels in a loop",
-        full_update_label: "CLOSED_MICROMATH full update",
-    },
-    Variant {
-        name: "fixed",
-        loop_label: "FIXED motion, 32 pixels in a loop",
-        full_update_label: "FIXED full update",
-    },
-    Variant {
-        name: "earth-reference",
-        loop_label: "EarthReference motion, 32 pixels in a loop",
-        full_update_label: "EarthReference full update",
-    },
-    Variant {
-        name: "earth-f64",
-        loop_label: "GENERAL_F64 motion, 32 pixels in a loop",
-        full_update_label: "GENERAL_F64 full update",
-    },
-    Variant {
-        name: "earth-f32",
-        loop_label: "GENERAL_F32 motion, 32 pixels in a loop",
-        full_update_label: "GENERAL_F32 full update",
-    },
+    Variant("naive-f32", "NaiveF32"),
+    Variant("reference", "Reference"),
+    Variant("f64", "CLOSED_F64"),
+    Variant("f32", "CLOSED_F32"),
+    Variant("f32-micromath", "CLOSED_MICROMATH"),
+    Variant("fixed", "FIXED"),
+    Variant("earth-reference", "EarthReference"),
+    Variant("earth-f64", "GENERAL_F64"),
+    Variant("earth-f32", "GENERAL_F32"),
 ];
 
 #[derive(Default)]
@@ -111,6 +82,17 @@ struct Errors {
     far: Vec<f64>,
     max_near: f64,
     refused: u64,
+}
+
+impl Errors {
+    /// One case's relative error (None: the backend refused it).
+    fn push(&mut self, rel: Option<f64>, is_near: bool) {
+        match rel {
+            None => self.refused += 1,
+            Some(rel) if is_near => self.max_near = self.max_near.max(rel),
+            Some(rel) => self.far.push(rel),
+        }
+    }
 }
 
 struct Sample {
@@ -160,7 +142,7 @@ pub fn run(args: &Args) -> Result<()> {
     let seed = args.seed.unwrap_or(DEFAULT_SEED);
     let sample = sweep(seed, cases);
     let (counts, flash) = if bench {
-        let names: Vec<&str> = VARIANTS.iter().map(|v| v.name).collect();
+        let names: Vec<&str> = VARIANTS.iter().map(|v| v.0).collect();
         (
             Some(bench_counts(true)?),
             Some(crate::footprint::variant_bytes(&names)?),
@@ -312,16 +294,7 @@ fn sweep(seed: u64, cases: usize) -> Sample {
         ];
         let sp = r.speed_mps();
         for (e, s) in errors.iter_mut().zip(speeds) {
-            let Some(s) = s else {
-                e.refused += 1;
-                continue;
-            };
-            let rel = (s - sp).abs() / sp;
-            if is_near {
-                e.max_near = e.max_near.max(rel);
-            } else {
-                e.far.push(rel);
-            }
+            e.push(s.map(|s| (s - sp).abs() / sp), is_near);
         }
     }
     let (earth_near, earth_f32) = earth_sweep(seed, cases, &mut errors[SPHERE_VARIANTS..]);
@@ -367,18 +340,10 @@ fn earth_sweep(seed: u64, cases: usize, errors: &mut [Errors]) -> (usize, EarthF
                 .map(widen),
         ];
         let sp = r.speed_mps();
-        let f32_err = motions[2].map(|m| (m.v1_mps - r.v1_mps).hypot(m.v2_mps - r.v2_mps) / sp);
+        let rel = |m: ImageMotion<f64>| (m.v1_mps - r.v1_mps).hypot(m.v2_mps - r.v2_mps) / sp;
+        let f32_err = motions[2].map(rel);
         for (e, m) in errors.iter_mut().zip(motions) {
-            let Some(m) = m else {
-                e.refused += 1;
-                continue;
-            };
-            let rel = (m.v1_mps - r.v1_mps).hypot(m.v2_mps - r.v2_mps) / sp;
-            if is_near {
-                e.max_near = e.max_near.max(rel);
-            } else {
-                e.far.push(rel);
-            }
+            e.push(m.map(rel), is_near);
         }
         let (Some(err), true) = (f32_err, margin.to_degrees() >= 0.01) else {
             continue;
@@ -435,7 +400,7 @@ fn print_table(
     );
     let mut rows = Vec::new();
     for (i, (v, e)) in VARIANTS.iter().zip(&sample.errors).enumerate() {
-        let name = v.name;
+        let name = v.0;
         let mut far = e.far.clone();
         let p99 = percentile(&mut far, 0.99);
         let max = far.last().copied().unwrap_or(0.0);
@@ -448,10 +413,10 @@ fn print_table(
                     .with_context(|| format!("report: no bench region `{label}`")),
             }
         };
-        let per_pixel = count(v.loop_label)?.map_or(String::new(), |n| {
+        let per_pixel = count(&v.loop_label())?.map_or(String::new(), |n| {
             format!("{:.1}", n as f64 / LOOP_PX as f64)
         });
-        let per_update = count(v.full_update_label)?.map_or(String::new(), |n| n.to_string());
+        let per_update = count(&v.full_update_label())?.map_or(String::new(), |n| n.to_string());
         rows.push([
             name.to_string(),
             format!("{max:.2e}"),
@@ -487,11 +452,7 @@ fn print_table(
         print!("{}", out.into_string()?);
     } else {
         println!("{notes}\n");
-        println!("| {} |", HEADER.join(" | "));
-        println!("|{}", "---|".repeat(HEADER.len()));
-        for r in &rows {
-            println!("| {} |", r.join(" | "));
-        }
+        print!("{}", markdown::table(&HEADER, &rows));
     }
     Ok(rows)
 }

@@ -22,10 +22,11 @@ use std::time::Instant;
 
 // Map A's limb-margin bands are the accuracy report's buckets, so that its table and
 // this document's split the margin the same way.
-use crate::accuracy::BUCKETS_DEG;
+use crate::accuracy::{bucket, BUCKETS_DEG};
 use crate::markdown::{e2, sig};
-use doc::{agg_table, aggregate, describe, parts, Agg};
-use maps::{Map, MAPS};
+use doc::{agg_table, describe, parts};
+use grid::Cell as _;
+use maps::{Cell, Map, MAPS};
 use point::{Outcome, Point, U_F32, U_FIXED};
 
 /// The stated bounds: f32 error (at the same or at the unrounded inputs) <= C_F32 kappa u,
@@ -108,7 +109,7 @@ pub fn run(args: &Args) -> Result<()> {
 pub fn check_bounds(maps: &[Map]) -> Result<()> {
     let mut bad = Vec::new();
     for m in maps {
-        let a = aggregate(m, |_, _, _| true);
+        let a = m.aggregate(|_, _| true);
         let mut check = |name: &str, ratio: f64, c: f64, w: Option<(Point, Outcome)>| {
             if ratio > c {
                 let at = w.map(|(p, o)| describe(&p, &o)).unwrap_or_default();
@@ -183,20 +184,21 @@ fn figures(maps: &[Map], quick: bool, secs: f64) -> BTreeMap<String, String> {
     put("samples_total", total.to_string());
 
     // Summary: one row per map, and the whole.
-    let mut rows: Vec<(String, Agg)> = Vec::new();
+    let mut rows: Vec<(String, Cell)> = Vec::new();
     let mut all = Vec::new();
     for m in maps {
         let letter = m.spec.letter;
-        let a = aggregate(m, |_, _, _| true);
+        let a = m.aggregate(|_, _| true);
+        let mut put = |what: &str, s: String| put(&format!("{letter}.{what}"), s);
         put(
-            &format!("{letter}.grid"),
+            "grid",
             format!(
                 "{} x {} cells, {} sub-samples each, {} cases",
                 m.nx, m.ny, m.sub, a.n
             ),
         );
-        put(&format!("{letter}.others"), m.spec.others.into());
-        put(&format!("{letter}.key"), m.spec.key.into());
+        put("others", m.spec.others.into());
+        put("key", m.spec.key.into());
         for (what, w) in [
             ("worst_f32", &a.worst_f32),
             ("worst_f32_in", &a.worst_f32_in),
@@ -204,32 +206,20 @@ fn figures(maps: &[Map], quick: bool, secs: f64) -> BTreeMap<String, String> {
             ("max_kappa", &a.max_kappa),
         ] {
             if let Some((p, o)) = w {
-                for (k, s) in sample_figures(&format!("{letter}.{what}"), p, o) {
+                for (k, s) in sample_figures(what, p, o) {
                     put(&k, s);
                 }
             }
         }
-        put(
-            &format!("{letter}.ratio_f32"),
-            format!("{:.2}", a.ratio_f32),
-        );
-        put(
-            &format!("{letter}.ratio_f32_in"),
-            format!("{:.2}", a.ratio_f32_in),
-        );
-        put(
-            &format!("{letter}.ratio_fixed"),
-            format!("{:.2}", a.ratio_fixed),
-        );
-        put(&format!("{letter}.kappa_min"), sig(a.kappa_min));
-        put(&format!("{letter}.kappa_max"), sig(a.kappa_max));
-        put(&format!("{letter}.e_f32"), e2(a.err.f32));
-        put(&format!("{letter}.e_f32_in"), e2(a.err.f32_in));
-        put(&format!("{letter}.e_fixed"), e2(a.err.fixed_worst()));
-        put(
-            &format!("{letter}.max_v1_terms"),
-            format!("{:.4}", a.max_v1_terms),
-        );
+        put("ratio_f32", format!("{:.2}", a.ratio_f32));
+        put("ratio_f32_in", format!("{:.2}", a.ratio_f32_in));
+        put("ratio_fixed", format!("{:.2}", a.ratio_fixed));
+        put("kappa_min", sig(a.kappa_min));
+        put("kappa_max", sig(a.kappa));
+        put("e_f32", e2(a.err.f32));
+        put("e_f32_in", e2(a.err.f32_in));
+        put("e_fixed", e2(a.err.fixed_worst()));
+        put("max_v1_terms", format!("{:.4}", a.v1_term_ratio));
         rows.push((format!("{letter}: {}", m.spec.title), a.clone()));
         all.push(a);
     }
@@ -263,27 +253,19 @@ fn figures(maps: &[Map], quick: bool, secs: f64) -> BTreeMap<String, String> {
 
     // Map A by limb margin and by altitude.
     let a_map = map_by_key(maps, "altitude-limb");
-    let band_of = |m: &Map, iy: usize| {
-        let (_, y) = m.centre(0, iy);
-        let deg = 10f64.powf(y);
-        BUCKETS_DEG
-            .iter()
-            .position(|(lo, _)| deg >= *lo)
-            .unwrap_or(BUCKETS_DEG.len() - 1)
-    };
-    let band_rows: Vec<(String, Agg)> = BUCKETS_DEG
+    let band_rows: Vec<(String, Cell)> = BUCKETS_DEG
         .iter()
         .enumerate()
         .map(|(b, (_, name))| {
             (
                 name.to_string(),
-                aggregate(a_map, |_, iy, _| band_of(a_map, iy) == b),
+                a_map.aggregate(|_, y| bucket(10f64.powf(y)) == b),
             )
         })
         .collect();
     put("limb_table", agg_table("limb margin", &band_rows));
     let near = &band_rows[BUCKETS_DEG.len() - 1].1;
-    put("limb.kappa_max", sig(near.kappa_max));
+    put("limb.kappa_max", sig(near.kappa));
     put("limb.e_f32", e2(near.err.f32));
     put("limb.e_f32_in", e2(near.err.f32_in));
     put("limb.e_fixed", e2(near.err.fixed_worst()));
@@ -300,21 +282,18 @@ fn figures(maps: &[Map], quick: bool, secs: f64) -> BTreeMap<String, String> {
     let far = &band_rows[0].1;
     put(
         "far.kappa",
-        format!("{} - {}", sig(far.kappa_min), sig(far.kappa_max)),
+        format!("{} - {}", sig(far.kappa_min), sig(far.kappa)),
     );
     if let Some((slope, n)) = doc::limb_slope(a_map, 0.1) {
         put("limb.slope", format!("{slope:.3}"));
         put("limb.slope_n", n.to_string());
     }
-    let alt_rows: Vec<(String, Agg)> = ALT_BANDS_KM
+    let alt_rows: Vec<(String, Cell)> = ALT_BANDS_KM
         .iter()
         .map(|&(lo, hi)| {
             (
                 format!("{lo:.0} - {hi:.0} km"),
-                aggregate(a_map, |ix, iy, _| {
-                    let (h, y) = a_map.centre(ix, iy);
-                    h >= lo && h < hi && 10f64.powf(y) >= 1.0
-                }),
+                a_map.aggregate(|h, y| h >= lo && h < hi && 10f64.powf(y) >= 1.0),
             )
         })
         .collect();
@@ -395,7 +374,7 @@ fn figures(maps: &[Map], quick: bool, secs: f64) -> BTreeMap<String, String> {
     );
     let mut v1_all = f64::NEG_INFINITY;
     for a in &all {
-        v1_all = v1_all.max(a.max_v1_terms);
+        v1_all = v1_all.max(a.v1_term_ratio);
     }
     put("v1.max_all", format!("{v1_all:.4}"));
     let c_cells_min = c_map
@@ -430,37 +409,10 @@ fn sample_figures(prefix: &str, p: &Point, o: &Outcome) -> [(String, String); 8]
 }
 
 /// Maxima over several aggregates.
-fn merge(all: &[Agg]) -> Agg {
-    let mut m = Agg {
-        kappa_min: f64::INFINITY,
-        kq: (f64::INFINITY, 0.0),
-        max_v1_terms: f64::NEG_INFINITY,
-        ..Agg::default()
-    };
+fn merge(all: &[Cell]) -> Cell {
+    let mut m = Cell::empty();
     for a in all {
-        m.n += a.n;
-        m.refused += a.refused;
-        m.refused_by = m.refused_by.or(a.refused_by);
-        m.err.max_assign(&a.err);
-        m.kappa_min = m.kappa_min.min(a.kappa_min);
-        m.kq = (m.kq.0.min(a.kq.0), m.kq.1.max(a.kq.1));
-        m.max_v1_terms = m.max_v1_terms.max(a.max_v1_terms);
-        if a.ratio_f32 > m.ratio_f32 {
-            m.ratio_f32 = a.ratio_f32;
-            m.worst_f32 = a.worst_f32;
-        }
-        if a.ratio_f32_in > m.ratio_f32_in {
-            m.ratio_f32_in = a.ratio_f32_in;
-            m.worst_f32_in = a.worst_f32_in;
-        }
-        if a.ratio_fixed > m.ratio_fixed {
-            m.ratio_fixed = a.ratio_fixed;
-            m.worst_fixed = a.worst_fixed;
-        }
-        if a.kappa_max > m.kappa_max {
-            m.kappa_max = a.kappa_max;
-            m.max_kappa = a.max_kappa;
-        }
+        m.merge(a);
     }
     m
 }
@@ -479,12 +431,12 @@ mod tests {
     fn coarse_maps_stay_within_the_stated_bounds() {
         let maps = sweep_all(Some((6, 2)));
         check_bounds(&maps).unwrap();
-        let all: Vec<Agg> = maps.iter().map(|m| aggregate(m, |_, _, _| true)).collect();
+        let all: Vec<Cell> = maps.iter().map(|m| m.aggregate(|_, _| true)).collect();
         let a = merge(&all);
         assert!(a.n > 2_000, "{} cases", a.n);
         assert_eq!(a.refused, 0);
         // The limb: map A's lowest row is within 1e-4 deg, where kappa is in the thousands.
-        assert!(a.kappa_max > 1e3, "max kappa {}", a.kappa_max);
+        assert!(a.kappa > 1e3, "max kappa {}", a.kappa);
         // kappa >= 3 everywhere: altitude, radius and orbit rate contribute ~1 each.
         assert!(a.kappa_min > 2.5, "min kappa {}", a.kappa_min);
         // Real errors: several u for f32, the input rounding near the limb, a few LSB fixed.

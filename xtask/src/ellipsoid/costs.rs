@@ -13,7 +13,7 @@
 use core_math::earth::kepler::Kepler;
 use core_math::earth::{limb_margin_rad, Attitude};
 use core_math::sample::SplitMix64;
-use core_math::sphere::{Geometry, OrbitState, Reference};
+use core_math::sphere::Reference;
 use core_math::vector::{dot, norm, scale};
 use core_math::{
     Backend, Camera, EarthCamera, EarthGeometry, EarthReference, Ellipsoid, ImageMotion,
@@ -23,6 +23,7 @@ use core_math::{
 use crate::markdown::signed;
 
 use super::motion::{eccentric_state, envelope_draw, general_motion, Orbit, Spheroid};
+use super::round_geometry;
 
 /// The paper's (and the controller's) Earth radius (m).
 const R_PAPER_M: f64 = 6_371e3;
@@ -146,23 +147,14 @@ fn paper(
     cam: &EarthCamera,
     n: f64,
 ) -> Option<ImageMotion<f64>> {
-    let o = OrbitState::from_state(state, R_PAPER_M).ok()?;
-    let g = Geometry {
-        roll_rad,
-        inclination_rad: o.inclination_rad,
-        arg_latitude_rad: o.arg_latitude_rad,
-        altitude_m: o.altitude_m,
-        earth_radius_m: R_PAPER_M,
-        earth_rate_rad_s: EARTH_RATE_RAD_S,
-        orbit_rate_rad_s: o.orbit_rate_rad_s,
-    };
+    let g = round_geometry(state, roll_rad, R_PAPER_M).ok()?;
     let camera = Camera {
         focal_m: cam.focal_m,
         pixel_m: cam.pixel_m,
     };
     // Nadir angle |roll + alpha| against the limb asin(R / (R + H)).
     let alpha = (n * cam.pixel_m / cam.focal_m).atan();
-    let limb = (R_PAPER_M / (R_PAPER_M + o.altitude_m)).asin();
+    let limb = (R_PAPER_M / (R_PAPER_M + g.altitude_m)).asin();
     let margin = limb - (roll_rad + alpha).abs();
     if margin < LIMB_BAND_RAD || margin.is_nan() {
         return None;

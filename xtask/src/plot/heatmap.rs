@@ -61,7 +61,6 @@ pub struct Heatmap {
     pub z_range: (f64, f64),
     /// The coordinate (or value) is log10 of the quantity: ticks at decades, labelled
     /// 1e-5, 0.01, 1, 100, ...
-    pub x_decades: bool,
     pub y_decades: bool,
     pub z_decades: bool,
     /// Ring markers at these (x, y) data coordinates.
@@ -94,7 +93,6 @@ impl Heatmap {
             x_range: (0.0, 1.0),
             y_range: (0.0, 1.0),
             z_range: (0.0, 1.0),
-            x_decades: false,
             y_decades: false,
             z_decades: false,
             marks: Vec::new(),
@@ -120,11 +118,6 @@ impl Heatmap {
         self
     }
 
-    pub fn x_decades(mut self, on: bool) -> Self {
-        self.x_decades = on;
-        self
-    }
-
     pub fn y_decades(mut self, on: bool) -> Self {
         self.y_decades = on;
         self
@@ -147,12 +140,6 @@ impl Heatmap {
 
     pub fn missing_label(mut self, s: &str) -> Self {
         self.missing_label = s.to_string();
-        self
-    }
-
-    pub fn size(mut self, width: u32, height: u32) -> Self {
-        self.width = width;
-        self.height = height;
         self
     }
 
@@ -194,7 +181,7 @@ impl Heatmap {
                 self.ny
             );
         }
-        let x_axis = Self::axis(self.x_range, self.x_decades)?;
+        let x_axis = Self::axis(self.x_range, false)?;
         let y_axis = Self::axis(self.y_range, self.y_decades)?;
         let z_axis = Self::axis(self.z_range, self.z_decades)?;
         render_rgb((self.width, self.height), &self.title, |root, body| {

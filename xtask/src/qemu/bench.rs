@@ -14,7 +14,7 @@ use object::{Object, ObjectSymbol};
 
 use super::board::{Board, BoardArg};
 use super::profile;
-use super::{build_board_bin, ensure_target_tools, runner, tools, workspace_root};
+use super::{build_firmware, ensure_target_tools, runner, tools, workspace_root};
 
 const PLUGIN_SOURCE: &str = "tools/qemu-stopwatch/stopwatch.c";
 const LABEL_PREFIX: &str = "BENCH ";
@@ -103,7 +103,7 @@ fn measure_on(board: Board, log_to_stderr: bool, profile: Option<usize>) -> Resu
     if !tools::have("gcc") {
         tools::apt_install(&["gcc", "libc6-dev"], "gcc (to build the QEMU plugin)")?;
     }
-    let elf = build_board_bin(board, "firmware", "bench", true, &["bench"])?;
+    let elf = build_firmware(board, "bench", true, &["bench"], &[])?;
     let dir = elf
         .parent()
         .context("bench ELF has no folder")?

@@ -123,7 +123,7 @@ pub fn size(args: &SizeArgs) -> Result<()> {
     super::ensure_target_tools()?;
     let mut lines = Vec::new();
     for board in boards {
-        let elf = super::build_board_bin(board, "firmware", "firmware", true, &[])?;
+        let elf = super::build_firmware(board, "firmware", true, &[], &[])?;
         lines.push(size_line(board, &elf)?);
     }
     println!("\nrelease flight binary (opt-level 3, fat LTO), bytes:");

@@ -8,7 +8,7 @@ use anyhow::{anyhow, bail, Context, Result};
 use std::process::Command;
 
 use super::board::Board;
-use super::{build_board_bin, exit_like, tools};
+use super::{build_firmware, exit_like, tools};
 
 /// `cargo xtask flash`'s options.
 #[derive(clap::Args)]
@@ -53,7 +53,7 @@ pub fn flash(args: &FlashArgs) -> Result<()> {
         )
     })?;
     super::ensure_target_tools()?;
-    let elf = build_board_bin(board, "firmware", bin, release, &["defmt-rtt"])?;
+    let elf = build_firmware(board, bin, release, &["defmt-rtt"], &[])?;
     let probe_rs_args = ["run", "--chip", chip];
     let shown = format!("probe-rs {} {}", probe_rs_args.join(" "), elf.display());
     if print_only {

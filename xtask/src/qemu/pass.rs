@@ -32,12 +32,12 @@ use std::time::{Duration, Instant};
 use controller::report::{mode_from_u8, Periods, Status};
 use controller::{Config, Fault, Mode};
 
-use crate::plot::{Legend, Plot, Series};
+use crate::plot::Plot;
 use check::{Downlink, F32_REL_TOLERANCE};
 use scenario::Pass;
 
 use super::board::{Board, BoardArg};
-use super::{build_board_bin, ensure_target_tools, exit_like, runner, workspace_root};
+use super::{build_firmware, ensure_target_tools, exit_like, runner, workspace_root};
 
 /// Segments shown in the table by default (first, one of the two central ones, last).
 pub const TABLE_SEGMENTS: [u8; 3] = [0, 5, 9];
@@ -104,7 +104,7 @@ pub fn run(args: &RunArgs) -> Result<()> {
     }
     if args.demo {
         ensure_target_tools()?;
-        let elf = build_board_bin(board, "firmware", "demo", release, &[])?;
+        let elf = build_firmware(board, "demo", release, &[], &[])?;
         let outcome = runner::run_elf(&elf, &runner::Options::default())?;
         return exit_like(outcome.status);
     }
@@ -116,7 +116,7 @@ pub fn run(args: &RunArgs) -> Result<()> {
         None => scenario::default_pass(tick_us)?,
     };
     ensure_target_tools()?;
-    let elf = build_board_bin(board, "firmware", "firmware", release, &[])?;
+    let elf = build_firmware(board, "firmware", release, &[], &[])?;
     let result = play(&elf, &pass)?;
     let segments = args.segments.as_ref().map_or(&TABLE_SEGMENTS[..], |s| &s.0);
     print_table(&pass, &result, args.every, segments);
@@ -156,7 +156,7 @@ pub fn export(path: &Path) -> Result<()> {
 pub fn e2e_test(board: Board) -> Result<()> {
     let started = Instant::now();
     let pass = scenario::short_pass(Config::default().update_period_us)?;
-    let elf = build_board_bin(board, "firmware", "firmware", true, &[])?;
+    let elf = build_firmware(board, "firmware", true, &[], &[])?;
     let result = play(&elf, &pass)?;
     result.finish()?;
     eprintln!(
@@ -646,29 +646,14 @@ fn telemetry_attitude_deg(pass: &Pass, t_us: u64) -> Option<[f64; 3]> {
 
 /// The line period of every segment over time, as programmed.
 fn plot_periods(pass: &Pass, played: &Played, path: &Path) -> Result<()> {
-    let decoded = played.firmware.decoded();
-    let mut series: BTreeMap<u8, Vec<(f64, f64)>> = BTreeMap::new();
-    for (t_us, p) in &decoded {
-        for r in p.records() {
-            series
-                .entry(r.index)
-                .or_default()
-                .push((*t_us as f64 * 1e-6, f64::from(r.ticks) * 1e-4));
-        }
-    }
-    let mut plot = Plot::new(
+    let plot = Plot::new(
         &format!("Line periods programmed by the firmware, {}", pass.name),
         "time (s)",
         "line period (ms)",
-    )
-    .legend(Legend::TopRight)
-    .x_range(0.0, (pass.end_us as f64 * 1e-6).max(1.0))
-    .size(1100, 650);
-    for (i, (index, points)) in series.into_iter().enumerate() {
-        plot = plot.series(Series::line(&format!("segment {index}"), points).palette(i));
-    }
+    );
     if let Some(dir) = path.parent() {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     }
-    plot.save(path)
+    let series = plots::per_segment(&played.firmware, true, |r| f64::from(r.ticks) * 1e-4);
+    plots::save(pass, plot, series, path)
 }

@@ -7,7 +7,7 @@ use std::path::Path;
 use crate::markdown::{e2, f2, sig, table};
 
 use super::maps::{Cell, Map};
-use super::point::{Outcome, Point, RelErrors, INPUTS};
+use super::point::{Outcome, Point, INPUTS};
 use super::{C_F32, C_FIXED};
 
 /// log10 with a floor, so that an exact 0 lands at the bottom of the colour scale.
@@ -166,76 +166,6 @@ pub fn write_pngs(map: &Map, dir: &Path) -> Result<Vec<String>> {
     Ok(names)
 }
 
-/// Maxima over the cells of `map` that pass `keep`.
-#[derive(Clone, Default)]
-pub struct Agg {
-    pub n: u64,
-    pub refused: u64,
-    pub refused_by: Option<&'static str>,
-    /// Quote `err.fixed_worst()` for the fixed |v_P| error, as the cells' maps do.
-    pub err: RelErrors,
-    pub kappa_min: f64,
-    pub kappa_max: f64,
-    pub ratio_f32: f64,
-    pub ratio_f32_in: f64,
-    pub ratio_fixed: f64,
-    /// min and max of kappa q over the max-kappa sample of each cell.
-    pub kq: (f64, f64),
-    pub worst_f32: Option<(Point, Outcome)>,
-    pub worst_f32_in: Option<(Point, Outcome)>,
-    pub worst_fixed: Option<(Point, Outcome)>,
-    pub max_kappa: Option<(Point, Outcome)>,
-    pub max_v1_terms: f64,
-}
-
-pub fn aggregate(map: &Map, keep: impl Fn(usize, usize, &Cell) -> bool) -> Agg {
-    let mut a = Agg {
-        kappa_min: f64::INFINITY,
-        kq: (f64::INFINITY, 0.0),
-        max_v1_terms: f64::NEG_INFINITY,
-        ..Agg::default()
-    };
-    for iy in 0..map.ny {
-        for ix in 0..map.nx {
-            let c = &map.cells[iy * map.nx + ix];
-            if c.n == 0 || !keep(ix, iy, c) {
-                continue;
-            }
-            a.n += c.n as u64;
-            a.refused += c.refused as u64;
-            a.refused_by = a.refused_by.or(c.refused_by);
-            a.err.max_assign(&c.err);
-            a.kappa_min = a.kappa_min.min(c.min_kappa);
-            a.max_v1_terms = a.max_v1_terms.max(c.v1_term_ratio);
-            let take = |best: &mut f64, slot: &mut Option<(Point, Outcome)>, v: f64, w| {
-                if v > *best || slot.is_none() {
-                    *best = v;
-                    *slot = w;
-                }
-            };
-            take(&mut a.ratio_f32, &mut a.worst_f32, c.ratio_f32, c.worst_f32);
-            take(
-                &mut a.ratio_f32_in,
-                &mut a.worst_f32_in,
-                c.ratio_f32_in,
-                c.worst_f32_in,
-            );
-            take(
-                &mut a.ratio_fixed,
-                &mut a.worst_fixed,
-                c.ratio_fixed,
-                c.worst_fixed,
-            );
-            take(&mut a.kappa_max, &mut a.max_kappa, c.kappa, c.max_kappa);
-            if let Some((_, o)) = c.max_kappa {
-                let kq = o.kappa * o.q;
-                a.kq = (a.kq.0.min(kq), a.kq.1.max(kq));
-            }
-        }
-    }
-    a
-}
-
 const AGG_HEADER: [&str; 12] = [
     "cases",
     "kappa min - max",
@@ -251,11 +181,11 @@ const AGG_HEADER: [&str; 12] = [
     "refused",
 ];
 
-fn agg_row(first: String, a: &Agg) -> Vec<String> {
+fn agg_row(first: String, a: &Cell) -> Vec<String> {
     vec![
         first,
         a.n.to_string(),
-        format!("{} - {}", sig(a.kappa_min), sig(a.kappa_max)),
+        format!("{} - {}", sig(a.kappa_min), sig(a.kappa)),
         e2(a.err.f32),
         e2(a.err.f32_v1),
         e2(a.err.f32_in),
@@ -269,7 +199,7 @@ fn agg_row(first: String, a: &Agg) -> Vec<String> {
     ]
 }
 
-pub fn agg_table(first: &str, rows: &[(String, Agg)]) -> String {
+pub fn agg_table(first: &str, rows: &[(String, Cell)]) -> String {
     let mut header = vec![first];
     header.extend(AGG_HEADER);
     let rows: Vec<Vec<String>> = rows.iter().map(|(n, a)| agg_row(n.clone(), a)).collect();

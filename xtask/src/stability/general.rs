@@ -22,7 +22,7 @@ use std::path::Path;
 use crate::markdown::{e2, sig, table};
 
 use super::doc::lg;
-use super::grid::{self, Spec};
+use super::grid::{self, Cell as _, Spec};
 use super::maps::I0_SSO_DEG;
 use super::point::U_F32;
 
@@ -105,39 +105,55 @@ fn rates(pitch_rate: f64, roll_rate: f64, s: usize) -> Option<EarthCase> {
     Some(case(H0_KM, I0_SSO_DEG, G0_DEG, a, PIXELS[s % 3]))
 }
 
+/// Map D: pitch x roll at yaw 0.
+const PITCH_ROLL: Spec<EarthCase> = Spec {
+    key: "general-pitch-roll",
+    letter: "D",
+    title: "pitch x roll, yaw 0",
+    x_label: "pitch (deg)",
+    y_label: "roll (deg)",
+    x_range: (-45.0, 45.0),
+    y_range: (-45.0, 45.0),
+    y_decades: false,
+    nx: 120,
+    ny: 120,
+    sub: 3,
+    point: |x, y, s| Some(pitch_roll(0.0, x, y, s)),
+    others: "645 km above the WGS 84 equatorial radius, circular, i0 97.98 deg, \
+             g0 45 deg, yaw 0, no rates; n_px = -30 000, 0, 30 000 over the sub-samples",
+    missing: MISSING,
+};
+
+/// Map F: pitch rate x roll rate.
+const RATES: Spec<EarthCase> = Spec {
+    key: "general-rates",
+    letter: "F",
+    title: "pitch rate x roll rate",
+    x_label: "pitch rate (deg/s)",
+    y_label: "roll rate (deg/s)",
+    x_range: (-2.0, 2.0),
+    y_range: (-2.0, 2.0),
+    y_decades: false,
+    nx: 120,
+    ny: 120,
+    sub: 6,
+    point: rates,
+    others: "645 km, circular, i0 97.98 deg, g0 45 deg; n_px = -30 000, 0, 30 000 at \
+             roll = pitch = yaw = 0, then at roll 20, pitch -10 deg; yaw rate 0",
+    missing: MISSING,
+};
+
 pub const GMAPS: [Spec<EarthCase>; 5] = [
-    Spec {
-        key: "general-pitch-roll",
-        letter: "D",
-        title: "pitch x roll, yaw 0",
-        x_label: "pitch (deg)",
-        y_label: "roll (deg)",
-        x_range: (-45.0, 45.0),
-        y_range: (-45.0, 45.0),
-        y_decades: false,
-        nx: 120,
-        ny: 120,
-        sub: 3,
-        point: |x, y, s| Some(pitch_roll(0.0, x, y, s)),
-        others: "645 km above the WGS 84 equatorial radius, circular, i0 97.98 deg, \
-                 g0 45 deg, yaw 0, no rates; n_px = -30 000, 0, 30 000 over the sub-samples",
-        missing: MISSING,
-    },
+    PITCH_ROLL,
     Spec {
         key: "general-pitch-roll-yaw30",
         letter: "D'",
         title: "pitch x roll, yaw 30 deg",
-        x_label: "pitch (deg)",
-        y_label: "roll (deg)",
-        x_range: (-45.0, 45.0),
-        y_range: (-45.0, 45.0),
-        y_decades: false,
         nx: 90,
         ny: 90,
-        sub: 3,
         point: |x, y, s| Some(pitch_roll(30.0, x, y, s)),
         others: "as map D with yaw 30 deg",
-        missing: MISSING,
+        ..PITCH_ROLL
     },
     Spec {
         key: "general-altitude-limb",
@@ -157,38 +173,17 @@ pub const GMAPS: [Spec<EarthCase>; 5] = [
                  (0, 45) and (30, 135) deg, cycling over the sub-samples; no rates",
         missing: MISSING,
     },
-    Spec {
-        key: "general-rates",
-        letter: "F",
-        title: "pitch rate x roll rate",
-        x_label: "pitch rate (deg/s)",
-        y_label: "roll rate (deg/s)",
-        x_range: (-2.0, 2.0),
-        y_range: (-2.0, 2.0),
-        y_decades: false,
-        nx: 120,
-        ny: 120,
-        sub: 6,
-        point: rates,
-        others: "645 km, circular, i0 97.98 deg, g0 45 deg; n_px = -30 000, 0, 30 000 at \
-                 roll = pitch = yaw = 0, then at roll 20, pitch -10 deg; yaw rate 0",
-        missing: MISSING,
-    },
+    RATES,
     Spec {
         key: "general-rates-zoom",
         letter: "F'",
         title: "pitch rate x roll rate, the cancellation",
-        x_label: "pitch rate (deg/s)",
-        y_label: "roll rate (deg/s)",
         x_range: (0.2, 1.0),
         y_range: (-0.2, 0.2),
-        y_decades: false,
         nx: 100,
         ny: 50,
-        sub: 6,
-        point: rates,
         others: "as map F",
-        missing: MISSING,
+        ..RATES
     },
 ];
 
@@ -291,6 +286,42 @@ impl grid::Cell for GCell {
     fn n(&self) -> u64 {
         self.n
     }
+
+    fn merge(&mut self, o: &GCell) {
+        if o.n == 0 {
+            self.refused += o.refused;
+            return;
+        }
+        self.n += o.n;
+        self.refused += o.refused;
+        self.kappa_min = self.kappa_min.min(o.kappa_min);
+        self.min_margin_rad = self.min_margin_rad.min(o.min_margin_rad);
+        self.over_tol += o.over_tol;
+        self.over_tol_kappa_min = self.over_tol_kappa_min.min(o.over_tol_kappa_min);
+        if o.err_tame > self.err_tame {
+            self.err_tame = o.err_tame;
+            self.tame = o.tame;
+        }
+        if o.err_v1_steady > self.err_v1_steady {
+            self.err_v1_steady = o.err_v1_steady;
+            self.steady = o.steady;
+        }
+        let take = |best: &mut f64, slot: &mut Option<(EarthCase, GOutcome)>, v: f64, w| {
+            if slot.is_none() || v > *best {
+                *best = v;
+                *slot = w;
+            }
+        };
+        take(&mut self.ratio, &mut self.worst, o.ratio, o.worst);
+        take(&mut self.kappa, &mut self.max_kappa, o.kappa, o.max_kappa);
+        take(&mut self.err, &mut self.max_err, o.err, o.max_err);
+        take(
+            &mut self.err_v1,
+            &mut self.max_err_v1,
+            o.err_v1,
+            o.max_err_v1,
+        );
+    }
 }
 
 impl GCell {
@@ -333,63 +364,10 @@ impl GCell {
         keep(&mut self.err, &mut self.max_err, o.err);
         keep(&mut self.err_v1, &mut self.max_err_v1, o.err_v1);
     }
-
-    /// Folds another cell (or aggregate) into this one.
-    pub fn merge(&mut self, o: &GCell) {
-        if o.n == 0 {
-            self.refused += o.refused;
-            return;
-        }
-        self.n += o.n;
-        self.refused += o.refused;
-        self.kappa_min = self.kappa_min.min(o.kappa_min);
-        self.min_margin_rad = self.min_margin_rad.min(o.min_margin_rad);
-        self.over_tol += o.over_tol;
-        self.over_tol_kappa_min = self.over_tol_kappa_min.min(o.over_tol_kappa_min);
-        if o.err_tame > self.err_tame {
-            self.err_tame = o.err_tame;
-            self.tame = o.tame;
-        }
-        if o.err_v1_steady > self.err_v1_steady {
-            self.err_v1_steady = o.err_v1_steady;
-            self.steady = o.steady;
-        }
-        let take = |best: &mut f64, slot: &mut Option<(EarthCase, GOutcome)>, v: f64, w| {
-            if slot.is_none() || v > *best {
-                *best = v;
-                *slot = w;
-            }
-        };
-        take(&mut self.ratio, &mut self.worst, o.ratio, o.worst);
-        take(&mut self.kappa, &mut self.max_kappa, o.kappa, o.max_kappa);
-        take(&mut self.err, &mut self.max_err, o.err, o.max_err);
-        take(
-            &mut self.err_v1,
-            &mut self.max_err_v1,
-            o.err_v1,
-            o.max_err_v1,
-        );
-    }
 }
 
 /// A swept map of the general model.
 pub type GMap = grid::Map<GCell>;
-
-impl GMap {
-    /// All cells that pass `keep` (by cell centre) merged.
-    pub fn aggregate(&self, keep: impl Fn(f64, f64) -> bool) -> GCell {
-        let mut a = GCell::empty();
-        for iy in 0..self.ny {
-            for ix in 0..self.nx {
-                let (x, y) = self.centre(ix, iy);
-                if keep(x, y) {
-                    a.merge(&self.cells[iy * self.nx + ix]);
-                }
-            }
-        }
-        a
-    }
-}
 
 /// Sweeps every general map: full grids, or every dimension divided by `coarse`.
 pub fn sweep_all(coarse: Option<usize>) -> Vec<GMap> {
@@ -561,22 +539,23 @@ pub fn figures(maps: &[GMap], secs: f64) -> std::collections::BTreeMap<String, S
     for m in maps {
         let a = m.aggregate(|_, _| true);
         let l = m.spec.letter.replace('\'', "y");
+        let mut put = |what: &str, s: String| put(&format!("{l}.{what}"), s);
         put(
-            &format!("{l}.grid"),
+            "grid",
             format!(
                 "{} x {} cells, {} sub-samples each, {} cases",
                 m.nx, m.ny, m.sub, a.n
             ),
         );
-        put(&format!("{l}.others"), m.spec.others.into());
-        put(&format!("{l}.key"), m.spec.key.into());
-        put(&format!("{l}.ratio"), format!("{:.2}", a.ratio));
-        put(&format!("{l}.kappa_max"), sig(a.kappa));
-        put(&format!("{l}.err"), e2(a.err));
-        put(&format!("{l}.err_v1"), e2(a.err_v1));
-        put(&format!("{l}.err_tame"), format!("{:.3e}", a.err_tame));
-        put(&format!("{l}.over_tol"), a.over_tol.to_string());
-        put(&format!("{l}.over_tol_kappa"), sig(a.over_tol_kappa_min));
+        put("others", m.spec.others.into());
+        put("key", m.spec.key.into());
+        put("ratio", format!("{:.2}", a.ratio));
+        put("kappa_max", sig(a.kappa));
+        put("err", e2(a.err));
+        put("err_v1", e2(a.err_v1));
+        put("err_tame", format!("{:.3e}", a.err_tame));
+        put("over_tol", a.over_tol.to_string());
+        put("over_tol_kappa", sig(a.over_tol_kappa_min));
         for (what, w) in [
             ("worst", &a.worst),
             ("max_kappa", &a.max_kappa),
@@ -585,12 +564,12 @@ pub fn figures(maps: &[GMap], secs: f64) -> std::collections::BTreeMap<String, S
             ("max_err_v1", &a.max_err_v1),
         ] {
             if let Some((c, o)) = w {
-                put(&format!("{l}.{what}.at"), describe(c, o));
-                put(&format!("{l}.{what}.kappa"), sig(o.kappa));
-                put(&format!("{l}.{what}.err"), e2(o.err));
-                put(&format!("{l}.{what}.ratio"), format!("{:.2}", o.ratio()));
-                put(&format!("{l}.{what}.err_v1"), e2(o.err_v1));
-                put(&format!("{l}.{what}.v"), e2(o.v));
+                put(&format!("{what}.at"), describe(c, o));
+                put(&format!("{what}.kappa"), sig(o.kappa));
+                put(&format!("{what}.err"), e2(o.err));
+                put(&format!("{what}.ratio"), format!("{:.2}", o.ratio()));
+                put(&format!("{what}.err_v1"), e2(o.err_v1));
+                put(&format!("{what}.v"), e2(o.v));
             }
         }
         rows.push(row(&format!("{}: {}", m.spec.letter, m.spec.title), &a));
@@ -615,16 +594,14 @@ pub fn figures(maps: &[GMap], secs: f64) -> std::collections::BTreeMap<String, S
         ("steady", &all.steady),
     ] {
         if let Some((c, o)) = w {
-            put(&format!("G.{what}.at"), describe(c, o));
-            put(&format!("G.{what}.kappa"), sig(o.kappa));
-            put(&format!("G.{what}.err"), e2(o.err));
-            put(&format!("G.{what}.err_v1"), e2(o.err_v1));
-            put(&format!("G.{what}.v"), e2(o.v));
-            put(&format!("G.{what}.v1"), e2(o.v1));
-            put(
-                &format!("G.{what}.period_ms"),
-                sig(1e3 * CAMERA.pixel_m / o.v1.abs()),
-            );
+            let mut put = |x: &str, s: String| put(&format!("G.{what}.{x}"), s);
+            put("at", describe(c, o));
+            put("kappa", sig(o.kappa));
+            put("err", e2(o.err));
+            put("err_v1", e2(o.err_v1));
+            put("v", e2(o.v));
+            put("v1", e2(o.v1));
+            put("period_ms", sig(1e3 * CAMERA.pixel_m / o.v1.abs()));
         }
     }
     put("G.table", table(&TABLE_HEADER, &rows));

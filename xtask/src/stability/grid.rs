@@ -38,6 +38,8 @@ pub trait Cell: Clone + Send {
     fn sample(&mut self, point: &Self::Point);
     /// The samples it holds.
     fn n(&self) -> u64;
+    /// Folds another cell (or aggregate of cells) into this one.
+    fn merge(&mut self, other: &Self);
 }
 
 /// A swept map: the cells, row-major from the bottom row (index iy * nx + ix).
@@ -100,6 +102,20 @@ impl<C: Cell> Map<C> {
             .filter(|&i| self.cells[i].n() > 0)
             .max_by(|&a, &b| f(&self.cells[a]).total_cmp(&f(&self.cells[b])))
             .map(|i| (i % self.nx, i / self.nx))
+    }
+
+    /// All cells whose centre (x, y) passes `keep`, merged.
+    pub fn aggregate(&self, keep: impl Fn(f64, f64) -> bool) -> C {
+        let mut a = C::empty();
+        for iy in 0..self.ny {
+            for ix in 0..self.nx {
+                let (x, y) = self.centre(ix, iy);
+                if keep(x, y) {
+                    a.merge(&self.cells[iy * self.nx + ix]);
+                }
+            }
+        }
+        a
     }
 
     pub fn samples(&self) -> u64 {

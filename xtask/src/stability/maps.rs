@@ -118,31 +118,49 @@ pub const MAPS: [Spec<Point>; 3] = [
     },
 ];
 
-/// What a cell keeps of its sub-samples: maxima, and the sample behind each ratio's max.
+/// What a cell (or an aggregate of cells) keeps of its samples: maxima, and the sample
+/// behind each ratio's max.
 #[derive(Clone, Debug, Default)]
 pub struct Cell {
     pub n: u32,
     pub refused: u32,
     pub refused_by: Option<&'static str>,
+    /// Quote `err.fixed_worst()` for the fixed |v_P| error, as the maps do.
     pub err: RelErrors,
     pub kappa: f64,
-    pub min_kappa: f64,
+    pub kappa_min: f64,
     pub ratio_f32: f64,
     pub ratio_f32_in: f64,
     pub ratio_fixed: f64,
     pub v1_term_ratio: f64,
     pub min_margin_rad: f64,
+    /// min and max of kappa q over the max-kappa sample of each cell.
+    pub kq: (f64, f64),
     pub worst_f32: Option<(Point, Outcome)>,
     pub worst_f32_in: Option<(Point, Outcome)>,
     pub worst_fixed: Option<(Point, Outcome)>,
     pub max_kappa: Option<(Point, Outcome)>,
 }
 
+/// `slot` and `best` become `w` and `v` when there is no sample yet or `v` is larger.
+fn take(best: &mut f64, slot: &mut Option<(Point, Outcome)>, v: f64, w: Option<(Point, Outcome)>) {
+    if slot.is_none() || v > *best {
+        *best = v;
+        *slot = w;
+    }
+}
+
 impl grid::Cell for Cell {
     type Point = Point;
 
     fn empty() -> Self {
-        Cell::default()
+        Cell {
+            kappa_min: f64::INFINITY,
+            min_margin_rad: f64::INFINITY,
+            v1_term_ratio: f64::NEG_INFINITY,
+            kq: (f64::INFINITY, 0.0),
+            ..Cell::default()
+        }
     }
 
     fn sample(&mut self, pt: &Point) {
@@ -159,38 +177,67 @@ impl grid::Cell for Cell {
     fn n(&self) -> u64 {
         self.n.into()
     }
+
+    /// A cell without samples adds nothing (not even its refusals).
+    fn merge(&mut self, o: &Cell) {
+        if o.n == 0 {
+            return;
+        }
+        self.n += o.n;
+        self.refused += o.refused;
+        self.refused_by = self.refused_by.or(o.refused_by);
+        self.err.max_assign(&o.err);
+        self.kappa_min = self.kappa_min.min(o.kappa_min);
+        self.min_margin_rad = self.min_margin_rad.min(o.min_margin_rad);
+        self.v1_term_ratio = self.v1_term_ratio.max(o.v1_term_ratio);
+        self.kq = (self.kq.0.min(o.kq.0), self.kq.1.max(o.kq.1));
+        take(
+            &mut self.ratio_f32,
+            &mut self.worst_f32,
+            o.ratio_f32,
+            o.worst_f32,
+        );
+        take(
+            &mut self.ratio_f32_in,
+            &mut self.worst_f32_in,
+            o.ratio_f32_in,
+            o.worst_f32_in,
+        );
+        take(
+            &mut self.ratio_fixed,
+            &mut self.worst_fixed,
+            o.ratio_fixed,
+            o.worst_fixed,
+        );
+        take(&mut self.kappa, &mut self.max_kappa, o.kappa, o.max_kappa);
+    }
 }
 
 impl Cell {
     fn add(&mut self, pt: &Point, o: &Outcome) {
-        if self.n == 0 {
-            self.min_kappa = f64::INFINITY;
-            self.min_margin_rad = f64::INFINITY;
-            self.v1_term_ratio = f64::NEG_INFINITY;
-        }
         self.n += 1;
         self.err.max_assign(&o.err);
-        self.min_kappa = self.min_kappa.min(o.kappa);
+        self.kappa_min = self.kappa_min.min(o.kappa);
         self.min_margin_rad = self.min_margin_rad.min(o.margin_rad);
         self.v1_term_ratio = self.v1_term_ratio.max(o.v1_term_ratio);
-        let keep = |best: &mut f64, slot: &mut Option<(Point, Outcome)>, v: f64| {
-            if slot.is_none() || v > *best {
-                *best = v;
-                *slot = Some((*pt, *o));
-            }
-        };
-        keep(&mut self.ratio_f32, &mut self.worst_f32, o.ratio_f32());
-        keep(
+        let w = Some((*pt, *o));
+        take(&mut self.ratio_f32, &mut self.worst_f32, o.ratio_f32(), w);
+        take(
             &mut self.ratio_f32_in,
             &mut self.worst_f32_in,
             o.ratio_f32_in(),
+            w,
         );
-        keep(
+        take(
             &mut self.ratio_fixed,
             &mut self.worst_fixed,
             o.ratio_fixed(),
+            w,
         );
-        keep(&mut self.kappa, &mut self.max_kappa, o.kappa);
+        take(&mut self.kappa, &mut self.max_kappa, o.kappa, w);
+        if let Some((_, m)) = self.max_kappa {
+            self.kq = (m.kappa * m.q, m.kappa * m.q);
+        }
     }
 }
 

@@ -10,14 +10,16 @@ use crate::plot::{Legend, Plot, Series};
 use super::check::Downlink;
 use super::scenario::Pass;
 
-/// One series per segment of `value` over the pass, from every record not held.
-fn per_segment(
+/// One series per segment of `value` over the pass, from every record (only those not
+/// held unless `with_held`).
+pub(super) fn per_segment(
     firmware: &Downlink,
+    with_held: bool,
     value: impl Fn(&controller::SegmentOutput) -> f64,
 ) -> BTreeMap<u8, Vec<(f64, f64)>> {
     let mut series: BTreeMap<u8, Vec<(f64, f64)>> = BTreeMap::new();
     for (t_us, p) in firmware.decoded() {
-        for r in p.records().iter().filter(|r| !r.held) {
+        for r in p.records().iter().filter(|r| with_held || !r.held) {
             series
                 .entry(r.index)
                 .or_default()
@@ -27,11 +29,21 @@ fn per_segment(
     series
 }
 
-fn save(pass: &Pass, plot: Plot, series: BTreeMap<u8, Vec<(f64, f64)>>, path: &Path) -> Result<()> {
-    let mut plot = plot
-        .legend(Legend::TopRight)
+/// `plot` over the pass's time span, legend top right, 1100 x 650 pixels.
+fn framed(pass: &Pass, plot: Plot) -> Plot {
+    plot.legend(Legend::TopRight)
         .x_range(0.0, (pass.end_us as f64 * 1e-6).max(1.0))
-        .size(1100, 650);
+        .size(1100, 650)
+}
+
+/// `plot` with one series per segment, written to `path`.
+pub(super) fn save(
+    pass: &Pass,
+    plot: Plot,
+    series: BTreeMap<u8, Vec<(f64, f64)>>,
+    path: &Path,
+) -> Result<()> {
+    let mut plot = framed(pass, plot);
     for (i, (index, points)) in series.into_iter().enumerate() {
         plot = plot.series(Series::line(&format!("segment {index}"), points).palette(i));
     }
@@ -48,7 +60,7 @@ pub fn pass_plots(pass: &Pass, firmware: &Downlink, dir: &Path) -> Result<()> {
             "time (s)",
             "drift atan(v2/v1) (mrad)",
         ),
-        per_segment(firmware, |r| f64::from(r.drift_rad) * 1e3),
+        per_segment(firmware, false, |r| f64::from(r.drift_rad) * 1e3),
         &dir.join("drift.png"),
     )?;
     save(
@@ -62,7 +74,7 @@ pub fn pass_plots(pass: &Pass, firmware: &Downlink, dir: &Path) -> Result<()> {
             "MTF",
         )
         .y_range(0.0, 1.05),
-        per_segment(firmware, |r| f64::from(r.mtf)),
+        per_segment(firmware, false, |r| f64::from(r.mtf)),
         &dir.join("mtf.png"),
     )?;
     let mut terrain: BTreeMap<u8, Vec<(f64, f64)>> = BTreeMap::new();
@@ -84,17 +96,14 @@ pub fn pass_plots(pass: &Pass, firmware: &Downlink, dir: &Path) -> Result<()> {
         terrain,
         &dir.join("terrain.png"),
     )?;
-    let mut yaw = Plot::new(
+    let yaw = Plot::new(
         &format!(
             "Yaw steering: the firmware's request and the yaw flown, {}",
             pass.name
         ),
         "time (s)",
         "yaw (mrad)",
-    )
-    .legend(Legend::TopRight)
-    .x_range(0.0, (pass.end_us as f64 * 1e-6).max(1.0))
-    .size(1100, 650);
+    );
     let requests: Vec<(f64, f64)> = firmware
         .decoded()
         .iter()
@@ -113,8 +122,8 @@ pub fn pass_plots(pass: &Pass, firmware: &Downlink, dir: &Path) -> Result<()> {
             )
         })
         .collect();
-    yaw = yaw
+    framed(pass, yaw)
         .series(Series::line("yaw flown (NAV)", flown).palette(0))
-        .series(Series::line("correction requested", requests).palette(1));
-    yaw.save(&dir.join("yaw.png"))
+        .series(Series::line("correction requested", requests).palette(1))
+        .save(&dir.join("yaw.png"))
 }

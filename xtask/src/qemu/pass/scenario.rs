@@ -11,6 +11,7 @@ use core_math::earth::kepler::Kepler;
 use core_math::vector::{add, dot, scale};
 use core_math::{StateVector, GM_M3_S2};
 
+use super::stream::Frames;
 use crate::csv::Table;
 
 /// One NAV frame's content and time tag.
@@ -472,7 +473,7 @@ pub struct Manoeuvres {
 /// stream the firmware will see (the injected faults change no output, which the pass
 /// checks), so its requests are the firmware's.
 pub fn build(m: Manoeuvres, tick_us: u64) -> Result<Pass> {
-    use controller::frame::{encode, kind, MAX_FRAME};
+    use controller::frame::kind;
     let end_us = us(m.duration_s);
     let in_gap = |t_us: u64| {
         m.faults.iter().any(|f| match *f {
@@ -499,25 +500,17 @@ pub fn build(m: Manoeuvres, tick_us: u64) -> Result<Pass> {
     let controller = controller::Controller::new(controller::Config::default(), scene)
         .map_err(|f| anyhow!("the default scene was refused: {}", f.name()))?;
     let mut session = controller::session::Session::new(controller);
-    let mut sequence = 0u16;
-    let mut feed =
-        |session: &mut controller::session::Session, kind: u8, t: u64, payload: &[u8]| {
-            let mut buf = [0u8; MAX_FRAME];
-            let n = encode(kind, sequence, t, payload, &mut buf).unwrap_or(0);
-            sequence = sequence.wrapping_add(1);
-            session.feed(&buf[..n], &mut super::check::Accept, |_| {});
-        };
+    let mut frames = Frames::default();
+    let feed = |session: &mut controller::session::Session, frame: Vec<u8>| {
+        session.feed(&frame, &mut super::check::Accept, |_| {});
+    };
     let (mut samples, mut terrain) = (Vec::new(), Vec::new());
     // The pass starts steered: the request of a first update at t = 0 with the yaw at 0.
     let mut target_rad = {
         let mut probe = session.controller.clone();
-        let nav = truth.nav(0.0);
-        let mut p = [0u8; 128];
-        let n = nav.encode(&mut p).unwrap_or(0);
-        let mut buf = [0u8; MAX_FRAME];
-        let len = encode(kind::NAV, 0, 0, &p[..n], &mut buf).unwrap_or(0);
+        let frame = Frames::default().nav(0, &truth.nav(0.0));
         let mut decoder = controller::frame::Decoder::new();
-        decoder.feed(&buf[..len], |e| {
+        decoder.feed(&frame, |e| {
             if let controller::frame::Event::Frame(f) = e {
                 probe.on_frame(&f);
             }
@@ -548,18 +541,16 @@ pub fn build(m: Manoeuvres, tick_us: u64) -> Result<Pass> {
                     truth.yaw.push((t_us, yaw, rate_rad_s));
                 }
                 let nav = truth.nav(t_s);
-                let mut p = [0u8; 128];
-                let n = nav.encode(&mut p).unwrap_or(0);
-                feed(&mut session, kind::NAV, t_us, &p[..n]);
+                feed(&mut session, frames.nav(t_us, &nav));
                 samples.push(Sample { t_us, nav });
             }
             SlotKind::Terrain => {
                 let heights = truth.heights_m(t_s + 0.5);
                 let payload = terrain_payload(&heights);
-                feed(&mut session, kind::TERRAIN, t_us, &payload);
+                feed(&mut session, frames.frame(kind::TERRAIN, t_us, &payload));
                 terrain.push((t_us, heights));
             }
-            SlotKind::Time => feed(&mut session, kind::TIME, t_us, &[]),
+            SlotKind::Time => feed(&mut session, frames.frame(kind::TIME, t_us, &[])),
         }
     }
     Ok(Pass {

@@ -57,18 +57,20 @@ impl Stream {
     }
 }
 
-struct Frames {
+/// Frames encoded in sequence (the sequence number wraps).
+#[derive(Default)]
+pub(super) struct Frames {
     sequence: u16,
 }
 
 impl Frames {
-    fn frame(&mut self, kind: u8, time_us: u64, payload: &[u8]) -> Vec<u8> {
+    pub(super) fn frame(&mut self, kind: u8, time_us: u64, payload: &[u8]) -> Vec<u8> {
         let mut buf = [0u8; MAX_FRAME];
         let n = encode(kind, self.sequence, time_us, payload, &mut buf).unwrap_or(0);
         self.sequence = self.sequence.wrapping_add(1);
         buf[..n].to_vec()
     }
-    fn nav(&mut self, time_us: u64, nav: &Nav) -> Vec<u8> {
+    pub(super) fn nav(&mut self, time_us: u64, nav: &Nav) -> Vec<u8> {
         let mut payload = [0u8; 128];
         let n = nav.encode(&mut payload).unwrap_or(0);
         self.frame(kind::NAV, time_us, &payload[..n])
@@ -84,7 +86,7 @@ pub fn build(pass: &Pass) -> Result<Stream> {
     let slots = schedule(&nav_us, &terrain_us, pass.tick_us, pass.end_us);
     let (mut navs, mut uploads) = (pass.samples.iter(), pass.terrain.iter());
 
-    let mut frames = Frames { sequence: 0 };
+    let mut frames = Frames::default();
     let mut items: Vec<Item> = Vec::with_capacity(slots.len() + 16);
     // Index of the item carrying the NAV frame of each instant.
     let mut nav_item = std::collections::HashMap::new();
@@ -127,77 +129,73 @@ pub fn build(pass: &Pass) -> Result<Stream> {
             .context("faults are injected into the built-in passes only")
     };
     for (k, f) in pass.faults.iter().enumerate() {
-        let expect = match *f {
+        // What the fault changes in place, or the frame (or noise) it adds after the
+        // frames of `t_s`; and the counter it must increment.
+        let (added, expect) = match *f {
             FaultSpec::BitFlip { t_s } => {
                 let i = item_at(t_s)?;
                 items[i].bytes = bit_flip(&items[i].bytes)?;
                 items[i].fault = Some(k);
-                Some(Fault::BadCrc)
+                (None, Some(Fault::BadCrc))
             }
             FaultSpec::Truncate { t_s } => {
                 let i = item_at(t_s)?;
                 items[i].bytes = truncate(&items[i].bytes)?;
                 items[i].fault = Some(k);
-                Some(Fault::Truncated)
+                (None, Some(Fault::Truncated))
             }
-            FaultSpec::Noise { t_s, bytes } => {
-                extra.push((
-                    after(us(t_s)),
-                    Item {
-                        bytes: noise(bytes, k as u64),
-                        fault: Some(k),
-                    },
-                ));
-                None
-            }
+            FaultSpec::Noise { t_s, bytes } => (Some((t_s, noise(bytes, k as u64))), None),
             FaultSpec::Backwards { t_s, back_s } => {
                 let t_old = t_s - back_s;
                 let bytes = frames.nav(us(t_old), &truth_nav(t_old)?);
-                extra.push(injected_item(after(us(t_s)), bytes, k));
-                Some(Fault::TimeWentBackwards)
+                (Some((t_s, bytes)), Some(Fault::TimeWentBackwards))
             }
             FaultSpec::NaN { t_s } => {
                 let mut nav = truth_nav(t_s)?;
                 nav.state.velocity_mps[0] = f64::NAN;
-                let bytes = frames.nav(us(t_s), &nav);
-                extra.push(injected_item(after(us(t_s)), bytes, k));
-                Some(Fault::NonFinite)
+                (
+                    Some((t_s, frames.nav(us(t_s), &nav))),
+                    Some(Fault::NonFinite),
+                )
             }
             FaultSpec::Altitude { t_s, altitude_m } => {
                 let mut nav = truth_nav(t_s)?;
                 let r = nav.state.position_m;
                 nav.state.position_m = scale((EARTH.a_m + altitude_m) / norm(r), r);
-                let bytes = frames.nav(us(t_s), &nav);
-                extra.push(injected_item(after(us(t_s)), bytes, k));
-                Some(Fault::OutOfRange)
+                (
+                    Some((t_s, frames.nav(us(t_s), &nav))),
+                    Some(Fault::OutOfRange),
+                )
             }
             // Cut out of the samples already: missing telemetry, in both runs.
-            FaultSpec::Gap { .. } => Some(Fault::Stale),
+            FaultSpec::Gap { .. } => (None, Some(Fault::Stale)),
             FaultSpec::TimeTag { t_s, tag_us } => {
                 let bytes = frames.frame(kind::TIME, tag_us, &[]);
-                extra.push(injected_item(after(us(t_s)), bytes, k));
-                Some(Fault::TimeJump)
+                (Some((t_s, bytes)), Some(Fault::TimeJump))
             }
             FaultSpec::BadScene { t_s, probe } => {
                 let bytes = frames.frame(kind::SCENE, us(t_s), &probe.payload());
-                extra.push(injected_item(after(us(t_s)), bytes, k));
-                Some(Fault::InvalidScene)
+                (Some((t_s, bytes)), Some(Fault::InvalidScene))
             }
             FaultSpec::Terrain { t_s, height_m } => {
                 let n = pass.terrain.first().map_or(0, |t| t.1.len());
                 let bytes =
                     frames.frame(kind::TERRAIN, us(t_s), &terrain_payload(&vec![height_m; n]));
-                extra.push(injected_item(after(us(t_s)), bytes, k));
-                Some(Fault::OutOfRange)
+                (Some((t_s, bytes)), Some(Fault::OutOfRange))
             }
             FaultSpec::Envelope { t_s } => {
                 let mut nav = truth_nav(t_s)?;
                 nav.attitude.roll_rate_rad_s = 0.5;
-                let bytes = frames.nav(us(t_s), &nav);
-                extra.push(injected_item(after(us(t_s)), bytes, k));
-                Some(Fault::AttitudeOutsideModel)
+                (
+                    Some((t_s, frames.nav(us(t_s), &nav))),
+                    Some(Fault::AttitudeOutsideModel),
+                )
             }
         };
+        if let Some((t_s, bytes)) = added {
+            let fault = Some(k);
+            extra.push((after(us(t_s)), Item { bytes, fault }));
+        }
         injected.push((f.label(), expect));
     }
     // The ground's scene upload at the start of the pass, 1 us after the first frame:
@@ -224,17 +222,6 @@ pub fn build(pass: &Pass) -> Result<Stream> {
         fault: None,
     });
     Ok(Stream { items, injected })
-}
-
-/// The item of injected fault `k`, to go before item `at`.
-fn injected_item(at: usize, bytes: Vec<u8>, k: usize) -> (usize, Item) {
-    (
-        at,
-        Item {
-            bytes,
-            fault: Some(k),
-        },
-    )
 }
 
 /// True when `bytes` holds the sync word anywhere.

@@ -12,16 +12,18 @@ use anyhow::{anyhow, Result};
 use controller::golden::{self, NavInput};
 use controller::Controller;
 use core_math::earth::{Attitude, EarthGeometry};
-use core_math::sphere::{Geometry, OrbitState, Reference};
+use core_math::sphere::Reference;
 use core_math::{Backend, EarthCamera, EarthReference, StateVector, EARTH_RATE_RAD_S};
 
 use super::check::Downlink;
 use super::scenario::AgileTruth;
+use crate::ellipsoid::round_geometry;
 
 /// The round-Earth radius of the paper's model (the controller's before issue 12).
 const PAPER_EARTH_RADIUS_M: f64 = 6_371_000.0;
 
 /// What the truth checks found.
+#[derive(Default)]
 pub struct Report {
     max_roll_deg: f64,
     max_pitch_deg: f64,
@@ -81,20 +83,10 @@ pub fn check(truth: &AgileTruth, firmware: &Downlink, controller: &Controller) -
     let scene = controller.scene();
     let plan = controller.plan();
     let mut r = Report {
-        max_roll_deg: 0.0,
-        max_pitch_deg: 0.0,
-        max_yaw_deg: 0.0,
         heights_m: (f64::INFINITY, f64::NEG_INFINITY),
         eccentricity: truth.orbit.eccentricity(0.0),
-        paper: (0.0, 0, 0),
-        firmware: (0.0, 0, 0),
-        drift_unsteered: 0.0,
-        drift_steered: 0.0,
-        centre_unsteered: 0.0,
-        centre_steered: 0.0,
         worst_mtf: (f32::INFINITY, 0, 0),
-        updates: 0,
-        holds: 0,
+        ..Report::default()
     };
     // The paper model's pixel constants at each segment's samples, once for the pass.
     let mut paper_pixels = std::collections::BTreeMap::new();
@@ -139,17 +131,8 @@ pub fn check(truth: &AgileTruth, firmware: &Downlink, controller: &Controller) -
             t_us,
         )
         .map_err(|e| anyhow!("truth at {t_s} s: {}", e.name()))?;
-        let orbit = OrbitState::from_state(&state, PAPER_EARTH_RADIUS_M)
+        let paper = round_geometry(&state, attitude.roll_rad, PAPER_EARTH_RADIUS_M)
             .map_err(|e| anyhow!("paper model at {t_s} s: {}", e.name()))?;
-        let paper = Geometry {
-            roll_rad: attitude.roll_rad,
-            inclination_rad: orbit.inclination_rad,
-            arg_latitude_rad: orbit.arg_latitude_rad,
-            altitude_m: orbit.altitude_m,
-            earth_radius_m: PAPER_EARTH_RADIUS_M,
-            earth_rate_rad_s: EARTH_RATE_RAD_S,
-            orbit_rate_rad_s: orbit.orbit_rate_rad_s,
-        };
         let paper_update = Reference.update(&paper).ok();
         let hold = attitude.roll_rate_rad_s == 0.0 && attitude.pitch_rate_rad_s == 0.0;
         r.holds += usize::from(hold);
