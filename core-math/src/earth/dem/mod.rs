@@ -275,9 +275,11 @@ impl<'a, H: DemHeight> DemTile<'a, H> {
 
 /// (fraction, index) of a grid coordinate x (in cells) in the closed range [0, last + 1]:
 /// the cell index clamped to 0..=last, so that the tile's far edge falls in its last cell.
+/// The conversion truncates, which is the floor for x >= 0, and saturates a negative x
+/// (a rounding below the edge) to 0 as the floor's conversion would: no `floorf` call.
 #[inline(always)]
 fn cell<T: Real>(x: T, last: u32) -> (T, u32) {
-    let i = x.floor().to_u32().min(last);
+    let i = x.to_u32().min(last);
     (x - T::from_u32(i), i)
 }
 
