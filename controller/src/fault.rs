@@ -109,6 +109,7 @@ impl From<ModelError> for Fault {
             | ModelError::OutOfDomain(_)
             | ModelError::InvalidInput(_)
             | ModelError::InvalidQuaternion(_)
+            | ModelError::OutsideDem
             | ModelError::DegenerateState
             | ModelError::SatelliteNotAboveGround => Fault::OutOfRange,
         }

@@ -52,6 +52,10 @@ pub enum Param {
     CameraQuaternion,
     /// The body rates measured by the gyros (Part II).
     BodyRate,
+    /// A DEM tile's grid: its origin, spacings and node counts (Part II).
+    DemGrid,
+    /// A DEM tile's node heights (Part II).
+    DemHeight,
 }
 
 impl Param {
@@ -93,6 +97,8 @@ impl Param {
             Param::Quaternion => "quaternion",
             Param::CameraQuaternion => "camera_quaternion",
             Param::BodyRate => "body_rate",
+            Param::DemGrid => "dem_grid",
+            Param::DemHeight => "dem_height",
         }
     }
 }
@@ -131,6 +137,9 @@ pub enum ModelError {
     /// Part II: a quaternion (the attitude `q` or the mounting `cam_q`, named by the
     /// parameter) whose norm is not within 1e-3 of 1.
     InvalidQuaternion(Param),
+    /// Part II: the line of sight reaches the ground (some point of it is as low as the
+    /// DEM tile's lowest node) but crosses the tile's surface nowhere inside the tile.
+    OutsideDem,
 }
 
 impl ModelError {
@@ -151,6 +160,7 @@ impl ModelError {
             ModelError::SatelliteNotAboveGround => "satellite_not_above_ground",
             ModelError::NoAlongTrackMotion => "no_along_track_motion",
             ModelError::InvalidQuaternion(_) => "invalid_quaternion",
+            ModelError::OutsideDem => "outside_dem",
         }
     }
 

@@ -48,12 +48,23 @@ pub trait Real:
     /// Conversion to u32, saturating at 0 and `u32::MAX` (NaN gives 0), as Rust's `as`.
     fn to_u32(self) -> u32;
     fn from_u32(n: u32) -> Self;
+    /// An i16 exactly (a DEM node height in metres).
+    fn from_i16(n: i16) -> Self;
+    /// An f32 exactly (f64) or as is (f32).
+    fn from_f32(x: f32) -> Self;
     /// atan(x) (f32: libm's `atanf`, pure f32, 0.85 ulp; used once per segment, never
     /// per pixel).
     fn atan(self) -> Self;
     /// (sin x, cos x) for |x| <= 0.15 by truncated Taylor series, to this type's
     /// precision: no call, a handful of multiply-adds. Used per pixel near the limb.
     fn small_sin_cos(x: Self) -> (Self, Self);
+    /// Cube root (libm's `cbrt`, `cbrtf`): the geodetic conversion's one root of its
+    /// cubic resolvent, once per call.
+    fn cbrt(self) -> Self;
+    /// atan2(self, x) in [-pi, pi] (libm's `atan2`, `atan2f`).
+    fn atan2(self, x: Self) -> Self;
+    /// sqrt(self^2 + y^2) without intermediate overflow (libm's `hypot`, `hypotf`).
+    fn hypot(self, y: Self) -> Self;
 }
 
 impl Scalar for f64 {
@@ -107,8 +118,28 @@ impl Real for f64 {
         n as f64
     }
     #[inline(always)]
+    fn from_i16(n: i16) -> Self {
+        f64::from(n)
+    }
+    #[inline(always)]
+    fn from_f32(x: f32) -> Self {
+        f64::from(x)
+    }
+    #[inline(always)]
     fn atan(self) -> Self {
         libm::atan(self)
+    }
+    #[inline(always)]
+    fn cbrt(self) -> Self {
+        libm::cbrt(self)
+    }
+    #[inline(always)]
+    fn atan2(self, x: Self) -> Self {
+        libm::atan2(self, x)
+    }
+    #[inline(always)]
+    fn hypot(self, y: Self) -> Self {
+        libm::hypot(self, y)
     }
     /// Terms to x^9 and x^10: the first omitted ones are below 1.2e-17 x and 2.7e-19.
     #[inline(always)]
@@ -163,8 +194,28 @@ impl Real for f32 {
         n as f32
     }
     #[inline(always)]
+    fn from_i16(n: i16) -> Self {
+        f32::from(n)
+    }
+    #[inline(always)]
+    fn from_f32(x: f32) -> Self {
+        x
+    }
+    #[inline(always)]
     fn atan(self) -> Self {
         libm::atanf(self)
+    }
+    #[inline(always)]
+    fn cbrt(self) -> Self {
+        libm::cbrtf(self)
+    }
+    #[inline(always)]
+    fn atan2(self, x: Self) -> Self {
+        libm::atan2f(self, x)
+    }
+    #[inline(always)]
+    fn hypot(self, y: Self) -> Self {
+        libm::hypotf(self, y)
     }
     /// Terms to x^5 and x^4: the first omitted ones are below 3.5e-10 x and 1.6e-8,
     /// both under f32's unit roundoff (6e-8) relative to the results.

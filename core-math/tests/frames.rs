@@ -13,7 +13,8 @@ use core_math::earth::frames::geodetic::GEODETIC_MAX_FLATTENING;
 use core_math::earth::frames::nutation::{nut00b, nut06b};
 use core_math::earth::frames::time::{tt_from_gps_s, ut1_from_gps_s, GPS_S_MAX, JD_J2000};
 use core_math::earth::frames::{
-    c2t, c2t_from_cio, geodetic_from_itrf, itrf_from_geodetic, Mat3, TimeScales, C2T_TOLERANCE_RAD,
+    c2t, c2t_from_cio, geodetic_from_itrf, itrf_from_geodetic, CelestialPole, Mat3, TimeScales,
+    C2T_TOLERANCE_RAD, POLE_MAX_AGE_S,
 };
 use core_math::sample::SplitMix64;
 use core_math::{Ellipsoid, ModelError, Param};
@@ -102,6 +103,35 @@ fn c2t_within_its_tolerance_of_erfa_c2t06a() {
     );
     assert!(max <= C2T_TOLERANCE_RAD);
     const { assert!(C2T_TOLERANCE_RAD <= 1.0e-7) };
+}
+
+/// C2T from a [`CelestialPole`] computed up to [`POLE_MAX_AGE_S`] earlier or later, with
+/// the Earth rotation angle of the instant: within the tolerance of `eraC2t06a`, and
+/// within 1.5e-9 rad of a fresh [`c2t`] (the pole's own motion over a minute).
+#[test]
+fn c2t_from_a_pole_a_minute_old_stays_within_tolerance() {
+    let (head, data) = rows(C2T_CSV);
+    let (mut max_erfa, mut max_fresh) = (0.0f64, 0.0f64);
+    for fields in &data {
+        let row = Row {
+            head: &head,
+            fields,
+        };
+        let (gps_s, sc) = (row.f("gps_s"), scales(&row));
+        for age_s in [-POLE_MAX_AGE_S, POLE_MAX_AGE_S] {
+            let Ok(pole) = CelestialPole::at(gps_s - age_s, &sc) else {
+                continue;
+            };
+            let m = pole.c2t(gps_s, &sc).unwrap();
+            max_erfa = max_erfa.max(angle_between(&m, &matrix(&row)));
+            max_fresh = max_fresh.max(angle_between(&m, &c2t(gps_s, &sc).unwrap()));
+        }
+    }
+    println!(
+        "C2T from a pole {POLE_MAX_AGE_S} s old: {max_fresh:.3e} rad from a fresh C2T, \
+         {max_erfa:.3e} rad from eraC2t06a"
+    );
+    assert!(max_fresh <= 1.5e-9 && max_erfa <= C2T_TOLERANCE_RAD);
 }
 
 #[test]

@@ -91,6 +91,42 @@ fn inertial_of<G: ReferenceGeometry>(g: &G) -> InertialAttitude<f64> {
     }
 }
 
+/// `EarthGeometry::to_inertial` (plain f64: the orbital frame and A, Omega from the
+/// general form's W_B and n_B) against the reference's axes on dual numbers (B0 = M(0),
+/// [Omega]x = B0^T dM/dt), over Part I's seeded cases.
+#[test]
+fn part_one_to_inertial_matches_the_dual_number_axes() {
+    let mut rng = SplitMix64(0x0EA7_2026_1126_0024);
+    let (mut n, mut worst_axes, mut worst_omega) = (0, 0f64, 0f64);
+    for _ in 0..2_000 {
+        let Some(c) = rng.earth_case() else { continue };
+        let mine = c.geometry.to_inertial().unwrap().attitude;
+        let dual = inertial_of(&c.geometry);
+        for i in 0..3 {
+            for j in 0..3 {
+                let d = (mine.camera_to_inertial[i][j] - dual.camera_to_inertial[i][j]).abs();
+                worst_axes = worst_axes.max(d);
+            }
+        }
+        let wn = dual
+            .omega_rad_s
+            .iter()
+            .map(|x| x * x)
+            .sum::<f64>()
+            .sqrt()
+            .max(1e-6);
+        for k in 0..3 {
+            worst_omega = worst_omega.max((mine.omega_rad_s[k] - dual.omega_rad_s[k]).abs() / wn);
+        }
+        n += 1;
+    }
+    assert!(n > 1_000, "{n} cases");
+    assert!(
+        worst_axes <= 1e-14 && worst_omega <= 1e-12,
+        "{worst_axes:e} {worst_omega:e}"
+    );
+}
+
 /// Part I's cases with the attitude handed over as the camera's axes in I and their
 /// angular velocity: every backend gives Part I's motion (reference to 1e-12, general
 /// f64 to Part I's 1e-12, general f32 to Part I's 2e-6 where kappa <= 30 and 1 deg

@@ -523,6 +523,7 @@ import general  # noqa: E402  (same directory as this script)
 general.run(check, info, full="--full" in sys.argv)
 general.run_numeric(check, info)
 general.run_case(check, info)
+general.run_bus(check, info)
 
 # --------------------------------------------------------------------------------------
 n_fail = sum(1 for _, ok in RESULTS if not ok)

@@ -144,8 +144,26 @@ def c2t_erfa(gps_s, gps_utc_s, dut1_s):
 
 # --- the definition ---------------------------------------------------------------------
 
-def motion(row, c2t):
-    """(v1, v2) of Part II for one row (dict of floats and strings); c2t a 3x3 or None."""
+def ellipsoid_root(row, r_i, d):
+    """The near root s of r_i + s d on the ellipsoid (a + h, a + h, b + h)."""
+    a = mp.mpf(row["a_m"])
+    b = a * (1 - mp.mpf(row["flattening"]))
+    h = mp.mpf(row["ground_h_m"])
+    ea, eb = a + h, b + h
+    qa = (d[0] ** 2 + d[1] ** 2) / ea ** 2 + d[2] ** 2 / eb ** 2
+    qb = 2 * ((r_i[0] * d[0] + r_i[1] * d[1]) / ea ** 2 + r_i[2] * d[2] / eb ** 2)
+    qc = (r_i[0] ** 2 + r_i[1] ** 2) / ea ** 2 + r_i[2] ** 2 / eb ** 2 - 1
+    disc = qb ** 2 - 4 * qa * qc
+    assert qc > 0 and disc > 0 and qb < 0
+    s = (-qb - mp.sqrt(disc)) / (2 * qa)
+    assert s > 0
+    return s
+
+
+def motion(row, c2t, ground_s=None):
+    """(v1, v2) of Part II for one row (dict of floats and strings); c2t a 3x3 or None.
+    ground_s: the ground point as r_I + ground_s d (a DEM's, found by the caller) instead
+    of the ellipsoid's."""
     r = mpv([row["x_m"], row["y_m"], row["z_m"]])
     v = mpv([row["vx_mps"], row["vy_mps"], row["vz_mps"]])
     w_e = mp.mpf(row["earth_rate_rad_s"])
@@ -168,17 +186,10 @@ def motion(row, c2t):
     p1 = mp.mpf(row["p1_m"])
     p2 = mp.mpf(row["n_px"]) * mp.mpf(row["pixel_m"])
     d = b0 * mp.matrix([p1, p2, -f])
-    a = mp.mpf(row["a_m"])
-    b = a * (1 - mp.mpf(row["flattening"]))
-    h = mp.mpf(row["ground_h_m"])
-    ea, eb = a + h, b + h
-    qa = (d[0] ** 2 + d[1] ** 2) / ea ** 2 + d[2] ** 2 / eb ** 2
-    qb = 2 * ((r_i[0] * d[0] + r_i[1] * d[1]) / ea ** 2 + r_i[2] * d[2] / eb ** 2)
-    qc = (r_i[0] ** 2 + r_i[1] ** 2) / ea ** 2 + r_i[2] ** 2 / eb ** 2 - 1
-    disc = qb ** 2 - 4 * qa * qc
-    assert qc > 0 and disc > 0 and qb < 0
-    s = (-qb - mp.sqrt(disc)) / (2 * qa)
-    assert s > 0
+    if ground_s is None:
+        s = ellipsoid_root(row, r_i, d)
+    else:
+        s = mp.mpf(ground_s)
     g0 = r_i + s * d
     acc = -GM * r_i / mp.norm(r_i) ** 3
 

@@ -3,8 +3,8 @@
 //! ground. `sphere` (the default) is the paper's round Earth; `earth` the real-Earth
 //! model, with the columns `shared/EARTH-MODEL.md` ("Eval CSV") specifies. One generic
 //! path serves both: a model names its columns ([`Columns`]) and any [`Backend`] of it
-//! is evaluated the same way. An earth file with a `frame` or quaternion column is
-//! Part II's ("Eval CSV, Part II", without the DEM): [`bus`].
+//! is evaluated the same way. An earth file with a `frame` or quaternion column, or any
+//! earth file given a DEM (`--dem`), is Part II's ("Eval CSV, Part II"): [`bus`].
 
 use std::fmt::Display;
 
@@ -13,6 +13,7 @@ use core_math::earth::bus::{
     bus_geometry, dps_to_rad_s, inertial_state, quaternion_matrix, AttitudeFrame, BusAttitude,
     BusState, BusTime, StateFrame, IDENTITY_QUATERNION,
 };
+use core_math::earth::dem::{DemGrid, DemTile};
 use core_math::earth::frames::{geodetic_from_itrf, TimeScales};
 use core_math::earth::{Attitude, EarthCamera, EarthGeometry, InertialGeometry};
 use core_math::sphere::fixed_point::{geometry_from_f64, motion_to_f64};
@@ -50,6 +51,10 @@ pub struct Args {
     /// The cases: a CSV file whose header names the model's input columns (`-`: stdin)
     #[arg(long, value_name = "CASES.csv")]
     input: String,
+    /// The ground as a DEM tile (earth model; the DEM CSV of shared/EARTH-MODEL.md,
+    /// "The ground from a DEM")
+    #[arg(long, value_name = "FILE.csv")]
+    dem: Option<String>,
 }
 
 pub fn run(args: &Args) -> Result<()> {
@@ -59,8 +64,33 @@ pub fn run(args: &Args) -> Result<()> {
     } else {
         std::fs::read_to_string(input).with_context(|| format!("reading {input}"))?
     };
-    print!("{}", eval_csv(args.model, &args.backend, &text)?);
+    let Some(dem) = &args.dem else {
+        print!("{}", eval_csv(args.model, &args.backend, &text)?);
+        return Ok(());
+    };
+    if args.model != Model::Earth {
+        bail!("eval: --dem needs --model earth");
+    }
+    let dem_text = std::fs::read_to_string(dem).with_context(|| format!("reading {dem}"))?;
+    let (grid, heights) = parse_dem(&dem_text).with_context(|| format!("DEM {dem}"))?;
+    let tile = DemTile::new(grid, &heights)
+        .map_err(|e| anyhow::anyhow!("DEM {dem}: the tile is refused: {e}"))?;
+    print!("{}", eval_csv_on_dem(&args.backend, &text, &tile)?);
     Ok(())
+}
+
+/// The earth model on a CSV text with the ground a DEM tile: Part II's path for every
+/// file, one output row per input row.
+pub fn eval_csv_on_dem(backend: &str, text: &str, tile: &DemTile<'_, f64>) -> Result<String> {
+    let dem = Some(tile);
+    match backend {
+        "reference" => eval_bus_rows(text, dem, |c| evaluate_bus_reference(c, dem)),
+        "f64" => eval_bus_rows(text, dem, |c| evaluate_bus_general(&GENERAL_F64, c, dem)),
+        "f32" => eval_bus_rows(text, dem, |c| evaluate_bus_general(&GENERAL_F32, c, dem)),
+        other => bail!(
+            "eval: unknown backend `{other}` for the earth model on a DEM (reference|f64|f32)"
+        ),
+    }
 }
 
 /// The whole command on a CSV text: one output row per input row, always.
@@ -72,9 +102,9 @@ pub fn eval_csv(model: Model, backend: &str, text: &str) -> Result<String> {
         (Model::Sphere, "fixed") => eval_rows(text, evaluate_fixed),
         (Model::Sphere, other) => bail!("unknown backend `{other}` (reference|f64|f32|fixed)"),
         (Model::Earth, "reference" | "f64" | "f32") if is_part2(text)? => match backend {
-            "reference" => eval_bus_rows(text, evaluate_bus_reference),
-            "f64" => eval_bus_rows(text, |c| evaluate_bus_general(&GENERAL_F64, c)),
-            _ => eval_bus_rows(text, |c| evaluate_bus_general(&GENERAL_F32, c)),
+            "reference" => eval_bus_rows(text, None, |c| evaluate_bus_reference(c, None)),
+            "f64" => eval_bus_rows(text, None, |c| evaluate_bus_general(&GENERAL_F64, c, None)),
+            _ => eval_bus_rows(text, None, |c| evaluate_bus_general(&GENERAL_F32, c, None)),
         },
         (Model::Earth, "reference") => eval_rows(text, |c| evaluate(&EarthReference, c, |g| g)),
         (Model::Earth, "f64") => eval_rows(text, |c| evaluate(&GENERAL_F64, c, |g| g)),

@@ -31,6 +31,7 @@
 
 use core::marker::PhantomData;
 
+use crate::earth::dem::{DemHeight, DemTile};
 use crate::earth::{
     check_altitude, check_state, Attitude, Earth, EarthCamera, EarthGeometry, Ellipsoid,
     InertialAttitude, InertialGeometry, MIN_V1_MPS,
@@ -349,6 +350,49 @@ impl<T: Real> Backend<Earth> for General<T> {
     }
 }
 
+impl<T: Real> General<T> {
+    /// The ground of a pixel on a DEM tile (Part II): 1/s for the first crossing
+    /// r + s d of the tile's surface ([`DemTile::first_crossing`], in `T`), d = B u the
+    /// pixel's line of sight in I (I is the ITRF at the instant). What
+    /// [`General::motion_at_inv_range`] takes in place of the ellipsoid's root.
+    pub fn dem_inv_range<H: DemHeight>(
+        &self,
+        g: &InertialGeometry<T>,
+        px: &GeneralPixel<T>,
+        tile: &DemTile<'_, H>,
+    ) -> Result<T, ModelError> {
+        let r = g.state.position_m.map(T::from_f64);
+        let m = &g.attitude.camera_to_inertial;
+        let d = [dot(m[0], px.u_m), dot(m[1], px.u_m), dot(m[2], px.u_m)];
+        let s = tile.first_crossing(&g.ellipsoid, r, d)?;
+        Ok(T::ONE / s)
+    }
+
+    /// [`Backend::motion`] with the ground point given by its range instead of the
+    /// ellipsoid: g = -W x u - V / s at 1/s = `inv_s`, then the projection. The image
+    /// motion of an Earth-fixed point depends on the surface only through where the
+    /// point is, so a DEM changes nothing else.
+    pub fn motion_at_inv_range(
+        &self,
+        up: &GeneralUpdate<T>,
+        px: &GeneralPixel<T>,
+        inv_s: T,
+    ) -> Result<ImageMotion<T>, ModelError> {
+        project(g_of(up, px.u_m, inv_s), px)
+    }
+}
+
+/// g = c'/s = -W x u - V / s at the pixel u and 1/s.
+#[inline(always)]
+fn g_of<T: Real>(up: &GeneralUpdate<T>, u: [T; 3], inv_s: T) -> [T; 3] {
+    let (w, v) = (up.w_b_rad_s, up.v_b_mps);
+    [
+        -(w[1] * u[2] - w[2] * u[1]) - v[0] * inv_s,
+        -(w[2] * u[0] - w[0] * u[2]) - v[1] * inv_s,
+        -(w[0] * u[1] - w[1] * u[0]) - v[2] * inv_s,
+    ]
+}
+
 /// g = c'/s at the pixel u (|u|^2 = `uu`): the near root, then -W x u - V / s.
 #[inline(always)]
 fn g_at<T: Real>(up: &GeneralUpdate<T>, u: [T; 3], uu: T) -> Result<[T; 3], ModelError> {
@@ -364,12 +408,7 @@ fn g_at<T: Real>(up: &GeneralUpdate<T>, u: [T; 3], uu: T) -> Result<[T; 3], Mode
         return Err(ModelError::LineOfSightMissesEarth);
     }
     let inv_s = (disc.sqrt() - beta) * up.inv_c_per_m2;
-    let (w, v) = (up.w_b_rad_s, up.v_b_mps);
-    Ok([
-        -(w[1] * u[2] - w[2] * u[1]) - v[0] * inv_s,
-        -(w[2] * u[0] - w[0] * u[2]) - v[1] * inv_s,
-        -(w[0] * u[1] - w[1] * u[0]) - v[2] * inv_s,
-    ])
+    Ok(g_of(up, u, inv_s))
 }
 
 /// (v1, v2) = (g1 + (p1/f) g3, g2 + (p2/f) g3), refused when v1 is too slow to clock.

@@ -23,9 +23,10 @@ use crate::error::{ModelError, Param};
 use crate::model::{domain, Model};
 use crate::orbit::StateVector;
 use crate::real::{Real, Scalar};
-use crate::vector::{cross, dot};
+use crate::vector::{cross, dot, unit};
 
 pub mod bus;
+pub mod dem;
 pub mod frames;
 pub mod general;
 #[cfg(feature = "reference")]
@@ -265,12 +266,54 @@ impl EarthGeometry<f64> {
             earth_rate_rad_s: self.earth_rate_rad_s,
         }
     }
+
+    /// The same instant with Part I's attitude re-expressed as Part II's: the camera's
+    /// axes in I, M = [x_L y_L z_L] A, and its angular velocity relative to I in B,
+    /// Omega = W_B + omega n_B (W_B, n_B of [`General::instant`], in f64). What a DEM
+    /// needs of a Part I attitude: each line of sight in I. Refusals: the state's
+    /// ([`check_state`]).
+    pub fn to_inertial(&self) -> Result<InertialGeometry<f64>, ModelError> {
+        let inst = General::<f64>::new().instant(
+            &self.state,
+            &self.attitude,
+            &self.ellipsoid,
+            self.earth_rate_rad_s,
+        )?;
+        let (r, v) = (self.state.position_m, self.state.velocity_mps);
+        let z_l = unit(r);
+        let y_l = unit(cross(r, v));
+        let x_l = cross(y_l, z_l);
+        let at = &self.attitude;
+        let (sp, cp) = libm::sincos(at.roll_rad);
+        let (st, ct) = libm::sincos(at.pitch_rad);
+        let (sy, cy) = libm::sincos(at.yaw_rad);
+        // A = Rx(roll) Ry(pitch) Rz(yaw), row-major.
+        let a = [
+            [ct * cy, -ct * sy, st],
+            [cp * sy + sp * st * cy, cp * cy - sp * st * sy, -sp * ct],
+            [sp * sy - cp * st * cy, sp * cy + cp * st * sy, cp * ct],
+        ];
+        let m = core::array::from_fn(|i| {
+            core::array::from_fn(|j| x_l[i] * a[0][j] + y_l[i] * a[1][j] + z_l[i] * a[2][j])
+        });
+        let w = self.earth_rate_rad_s;
+        Ok(InertialGeometry {
+            state: self.state,
+            attitude: InertialAttitude {
+                camera_to_inertial: m,
+                omega_rad_s: core::array::from_fn(|k| inst.w_b_rad_s[k] + w * inst.n_b[k]),
+            },
+            ground_h_m: self.ground_h_m,
+            ellipsoid: self.ellipsoid,
+            earth_rate_rad_s: self.earth_rate_rad_s,
+        })
+    }
 }
 
 /// [`EarthGeometry`] with Part II's attitude: the camera's axes in I and its angular
 /// velocity ([`InertialAttitude`], from the bus's quaternion and gyro rates by
 /// [`bus::bus_geometry`]). Everything else as in Part I. The backends take it through
-/// their own entry points (`EarthReference::chain_inertial`,
+/// their own entry points (`EarthReference::chain` and `motion_of`,
 /// `General::update_inertial`), whose update is the same type as Part I's: the
 /// per-pixel work does not change.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -13,8 +13,10 @@
 //! closed-form range): agreement between the two is the proof of that derivation.
 
 use crate::dual::Dual;
+use crate::earth::dem::{DemHeight, DemTile};
 use crate::earth::{
-    Attitude, Earth, EarthCamera, EarthGeometry, Ground, InertialAttitude, InertialGeometry,
+    Attitude, Earth, EarthCamera, EarthGeometry, Ellipsoid, Ground, InertialAttitude,
+    InertialGeometry,
 };
 use crate::error::ModelError;
 use crate::model::{Backend, ImageMotion, GM_M3_S2};
@@ -87,6 +89,8 @@ pub trait ReferenceGeometry {
     fn ground(&self) -> Result<Ground, ModelError>;
     fn state(&self) -> &StateVector;
     fn earth_rate_rad_s(&self) -> f64;
+    /// The ellipsoid the ground (or a DEM's heights) is above.
+    fn ellipsoid(&self) -> Ellipsoid;
     /// M(t), the camera's axes in I at time t.
     fn axes(&self, t: Dual) -> M3;
 }
@@ -100,6 +104,9 @@ impl ReferenceGeometry for EarthGeometry<f64> {
     }
     fn earth_rate_rad_s(&self) -> f64 {
         self.earth_rate_rad_s
+    }
+    fn ellipsoid(&self) -> Ellipsoid {
+        self.ellipsoid
     }
     fn axes(&self, t: Dual) -> M3 {
         self.attitude.axes(&self.state, t)
@@ -115,6 +122,9 @@ impl ReferenceGeometry for InertialGeometry<f64> {
     }
     fn earth_rate_rad_s(&self) -> f64 {
         self.earth_rate_rad_s
+    }
+    fn ellipsoid(&self) -> Ellipsoid {
+        self.ellipsoid
     }
     fn axes(&self, t: Dual) -> M3 {
         self.attitude.axes(&self.state, t)
@@ -187,9 +197,32 @@ impl EarthReference {
         core::array::from_fn(|i| m[i][0].re * u[0] + m[i][1].re * u[1] + m[i][2].re * u[2])
     }
 
-    /// The whole construction for the pixel at (p1, p2) on the focal plane.
+    /// The whole construction for the pixel at (p1, p2) on the focal plane, the ground
+    /// the geometry's ellipsoid raised by its `ground_h_m`.
     pub fn chain<G: ReferenceGeometry>(g: &G, p: &EarthRefPixel) -> Result<EarthChain, ModelError> {
         let ground = g.ground()?;
+        EarthReference::chain_with(g, p, |r0, d| ellipsoid_root(&ground, r0, d))
+    }
+
+    /// [`EarthReference::chain`] with the ground a DEM tile (Part II): the ground point
+    /// is the tile's [`DemTile::first_crossing`] (whose independent check is
+    /// `tools/goldens/dem_crossing.py`); the construction from it on is the same.
+    pub fn chain_on_dem<G: ReferenceGeometry, H: DemHeight>(
+        g: &G,
+        p: &EarthRefPixel,
+        tile: &DemTile<'_, H>,
+    ) -> Result<EarthChain, ModelError> {
+        g.ground()?;
+        let ellipsoid = g.ellipsoid();
+        EarthReference::chain_with(g, p, |r0, d| tile.first_crossing(&ellipsoid, r0, d))
+    }
+
+    /// The construction with the ground point r0 + s d, s from `ground_s(r0, d)`.
+    fn chain_with<G: ReferenceGeometry>(
+        g: &G,
+        p: &EarthRefPixel,
+        ground_s: impl FnOnce([f64; 3], [f64; 3]) -> Result<f64, ModelError>,
+    ) -> Result<EarthChain, ModelError> {
         let t = Dual::new(0.0, 1.0);
         let (r0, v0) = (g.state().position_m, g.state().velocity_mps);
         let r: V3 = core::array::from_fn(|i| c(r0[i]) + c(v0[i]) * t);
@@ -199,34 +232,7 @@ impl EarthReference {
         let u = [p.p1_m, p.p2_m, -p.focal_m];
         let d: [f64; 3] =
             core::array::from_fn(|i| m[i][0].re * u[0] + m[i][1].re * u[1] + m[i][2].re * u[2]);
-
-        // First intersection of r0 + s d with (x^2 + y^2)/A^2 + z^2/B^2 = 1.
-        let (ia2, ib2) = (
-            1.0 / (ground.eq_m * ground.eq_m),
-            1.0 / (ground.polar_m * ground.polar_m),
-        );
-        let qa = (d[0] * d[0] + d[1] * d[1]) * ia2 + d[2] * d[2] * ib2;
-        let qb = 2.0 * ((r0[0] * d[0] + r0[1] * d[1]) * ia2 + r0[2] * d[2] * ib2);
-        let qc = (r0[0] * r0[0] + r0[1] * r0[1]) * ia2 + r0[2] * r0[2] * ib2 - 1.0;
-        let disc = qb * qb - 4.0 * qa * qc;
-        // The satellite is outside (qc > 0, checked by validate): both roots have the sign
-        // of -qb, so the ray meets the ellipsoid ahead only if qb < 0.
-        if !(disc >= 0.0 && qb < 0.0) {
-            return Err(ModelError::LineOfSightMissesEarth);
-        }
-        let mut s = (-qb - libm::sqrt(disc)) / (2.0 * qa);
-        // The textbook near root loses digits to cancellation when the far root is much
-        // larger (a low satellite); one Newton step on the quadratic restores them.
-        let slope = 2.0 * qa * s + qb;
-        if slope != 0.0 {
-            let step = (qa * s * s + qb * s + qc) / slope;
-            if step.is_finite() {
-                s -= step;
-            }
-        }
-        if !(s > 0.0) {
-            return Err(ModelError::LineOfSightMissesEarth);
-        }
+        let s = ground_s(r0, d)?;
         let g0: [f64; 3] = core::array::from_fn(|i| r0[i] + s * d[i]);
 
         // The ground point is fixed to the Earth, which turns about z.
@@ -294,10 +300,57 @@ impl EarthReference {
         g: &G,
         p: &EarthRefPixel,
     ) -> Result<ImageMotion<f64>, ModelError> {
-        let chain = EarthReference::chain(g, p)?;
-        if !(chain.motion.v1_mps.abs() >= super::MIN_V1_MPS) {
-            return Err(ModelError::NoAlongTrackMotion);
-        }
-        Ok(chain.motion)
+        along_track(EarthReference::chain(g, p)?)
     }
+
+    /// [`EarthReference::motion_of`] with the ground a DEM tile
+    /// ([`EarthReference::chain_on_dem`]).
+    pub fn motion_on_dem<G: ReferenceGeometry, H: DemHeight>(
+        g: &G,
+        p: &EarthRefPixel,
+        tile: &DemTile<'_, H>,
+    ) -> Result<ImageMotion<f64>, ModelError> {
+        along_track(EarthReference::chain_on_dem(g, p, tile)?)
+    }
+}
+
+/// The chain's motion, refused when v1 is too slow to clock (as the general form).
+fn along_track(chain: EarthChain) -> Result<ImageMotion<f64>, ModelError> {
+    if !(chain.motion.v1_mps.abs() >= super::MIN_V1_MPS) {
+        return Err(ModelError::NoAlongTrackMotion);
+    }
+    Ok(chain.motion)
+}
+
+/// The first intersection s of r0 + s d with the ground ellipsoid
+/// (x^2 + y^2)/A^2 + z^2/B^2 = 1.
+fn ellipsoid_root(ground: &Ground, r0: [f64; 3], d: [f64; 3]) -> Result<f64, ModelError> {
+    // First intersection of r0 + s d with (x^2 + y^2)/A^2 + z^2/B^2 = 1.
+    let (ia2, ib2) = (
+        1.0 / (ground.eq_m * ground.eq_m),
+        1.0 / (ground.polar_m * ground.polar_m),
+    );
+    let qa = (d[0] * d[0] + d[1] * d[1]) * ia2 + d[2] * d[2] * ib2;
+    let qb = 2.0 * ((r0[0] * d[0] + r0[1] * d[1]) * ia2 + r0[2] * d[2] * ib2);
+    let qc = (r0[0] * r0[0] + r0[1] * r0[1]) * ia2 + r0[2] * r0[2] * ib2 - 1.0;
+    let disc = qb * qb - 4.0 * qa * qc;
+    // The satellite is outside (qc > 0, checked by validate): both roots have the sign
+    // of -qb, so the ray meets the ellipsoid ahead only if qb < 0.
+    if !(disc >= 0.0 && qb < 0.0) {
+        return Err(ModelError::LineOfSightMissesEarth);
+    }
+    let mut s = (-qb - libm::sqrt(disc)) / (2.0 * qa);
+    // The textbook near root loses digits to cancellation when the far root is much
+    // larger (a low satellite); one Newton step on the quadratic restores them.
+    let slope = 2.0 * qa * s + qb;
+    if slope != 0.0 {
+        let step = (qa * s * s + qb * s + qc) / slope;
+        if step.is_finite() {
+            s -= step;
+        }
+    }
+    if !(s > 0.0) {
+        return Err(ModelError::LineOfSightMissesEarth);
+    }
+    Ok(s)
 }

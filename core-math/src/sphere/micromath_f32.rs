@@ -86,6 +86,14 @@ impl Real for MicroF32 {
     fn from_u32(n: u32) -> Self {
         MicroF32(<f32 as Real>::from_u32(n))
     }
+    #[inline(always)]
+    fn from_i16(n: i16) -> Self {
+        MicroF32(f32::from(n))
+    }
+    #[inline(always)]
+    fn from_f32(x: f32) -> Self {
+        MicroF32(x)
+    }
     /// micromath's atan (2.8e-3, EMBEDDED-NOTES.md), consistent with the variant.
     #[inline(always)]
     fn atan(self) -> Self {
@@ -95,5 +103,18 @@ impl Real for MicroF32 {
     fn small_sin_cos(x: Self) -> (Self, Self) {
         let (s, c) = <f32 as Real>::small_sin_cos(x.0);
         (MicroF32(s), MicroF32(c))
+    }
+    /// The round-Earth model needs no geodetic conversion: libm's, as f32.
+    #[inline(always)]
+    fn cbrt(self) -> Self {
+        MicroF32(<f32 as Real>::cbrt(self.0))
+    }
+    #[inline(always)]
+    fn atan2(self, x: Self) -> Self {
+        MicroF32(<f32 as Real>::atan2(self.0, x.0))
+    }
+    #[inline(always)]
+    fn hypot(self, y: Self) -> Self {
+        MicroF32(<f32 as Real>::hypot(self.0, y.0))
     }
 }

@@ -295,6 +295,95 @@ const EARTH_CAMERA: EarthCamera = EarthCamera {
     p1_m: 0.0,
 };
 
+/// Nodes along each side of the bench's DEM tile (64 x 64 int16: 8 KiB of RAM).
+const DEM_SIDE: usize = 64;
+/// Its heights, filled at run time (a smooth relief, as `core-math/tests/dem.rs`'s).
+static mut DEM_HEIGHTS: [i16; DEM_SIDE * DEM_SIDE] = [0; DEM_SIDE * DEM_SIDE];
+
+/// The DEM searches' regions: on a 64 x 64 tile at 0.005 deg (555 m x 455 m cells,
+/// 1 300..3 700 m, slopes to 0.3) centred under the agile instant's boresight, that
+/// line of sight in f32: the height search's per-tile constants, one ray cold and
+/// warm, and the march (`DemTile::first_crossing`) for comparison.
+fn dem_regions() -> Result<(), FirmwareError> {
+    use core_math::earth::dem::{DemGrid, DemTile};
+    use core_math::earth::frames::geodetic_from_itrf;
+    use core_math::earth::reference::EarthRefPixel;
+
+    let g = earth_geometry().to_inertial()?;
+    let px = EarthRefPixel {
+        p1_m: 0.0,
+        p2_m: 0.0,
+        focal_m: EARTH_CAMERA.focal_m,
+    };
+    let chain = EarthReference::chain(&g, &px)?;
+    let (lat, lon, _) = geodetic_from_itrf(chain.ground_m, &g.ellipsoid)?;
+    let half = 0.5 * (DEM_SIDE - 1) as f64 * 0.005;
+    let grid = DemGrid {
+        lat0_deg: lat.to_degrees() - half,
+        lon0_deg: lon.to_degrees() - half,
+        dlat_deg: 0.005,
+        dlon_deg: 0.005,
+        nrows: DEM_SIDE,
+        ncols: DEM_SIDE,
+    };
+    let tau = core::f64::consts::TAU;
+    // SAFETY: the bench is single-threaded and takes no interrupt that reads it; the
+    // table is written once here, before any reference to it is taken.
+    let heights = unsafe {
+        let table = &mut *core::ptr::addr_of_mut!(DEM_HEIGHTS);
+        for (k, h) in table.iter_mut().enumerate() {
+            let (i, j) = ((k / DEM_SIDE) as f64, (k % DEM_SIDE) as f64);
+            *h = libm::round(
+                2_500.0
+                    + 900.0 * libm::sin(tau * i / 128.0) * libm::cos(tau * j / 100.0)
+                    + 300.0 * libm::sin(tau * (i + j) / 60.0),
+            ) as i16;
+        }
+        &*core::ptr::addr_of!(DEM_HEIGHTS)
+    };
+    let tile = DemTile::new(grid, heights)?;
+    let m = &g.attitude.camera_to_inertial;
+    let u = [0.0, 0.0, -EARTH_CAMERA.focal_m];
+    let d: [f32; 3] =
+        core::array::from_fn(|i| (m[i][0] * u[0] + m[i][1] * u[1] + m[i][2] * u[2]) as f32);
+    let r = g.state.position_m.map(|x| x as f32);
+    let e = g.ellipsoid;
+    region(
+        "DEM height search (f32): its constants, once per tile",
+        &tile,
+        |t| t.height_search::<f32>(&e),
+    );
+    let search = tile.height_search::<f32>(&e);
+    let cold = search.crossing(r, d, None, 0.5);
+    let h_found = match cold {
+        Ok(c) => {
+            defmt::info!(
+                "DEM height search: {=u32} evaluations, height {=f32} m, bound {=f32} m",
+                c.evaluations,
+                c.h_m,
+                c.error_bound_m
+            );
+            c.h_m
+        }
+        // The height search declining this ray would be a bench set-up error.
+        Err(_) => return Err(core_math::ModelError::OutsideDem.into()),
+    };
+    region(
+        "DEM height search (f32), one ray, from mid-band",
+        (r, d),
+        |(r, d)| search.crossing(r, d, None, 0.5),
+    );
+    region(
+        "DEM height search (f32), one ray, from a hint 200 m off",
+        (r, d, h_found + 200.0),
+        |(r, d, hint)| search.crossing(r, d, Some(hint), 0.5),
+    );
+    region("DEM march (f32), one ray", (r, d), |(r, d)| {
+        tile.first_crossing(&e, r, d)
+    });
+    Ok(())
+}
+
 /// The real-Earth backends' regions: update, motion in a loop and alone, full update.
 fn earth_regions() -> Result<(), FirmwareError> {
     let camera = EARTH_CAMERA;
@@ -530,6 +619,7 @@ fn run() -> Result<(), FirmwareError> {
     );
     scene_kinds()?;
     earth_regions()?;
+    dem_regions()?;
     region(
         "NaiveF32 motion, 1 pixel (n = 0)",
         (&update_naive, &axis_naive),

@@ -1,7 +1,8 @@
-//! Part II of the eval (`shared/EARTH-MODEL.md`, "Eval CSV, Part II", without the DEM):
-//! the bus's frames, time and quaternion attitude, and the ground point's geodetic
-//! coordinates. A file takes this path only when its header has a `frame` column or a
-//! quaternion column; any other file is Part I's, through `eval_rows` exactly as before.
+//! Part II of the eval (`shared/EARTH-MODEL.md`, "Eval CSV, Part II"): the bus's frames,
+//! time and quaternion attitude, the ground from a DEM tile, and the ground point's
+//! geodetic coordinates. A file takes this path when its header has a `frame` column or
+//! a quaternion column, or when a DEM is given; any other file is Part I's, through
+//! `eval_rows` exactly as before.
 
 use super::*;
 
@@ -103,11 +104,15 @@ impl RowCells<'_> {
     }
 }
 
-/// The case of a Part II row (see [`eval_bus_rows`] for the order of the checks).
-pub(super) fn bus_case(cells: &RowCells) -> Result<BusCase, RowError> {
+/// The case of a Part II row (see [`eval_bus_rows`] for the order of the checks). With
+/// a DEM (`on_dem`) `ground_h_m` is ignored (0 where absent) and `gps_s` is needed.
+pub(super) fn bus_case(cells: &RowCells, on_dem: bool) -> Result<BusCase, RowError> {
     let [x, y, z, vx, vy, vz] = STATE_COLUMNS.map(|n| cells.required(n));
     let (position_m, velocity_mps) = ([x?, y?, z?], [vx?, vy?, vz?]);
-    let [ground_h_m, focal_m, pixel_m, n_px] = COMMON_COLUMNS.map(|n| cells.required(n));
+    let [ground_h_m, focal_m, pixel_m, n_px] = COMMON_COLUMNS.map(|n| match n {
+        "ground_h_m" if on_dem => Ok(0.0),
+        _ => cells.required(n),
+    });
     let (ground_h_m, focal_m, pixel_m, n_px) = (ground_h_m?, focal_m?, pixel_m?, n_px?);
     let camera = EarthCamera {
         focal_m,
@@ -148,9 +153,11 @@ pub(super) fn bus_case(cells: &RowCells) -> Result<BusCase, RowError> {
         quaternion_matrix(q, Param::Quaternion)?;
         quaternion_matrix(camera_q, Param::CameraQuaternion)?;
     }
-    // The contract: `frame` itrf or gcrf, or a quaternion in gcrf, need `gps_s` (for an
-    // ITRF state the time is that of "I = the ITRF at t", even if no C2T is needed).
-    let needs_time = frame != StateFrame::Inertial
+    // The contract: `frame` itrf or gcrf, a quaternion in gcrf, or a DEM need `gps_s`
+    // (for an ITRF state or a DEM the time is that of "I = the ITRF at t", even if no
+    // C2T is needed).
+    let needs_time = on_dem
+        || frame != StateFrame::Inertial
         || (quaternion.is_some() && attitude_frame == AttitudeFrame::Gcrf);
     if needs_time && time.gps_s.is_none() {
         return Err(ModelError::InvalidInput(Param::GpsTime).into());
@@ -211,48 +218,149 @@ pub(super) fn bus_case(cells: &RowCells) -> Result<BusCase, RowError> {
     })
 }
 
-/// The reference's numbers for a Part II case.
-pub(super) fn evaluate_bus_reference(case: &BusCase) -> Result<Vec<String>, RowError> {
-    let m = match &case.geometry {
-        BusRowGeometry::Angles(g) => EarthReference.evaluate(&case.camera, g, case.n_px)?,
-        BusRowGeometry::Quaternion(g) => {
-            let p = EarthReference.pixel(&case.camera, case.n_px)?;
-            EarthReference::motion_of(g, &p)?
-        }
+impl BusCase {
+    /// The geometry with the camera's axes in I (a Part I attitude converted), for the
+    /// DEM's search, which needs each line of sight in I.
+    fn inertial(&self) -> Result<InertialGeometry<f64>, RowError> {
+        Ok(match &self.geometry {
+            BusRowGeometry::Angles(g) => {
+                g.validate()?;
+                g.to_inertial()?
+            }
+            BusRowGeometry::Quaternion(g) => *g,
+        })
+    }
+}
+
+/// The reference's numbers for a Part II case, on the ellipsoid or on the DEM.
+pub(super) fn evaluate_bus_reference(
+    case: &BusCase,
+    dem: Option<&DemTile<'_, f64>>,
+) -> Result<Vec<String>, RowError> {
+    let p = EarthReference.pixel(&case.camera, case.n_px)?;
+    let m = match (dem, &case.geometry) {
+        (Some(tile), _) => EarthReference::motion_on_dem(&case.inertial()?, &p, tile)?,
+        (None, BusRowGeometry::Angles(g)) => EarthReference.evaluate(&case.camera, g, case.n_px)?,
+        (None, BusRowGeometry::Quaternion(g)) => EarthReference::motion_of(g, &p)?,
     };
     Ok(Earth::numbers(&case.camera, &m)?)
 }
 
 /// The general form's numbers for a Part II case, in its own precision: Part I's
-/// geometry or the quaternion's (`General::update_inertial`), rounded to `T` once.
+/// geometry or the quaternion's (`General::update_inertial`), rounded to `T` once; on a
+/// DEM, the general form's own search in `T` for the range
+/// (`General::dem_inv_range`, `General::motion_at_inv_range`).
 pub(super) fn evaluate_bus_general<T: Real + Display>(
     backend: &General<T>,
     case: &BusCase,
+    dem: Option<&DemTile<'_, f64>>,
 ) -> Result<Vec<String>, RowError> {
     let p = backend.pixel(&case.camera, case.n_px)?;
-    let up = match &case.geometry {
-        BusRowGeometry::Angles(g) => backend.update(&g.to::<T>())?,
-        BusRowGeometry::Quaternion(g) => backend.update_inertial(&g.to::<T>())?,
+    let m = match (dem, &case.geometry) {
+        (Some(tile), _) => {
+            let g = case.inertial()?.to::<T>();
+            let up = backend.update_inertial(&g)?;
+            let inv_s = backend.dem_inv_range(&g, &p, tile)?;
+            backend.motion_at_inv_range(&up, &p, inv_s)?
+        }
+        (None, BusRowGeometry::Angles(g)) => {
+            let up = backend.update(&g.to::<T>())?;
+            backend.motion(&up, &p)?
+        }
+        (None, BusRowGeometry::Quaternion(g)) => {
+            let up = backend.update_inertial(&g.to::<T>())?;
+            backend.motion(&up, &p)?
+        }
     };
-    let m = backend.motion(&up, &p)?;
     Ok(Earth::numbers(&case.camera, &m)?)
 }
 
 /// G's geodetic latitude and longitude (deg) and height (m) on the row's ellipsoid, for
-/// every backend from the f64 reference's chain (`EarthChain::ground_m`): I at t is the
-/// ITRF at t, so G's coordinates in I are its ITRF coordinates.
-pub(super) fn ground_point(case: &BusCase) -> Result<[f64; 3], RowError> {
+/// every backend from the f64 reference's chain (`EarthChain::ground_m`, on the DEM
+/// where one is given): I at t is the ITRF at t, so G's coordinates in I are its ITRF
+/// coordinates.
+pub(super) fn ground_point(
+    case: &BusCase,
+    dem: Option<&DemTile<'_, f64>>,
+) -> Result<[f64; 3], RowError> {
     let p = EarthReference.pixel(&case.camera, case.n_px)?;
-    let (chain, ellipsoid) = match &case.geometry {
-        BusRowGeometry::Angles(g) => (EarthReference::chain(g, &p)?, g.ellipsoid),
-        BusRowGeometry::Quaternion(g) => (EarthReference::chain(g, &p)?, g.ellipsoid),
+    let (chain, ellipsoid) = match (dem, &case.geometry) {
+        (Some(tile), _) => {
+            let g = case.inertial()?;
+            (EarthReference::chain_on_dem(&g, &p, tile)?, g.ellipsoid)
+        }
+        (None, BusRowGeometry::Angles(g)) => (EarthReference::chain(g, &p)?, g.ellipsoid),
+        (None, BusRowGeometry::Quaternion(g)) => (EarthReference::chain(g, &p)?, g.ellipsoid),
     };
     let (lat, lon, h) = geodetic_from_itrf(chain.ground_m, &ellipsoid)?;
     Ok([lat.to_degrees(), lon.to_degrees(), h])
 }
 
+/// A DEM CSV (`shared/EARTH-MODEL.md`, "The ground from a DEM"): line 1
+/// `lat0_deg,lon0_deg,dlat_deg,dlon_deg,nrows,ncols`, line 2 their values, then nrows
+/// lines of ncols heights (row i at lat0 + i dlat, from the south). The tile's own
+/// checks are `DemTile::new`'s.
+pub(super) fn parse_dem(text: &str) -> Result<(DemGrid, Vec<f64>)> {
+    let table = Table::parse(text)?;
+    const HEAD: [&str; 6] = [
+        "lat0_deg", "lon0_deg", "dlat_deg", "dlon_deg", "nrows", "ncols",
+    ];
+    if table.header != HEAD {
+        bail!("line 1 must be `{}`", HEAD.join(","));
+    }
+    let number = |line: usize, cell: &str| -> Result<f64> {
+        cell.trim()
+            .parse::<f64>()
+            .with_context(|| format!("line {line}: `{cell}` is not a number"))
+    };
+    let mut rows = table.rows.iter();
+    let grid_row = rows.next().context("line 2 (the grid) is missing")?;
+    if grid_row.len() != 6 {
+        bail!("line 2 must hold 6 values");
+    }
+    let g: Vec<f64> = (0..6)
+        .map(|k| number(2, &grid_row[k]))
+        .collect::<Result<_>>()?;
+    let count = |x: f64, name: &str| -> Result<usize> {
+        if x.fract() != 0.0 || !(1.0..=1e6).contains(&x) {
+            bail!("line 2: {name} must be a whole count, not {x}");
+        }
+        Ok(x as usize)
+    };
+    let grid = DemGrid {
+        lat0_deg: g[0],
+        lon0_deg: g[1],
+        dlat_deg: g[2],
+        dlon_deg: g[3],
+        nrows: count(g[4], "nrows")?,
+        ncols: count(g[5], "ncols")?,
+    };
+    let mut heights = Vec::with_capacity(grid.nrows * grid.ncols);
+    for (i, row) in rows.enumerate() {
+        if row.len() != grid.ncols {
+            bail!(
+                "line {}: {} heights, ncols is {}",
+                i + 3,
+                row.len(),
+                grid.ncols
+            );
+        }
+        for cell in row {
+            heights.push(number(i + 3, cell)?);
+        }
+    }
+    if heights.len() != grid.nrows * grid.ncols {
+        bail!(
+            "{} rows of heights, nrows is {}",
+            heights.len() / grid.ncols.max(1),
+            grid.nrows
+        );
+    }
+    Ok((grid, heights))
+}
+
 /// The Part II output: as [`eval_rows`], with `ground_lat_deg,ground_lon_deg,
-/// ground_height_m` after `error` when the header has `frame`. A row's checks, in
+/// ground_height_m` after `error` when the header has `frame` or a DEM is given. A row's checks, in
 /// order: its numbers (`unparsable_input`); a partial quaternion (some of its four
 /// cells), an unknown `frame` or `attitude_frame` (`invalid_input`); the quaternions
 /// (`invalid_quaternion`); a missing `gps_s` where the contract needs it
@@ -260,11 +368,16 @@ pub(super) fn ground_point(case: &BusCase) -> Result<[f64; 3], RowError> {
 /// if the backend refuses it or the reference finds no ground point for it.
 pub(super) fn eval_bus_rows(
     text: &str,
+    dem: Option<&DemTile<'_, f64>>,
     eval: impl Fn(&BusCase) -> Result<Vec<String>, RowError>,
 ) -> Result<String> {
     let table = Table::parse(text)?;
     table.columns(&STATE_COLUMNS)?;
-    table.columns(&COMMON_COLUMNS)?;
+    let common: Vec<&str> = COMMON_COLUMNS
+        .into_iter()
+        .filter(|c| dem.is_none() || *c != "ground_h_m")
+        .collect();
+    table.columns(&common)?;
     if !table
         .header
         .iter()
@@ -272,7 +385,7 @@ pub(super) fn eval_bus_rows(
     {
         table.columns(&ANGLE_COLUMNS)?;
     }
-    let with_ground = table.header.iter().any(|h| h == "frame");
+    let with_ground = dem.is_some() || table.header.iter().any(|h| h == "frame");
     let extra: &[&str] = if with_ground { &GROUND_OUTPUTS } else { &[] };
     let header: Vec<&str> = table
         .header
@@ -289,10 +402,10 @@ pub(super) fn eval_bus_rows(
             header: &table.header,
             row,
         };
-        let result = bus_case(&cells).and_then(|case| {
+        let result = bus_case(&cells, dem.is_some()).and_then(|case| {
             let nums = eval(&case)?;
             let ground = if with_ground {
-                ground_point(&case)?.map(|x| x.to_string()).to_vec()
+                ground_point(&case, dem)?.map(|x| x.to_string()).to_vec()
             } else {
                 Vec::new()
             };
@@ -312,4 +425,116 @@ pub(super) fn eval_bus_rows(
         out.row(&fields)?;
     }
     out.into_string()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const TILE: &str = include_str!("../../../core-math/tests/data/dem_tile.csv");
+    const GOLDEN: &str = include_str!("../../../core-math/tests/data/dem_cases.csv");
+    /// The golden file's own outputs, left out of the eval's input.
+    const GOLDEN_OUTPUTS: [&str; 11] = [
+        "error",
+        "ground_x_m",
+        "ground_y_m",
+        "ground_z_m",
+        "ground_lat_deg",
+        "ground_lon_deg",
+        "ground_height_m",
+        "v1_mps",
+        "v2_mps",
+        "kind",
+        "ground_h_m",
+    ];
+
+    /// The golden rows without their outputs (and without `ground_h_m`, which a DEM makes
+    /// optional), as an eval input.
+    fn input(golden: &Table) -> String {
+        let keep: Vec<usize> = (0..golden.header.len())
+            .filter(|&c| !GOLDEN_OUTPUTS.contains(&golden.header[c].as_str()))
+            .collect();
+        let head: Vec<&str> = keep.iter().map(|&c| golden.header[c].as_str()).collect();
+        let mut w = Writer::new("", &head).unwrap();
+        for row in &golden.rows {
+            let fields: Vec<&str> = keep.iter().map(|&c| row[c].as_str()).collect();
+            w.row(&fields).unwrap();
+        }
+        w.into_string().unwrap()
+    }
+
+    /// `eval --model earth --dem` on the independent goldens of
+    /// `tools/goldens/dem_crossing.py`, every backend: the same errors, the motion within
+    /// 1e-9 (reference, f64) or 5e-6 (f32) of |v|, the ground point's latitude and
+    /// longitude within 1e-9 deg and its height within 0.01 m.
+    #[test]
+    fn dem_eval_matches_the_independent_goldens() {
+        let golden = Table::parse(GOLDEN).unwrap();
+        let (grid, heights) = parse_dem(TILE).unwrap();
+        let tile = DemTile::new(grid, &heights).unwrap();
+        let text = input(&golden);
+        let col = |t: &Table, name: &str| t.columns(&[name]).unwrap()[0];
+        for (backend, tol) in [("reference", 1e-9), ("f64", 1e-9), ("f32", 5e-6)] {
+            let out = Table::parse(&crate::eval::eval_csv_on_dem(backend, &text, &tile).unwrap())
+                .unwrap();
+            assert_eq!(out.rows.len(), golden.rows.len());
+            let mut hits = 0;
+            for (o, g) in out.rows.iter().zip(&golden.rows) {
+                let case = &g[col(&golden, "case")];
+                assert_eq!(
+                    o[col(&out, "error")],
+                    g[col(&golden, "error")],
+                    "{backend} case {case}"
+                );
+                if !g[col(&golden, "error")].is_empty() {
+                    continue;
+                }
+                let num =
+                    |t: &Table, r: &[String], n: &str| -> f64 { r[col(t, n)].parse().unwrap() };
+                let dv = (num(&out, o, "v1_mps") - num(&golden, g, "v1_mps"))
+                    .hypot(num(&out, o, "v2_mps") - num(&golden, g, "v2_mps"));
+                let v = num(&golden, g, "v1_mps").hypot(num(&golden, g, "v2_mps"));
+                assert!(dv <= tol * v, "{backend} case {case}: {:e}", dv / v);
+                // The ground columns are the reference's for every backend.
+                for (name, gtol) in [
+                    ("ground_lat_deg", 1e-9),
+                    ("ground_lon_deg", 1e-9),
+                    ("ground_height_m", 0.01),
+                ] {
+                    let d = (num(&out, o, name) - num(&golden, g, name)).abs();
+                    assert!(d <= gtol, "{backend} case {case} {name}: {d:e}");
+                }
+                hits += 1;
+            }
+            assert!(hits >= 40, "{backend}: {hits}");
+        }
+    }
+
+    /// A DEM makes `gps_s` necessary (`invalid_input`), `ground_h_m` optional, and the
+    /// ground columns appear; a bad DEM file is refused whole.
+    #[test]
+    fn dem_rows_need_time_and_bad_files_are_refused() {
+        let golden = Table::parse(GOLDEN).unwrap();
+        let (grid, heights) = parse_dem(TILE).unwrap();
+        let tile = DemTile::new(grid, &heights).unwrap();
+        let text = input(&golden).replace("1500000000.0", "");
+        let out =
+            Table::parse(&crate::eval::eval_csv_on_dem("f64", &text, &tile).unwrap()).unwrap();
+        let e = out.columns(&["error"]).unwrap()[0];
+        assert!(out.rows.iter().all(|r| r[e] == "invalid_input"));
+        assert!(out
+            .columns(&["ground_lat_deg", "ground_lon_deg", "ground_height_m"])
+            .is_ok());
+        assert!(parse_dem("lat0_deg,lon0_deg\n1,2\n").is_err());
+        let short = TILE
+            .rsplit_once('\n')
+            .unwrap()
+            .0
+            .rsplit_once('\n')
+            .unwrap()
+            .0;
+        assert!(parse_dem(short).is_err(), "a missing row of heights");
+        let ragged = TILE.replacen(",", ";", 20);
+        assert!(parse_dem(&ragged).is_err());
+    }
 }

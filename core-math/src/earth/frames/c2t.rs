@@ -73,3 +73,54 @@ pub fn c2t(gps_s: f64, scales: &TimeScales) -> Result<Mat3, ModelError> {
     let ut1 = ut1_from_gps_s(gps_s, scales)?;
     Ok(c2t_from_dates(&tt, &ut1))
 }
+
+/// How long the slowly moving part of C2T ([`CelestialPole`]) may be reused (s): its
+/// motion (precession 7.7e-12 rad/s, nutation's fastest terms 5e-12 rad/s) moves it by
+/// 5.1e-10 rad at most in that time (measured over the ERFA goldens), so that C2T from
+/// it stays within [`C2T_TOLERANCE_RAD`] of `iauC2t06a` (4.2e-9 rad with IAU 2000B's
+/// 3.9e-9; `cargo test --release -p core-math --test frames -- --nocapture`).
+pub const POLE_MAX_AGE_S: f64 = 60.0;
+
+/// The part of C2T that moves slowly: the celestial-to-intermediate matrix C2I(X, Y, s)
+/// and the TIO locator s' at one instant. C2T at a later instant within
+/// [`POLE_MAX_AGE_S`] is R3(s') R3(ERA(t)) C2I: the Earth rotation angle alone, a
+/// handful of f64 operations, instead of the nutation series' 77 terms. What a
+/// controller computes once a minute and per update respectively.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CelestialPole {
+    /// The instant it was computed for (s of GPS time).
+    pub gps_s: f64,
+    pub c2i: Mat3,
+    pub sp_rad: f64,
+}
+
+impl CelestialPole {
+    /// The pole at `gps_s`; the refusals of [`c2t`].
+    pub fn at(gps_s: f64, scales: &TimeScales) -> Result<Self, ModelError> {
+        let tt = tt_from_gps_s(gps_s)?;
+        scales.validate()?;
+        let t = tt.centuries();
+        let fw = pfw06(t);
+        let (dpsi, deps) = nut06b(t);
+        let npb = fw2m(
+            fw.gamb_rad,
+            fw.phib_rad,
+            fw.psib_rad + dpsi,
+            fw.epsa_rad + deps,
+        );
+        let (x, y) = (npb[2][0], npb[2][1]);
+        Ok(CelestialPole {
+            gps_s,
+            c2i: c2ixys(x, y, s06(t, x, y)),
+            sp_rad: sp00(t),
+        })
+    }
+
+    /// C2T at `gps_s` from this pole and the Earth rotation angle at `gps_s`. Refusals:
+    /// those of [`ut1_from_gps_s`]. The caller keeps |gps_s - self.gps_s| within
+    /// [`POLE_MAX_AGE_S`]; further away the error grows by about 2e-11 rad a second.
+    pub fn c2t(&self, gps_s: f64, scales: &TimeScales) -> Result<Mat3, ModelError> {
+        let ut1 = ut1_from_gps_s(gps_s, scales)?;
+        Ok(rz(self.sp_rad, &rz(era00(&ut1), &self.c2i)))
+    }
+}

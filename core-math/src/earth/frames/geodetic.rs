@@ -18,6 +18,7 @@
 use crate::earth::{Ellipsoid, MAX_POSITION_M};
 use crate::error::{ModelError, Param};
 use crate::model::domain;
+use crate::real::Real;
 use crate::vector::dot;
 
 /// Largest flattening the geodetic conversions accept (WGS 84's is 0.0034).
@@ -124,29 +125,41 @@ pub fn geodetic_from_itrf(
     }
     let a = ellipsoid.a_m;
     let (x, y, z) = (r_m[0] / a, r_m[1] / a, r_m[2] / a);
-    let rho = libm::hypot(x, y);
-    let e4 = e2 * e2;
-    let p = rho * rho;
-    let q = (1.0 - e2) * z * z;
-    if !(p + q >= GEODETIC_MIN_RADIUS2_OVER_A2) {
+    if !(x * x + y * y + (1.0 - e2) * z * z >= GEODETIC_MIN_RADIUS2_OVER_A2) {
         return Err(ModelError::OutOfDomain(Param::Position));
     }
+    Ok(geodetic_in(r_m, a, e2))
+}
+
+/// [`geodetic_from_itrf`]'s closed form in any [`Real`], without its checks: `a` the
+/// semi-major axis (m), `e2` = f (2 - f). The caller keeps the point in the domain (see
+/// the module): the DEM search ([`crate::earth::dem`]) evaluates it only in the band of
+/// the tile's heights. In f32 the height carries about 1e-7 a (0.6 m) of rounding, from
+/// k + e^2 - 1, a difference of terms near 1.
+#[inline]
+pub fn geodetic_in<T: Real>(r_m: [T; 3], a: T, e2: T) -> (T, T, T) {
+    let (one, two) = (T::ONE, T::ONE + T::ONE);
+    let (x, y, z) = (r_m[0] / a, r_m[1] / a, r_m[2] / a);
+    let rho = x.hypot(y);
+    let e4 = e2 * e2;
+    let p = rho * rho;
+    let q = (one - e2) * z * z;
     // r > 0 in the domain (p + q >= 1/4 > e^4), so s >= 0 and every root is real.
-    let r = (p + q - e4) / 6.0;
-    let s = e4 * p * q / (4.0 * r * r * r);
-    let t = libm::cbrt(1.0 + s + libm::sqrt(s * (2.0 + s)));
-    let u = r * (1.0 + t + 1.0 / t);
-    let v = libm::sqrt(u * u + e4 * q);
-    let w = e2 * (u + v - q) / (2.0 * v);
-    let k = (u + v) / (libm::sqrt(u + v + w * w) + w);
+    let r = (p + q - e4) / T::from_f64(6.0);
+    let s = e4 * p * q / (T::from_f64(4.0) * r * r * r);
+    let t = (one + s + (s * (two + s)).sqrt()).cbrt();
+    let u = r * (one + t + one / t);
+    let v = (u * u + e4 * q).sqrt();
+    let w = e2 * (u + v - q) / (two * v);
+    let k = (u + v) / ((u + v + w * w).sqrt() + w);
     let d = k * rho / (k + e2);
-    let dz = libm::hypot(d, z);
-    let lat = 2.0 * libm::atan2(z, d + dz);
-    let h = (k + e2 - 1.0) / k * dz * a;
-    let lon = if rho > 0.0 {
-        libm::atan2(r_m[1], r_m[0])
+    let dz = d.hypot(z);
+    let lat = two * z.atan2(d + dz);
+    let h = (k + e2 - one) / k * dz * a;
+    let lon = if rho > T::ZERO {
+        r_m[1].atan2(r_m[0])
     } else {
-        0.0
+        T::ZERO
     };
-    Ok((lat, lon, h))
+    (lat, lon, h)
 }

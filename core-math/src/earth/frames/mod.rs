@@ -25,7 +25,9 @@ pub mod nutation;
 mod rot;
 pub mod time;
 
-pub use c2t::{c2t, c2t_from_cio, c2t_from_dates, C2T_TOLERANCE_RAD};
+pub use c2t::{
+    c2t, c2t_from_cio, c2t_from_dates, CelestialPole, C2T_TOLERANCE_RAD, POLE_MAX_AGE_S,
+};
 pub use geodetic::{geodetic_from_itrf, itrf_from_geodetic};
 pub use rot::Mat3;
 pub use time::{JulianDays, TimeScales};
