@@ -41,7 +41,8 @@ pub struct SegmentOutput {
     /// f32::MAX when the image is too slow for any bound (the MTF is then 0).
     pub worst_mismatch: f32,
     /// MTF at Nyquist with the segment's stages: mismatch MTF at `worst_mismatch` times
-    /// drift-smear MTF at `worst_drift_rad`, each clamped to [0, 1].
+    /// drift-smear MTF at `worst_drift_rad`, each |sinc|, the modulus of the smear's
+    /// transfer function (in [0, 1]).
     pub mtf: f32,
     /// Largest TDI stage count whose combined MTF meets the scene's floor.
     pub max_stages: u16,
