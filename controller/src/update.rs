@@ -58,7 +58,7 @@ impl Controller {
         self.yaw_request_rad = None;
         let Some(nav) = self.nav else { return };
         if self.update_mode == Mode::Stale {
-            self.hold_all();
+            self.hold_planned();
             return;
         }
         // Not stale: t - t_nav lies in [-update period, stale_after], both < 2^53 us:
@@ -81,7 +81,7 @@ impl Controller {
             Ok(i) => i,
             Err(e) => {
                 self.reject(Fault::from(e));
-                self.hold_all();
+                self.hold_planned();
                 return;
             }
         };
@@ -135,17 +135,15 @@ impl Controller {
                             *o = out;
                             *h = true;
                         }
-                    } else if let Some(o) = self.outputs.get_mut(slot) {
+                    } else {
                         // The register kept its old period: report it as held, not as
                         // the new value.
-                        o.held = true;
+                        self.hold(index);
                     }
                 }
                 Err(f) => {
                     self.reject(f);
-                    if let Some(o) = self.outputs.get_mut(slot) {
-                        o.held = true;
-                    }
+                    self.hold(index);
                 }
             }
         }
