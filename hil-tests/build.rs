@@ -1,11 +1,13 @@
 //! Golden values for the on-target tests, computed here on the host at build time.
 //!
-//! Every expected number comes from `core-math` itself (a build-dependency): the f64
-//! `Reference` chain, `mtf_mismatch::<f64>`, `line_period_*::<f64>`, and, for the
+//! Every expected number but the MTF's comes from `core-math` itself (a build-dependency): the f64
+//! `Reference` chain, `line_period_*::<f64>`, and, for the
 //! bit-identity tests, the same `CLOSED_F32` path run on the host. Inputs are rounded
 //! to f32 first and the references are evaluated at exactly those values widened back
 //! to f64, so a comparison measures the algorithm, not the input rounding. Tolerances
 //! come from `core_math::accuracy`. Nothing here is typed by hand but the case list.
+//! The MTF's expectation is its definition, |sin(x)/x| with libm's sine, not
+//! core-math's `mtf_mismatch` (issue 25: a definition both sides shared went unseen).
 //!
 //! The controller's cases (`src/controller_cases.rs`, included here and on the target)
 //! get theirs from `controller::golden`: the f64 reference of a whole update (Kepler
@@ -287,7 +289,14 @@ fn write_mtf_cases(out: &mut String) {
             0.0_f64, 1.0e-4, 1.0e-3, -2.5e-3, 5.0e-3, 0.01, -0.01, 0.02, 0.05,
         ] {
             let rel32 = rel as f32;
-            let expected = mtf_mismatch::<f64>(stages, f64::from(rel32));
+            // The MTF's definition, |sin(x)/x| at x = pi/2 M dv/v, in f64 with libm:
+            // not the function under test (its f64 form included).
+            let x = core::f64::consts::FRAC_PI_2 * f64::from(stages) * f64::from(rel32);
+            let expected: Result<f64, ModelError> = Ok(if x == 0.0 {
+                1.0
+            } else {
+                libm::fabs(libm::sin(x) / x)
+            });
             let host = mtf_mismatch::<f32>(stages, rel32);
             let expected_src = match expected {
                 Ok(v) => format!("Ok({})", f64_src(v)),

@@ -41,7 +41,8 @@ pub struct SegmentOutput {
     /// f32::MAX when the image is too slow for any bound (the MTF is then 0).
     pub worst_mismatch: f32,
     /// MTF at Nyquist with the segment's stages: mismatch MTF at `worst_mismatch` times
-    /// drift-smear MTF at `worst_drift_rad`, each clamped to [0, 1].
+    /// drift-smear MTF at `worst_drift_rad`, each |sinc|, the modulus of the smear's
+    /// transfer function (in [0, 1]).
     pub mtf: f32,
     /// Largest TDI stage count whose combined MTF meets the scene's floor.
     pub max_stages: u16,
@@ -57,6 +58,28 @@ pub struct SegmentOutput {
     pub reversed: bool,
     /// True when this is the last good value held over a fault.
     pub held: bool,
+}
+
+impl SegmentOutput {
+    /// The record of an active segment that has no valid period: none computed yet
+    /// under its current geometry (a new or changed segment whose updates all failed).
+    /// Ticks 0, which is never a period; no contrast promised (MTF 0, stage limit 0,
+    /// mismatch f32::MAX, as for an image too slow for any bound); drifts 0, not
+    /// computed; flagged held. Nothing is written to its register for it.
+    pub const fn no_period(index: u8) -> SegmentOutput {
+        SegmentOutput {
+            index,
+            ticks: 0,
+            worst_mismatch: f32::MAX,
+            mtf: 0.0,
+            max_stages: 0,
+            drift_rad: 0.0,
+            worst_drift_rad: 0.0,
+            residual_drift_rad: 0.0,
+            reversed: false,
+            held: true,
+        }
+    }
 }
 
 /// Operating state, as the status frame reports it.
@@ -166,12 +189,21 @@ impl Controller {
     }
 
     /// The spare plan, just built for `scene`, goes in force.
+    ///
+    /// A segment's output stays in force, held or not, where the new scene leaves its
+    /// period's meaning as it was ([`Scene::keeps_output_of`]: the same camera, clock,
+    /// floor, envelope and chip; the ground height may change, as a TERRAIN frame
+    /// changes it), so a re-upload of the same scene changes no output. A segment whose
+    /// geometry changed has no valid last period: its output is dropped, and until its
+    /// first period under the new scene it is reported as having none
+    /// ([`SegmentOutput::no_period`]).
     fn install(&mut self, scene: Scene) {
         core::mem::swap(&mut self.plan, &mut self.spare_plan);
+        for (k, kept) in self.has_output.iter_mut().enumerate() {
+            *kept = *kept && scene.keeps_output_of(&self.scene, k);
+        }
         self.heights_m = scene.segments.map(|s| s.ground_h_m);
         self.scene = scene;
-        // A new focal plane: nothing of the old one's outputs applies.
-        self.has_output = [false; MAX_SEGMENTS];
     }
 
     pub fn scene(&self) -> &Scene {
@@ -241,6 +273,30 @@ impl Controller {
     pub(crate) fn hold_all(&mut self) {
         for o in self.outputs.iter_mut() {
             o.held = true;
+        }
+    }
+
+    /// Segment `index` keeps the output it has in force, flagged held; one with none
+    /// (no period under its geometry yet) gets [`SegmentOutput::no_period`], so that
+    /// every active segment has a record from the first update with NAV on.
+    pub(crate) fn hold(&mut self, index: u8) {
+        let slot = usize::from(index);
+        if let (Some(o), Some(h)) = (self.outputs.get_mut(slot), self.has_output.get_mut(slot)) {
+            if *h {
+                o.held = true;
+            } else {
+                *o = SegmentOutput::no_period(index);
+                *h = true;
+            }
+        }
+    }
+
+    /// Every active segment of the plan in force held ([`Controller::hold`]).
+    pub(crate) fn hold_planned(&mut self) {
+        for k in 0..self.plan.segments.len() {
+            if let Some(index) = self.plan.segments.get(k).map(|s| s.index) {
+                self.hold(index);
+            }
         }
     }
 }

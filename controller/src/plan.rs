@@ -91,8 +91,12 @@ pub struct Plan {
     /// The array centre: the boresight pixel (p1 = p2 = 0), where a yaw turn turns the
     /// image motion and nothing else (the yaw steering request zeroes its drift).
     pub boresight: GeneralPixel<f32>,
-    /// The table index of the segment whose ground the boresight sees (the one
-    /// containing pixel 0, or the nearest).
+    /// The table index of the segment whose ground the boresight sees: the one
+    /// containing pixel 0; when none does (a gap in the mosaic at the array centre), the
+    /// table entry nearest to pixel 0, active or not (its height is known: SCENE,
+    /// TERRAIN), on a tie the lower index, at negative pixels. The yaw request is then
+    /// still formed over that ground and flagged valid (docs/controller.md, "Per
+    /// update"; `controller/tests/yaw_request.rs`).
     pub boresight_segment: u8,
     pub pixel_m: f32,
     pub line_clock_hz: f32,
@@ -345,7 +349,8 @@ impl Plan {
                 .push(segment)
                 .map_err(|_| Fault::InvalidScene)?;
         }
-        // The segment the boresight falls in, else the one nearest to it.
+        // The segment the boresight falls in, else the one nearest to it (`min_by_key`
+        // keeps the first of equals: on a tie the lower index).
         let distance = |s: &SegmentSpec| {
             if s.first_px > 0 {
                 i64::from(s.first_px)

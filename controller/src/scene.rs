@@ -126,6 +126,26 @@ impl Scene {
             .filter(|(_, s)| s.active)
     }
 
+    /// Whether segment `k`'s output under `old` (its period, held or not, and what its
+    /// record says of it) still holds under this scene: the same camera, line clock,
+    /// MTF floor, envelope (the period bounds) and stage limit, and the same chip,
+    /// active in both (its pixels, line p1 and stages). Only the ground height may
+    /// differ: a TERRAIN frame changes it as well, without dropping a held period.
+    pub fn keeps_output_of(&self, old: &Scene, k: usize) -> bool {
+        let same_camera = self.camera == old.camera
+            && self.line_clock_hz == old.line_clock_hz
+            && self.mtf_floor == old.mtf_floor
+            && self.envelope == old.envelope
+            && self.max_stages == old.max_stages;
+        let chip = |s: &Scene| {
+            s.table().get(k).filter(|c| c.active).map(|c| SegmentSpec {
+                ground_h_m: 0.0,
+                ..*c
+            })
+        };
+        same_camera && chip(self).is_some() && chip(self) == chip(old)
+    }
+
     /// The table's entries (active or not).
     pub fn table(&self) -> &[SegmentSpec] {
         &self.segments[..usize::from(self.count).min(MAX_SEGMENTS)]

@@ -7,7 +7,7 @@
 
 use core_math::earth::{GeneralRowMotion, GeneralUpdate};
 use core_math::ImageMotion;
-use core_math::{nearest_ticks, sinc, Backend, Real, GENERAL_F32};
+use core_math::{nearest_ticks, smear_mtf, Backend, Real, GENERAL_F32};
 
 use crate::config::{EARTH, EARTH_RATE_RAD_S, MAX_TIME_TAG_US};
 use crate::control::{Controller, Mode, SegmentOutput};
@@ -58,7 +58,7 @@ impl Controller {
         self.yaw_request_rad = None;
         let Some(nav) = self.nav else { return };
         if self.update_mode == Mode::Stale {
-            self.hold_all();
+            self.hold_planned();
             return;
         }
         // Not stale: t - t_nav lies in [-update period, stale_after], both < 2^53 us:
@@ -81,7 +81,7 @@ impl Controller {
             Ok(i) => i,
             Err(e) => {
                 self.reject(Fault::from(e));
-                self.hold_all();
+                self.hold_planned();
                 return;
             }
         };
@@ -135,17 +135,15 @@ impl Controller {
                             *o = out;
                             *h = true;
                         }
-                    } else if let Some(o) = self.outputs.get_mut(slot) {
+                    } else {
                         // The register kept its old period: report it as held, not as
                         // the new value.
-                        o.held = true;
+                        self.hold(index);
                     }
                 }
                 Err(f) => {
                     self.reject(f);
-                    if let Some(o) = self.outputs.get_mut(slot) {
-                        o.held = true;
-                    }
+                    self.hold(index);
                 }
             }
         }
@@ -217,19 +215,12 @@ impl Controller {
             let (below, above) = ((v_line / v_lo - 1.0).abs(), (1.0 - v_line / v_hi).abs());
             let worst = if below > above { below } else { above };
             let half_pi_m = core::f32::consts::FRAC_PI_2 * stages as f32;
-            // Past the sinc's first zero no contrast is left; its negative lobe is a
-            // phase reversal, not an MTF below 0. Never above 1: the polynomial's
+            // Each factor is |sinc|, the modulus of the smear's transfer function: past
+            // the first zero the contrast is reversed and weaker, not gone
+            // (docs/controller.md, "Per update"). In [0, 1]: the polynomial's
             // (sinc(x) - 1) / x^2 part is negative on its whole range, and past pi
             // |sinc| < 1/pi.
-            let contrast = |x: f32| {
-                let s = sinc(x);
-                if s > 0.0 {
-                    s
-                } else {
-                    0.0
-                }
-            };
-            let mtf = contrast(half_pi_m * worst) * contrast(half_pi_m * tan_max);
+            let mtf = smear_mtf(half_pi_m * worst) * smear_mtf(half_pi_m * tan_max);
             let m = self
                 .plan
                 .stage_rule

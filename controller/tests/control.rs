@@ -147,19 +147,20 @@ fn periods_match_the_reference_and_follow_the_orbit_and_the_attitude() {
     let floor = f64::from(c.scene().mtf_floor);
     for o in c.outputs() {
         // Pitched, the far segments' drift (the keystone: tan(pitch) tan(field)) smears
-        // beyond the sinc's first zero: an MTF of 0 is the truth there.
+        // beyond the sinc's first zero: the contrast there is reversed and weak, and
+        // the MTF is its modulus.
         assert!(
             !o.held && !o.reversed && (0.0..=1.0).contains(&o.mtf),
             "{o:?}"
         );
         let product = |m: u32| {
             let h = std::f64::consts::FRAC_PI_2 * f64::from(m);
-            // Each factor clamped at its first zero (no contrast, not a negative one).
+            // Each factor the modulus |sin(x)/x| (docs/controller.md, "Per update").
             let s = |x: f64| {
                 if x == 0.0 {
                     1.0
                 } else {
-                    (x.sin() / x).max(0.0)
+                    (x.sin() / x).abs()
                 }
             };
             s(h * f64::from(o.worst_mismatch)) * s(h * f64::from(o.worst_drift_rad).tan())

@@ -60,7 +60,7 @@ pub use earth::{Earth, EarthCamera, EarthGeometry, Ellipsoid, General};
 pub use error::{ModelError, Param};
 pub use line_period::{line_period_s, line_period_ticks, nearest_ticks, Ticks};
 pub use model::{domain, Backend, Camera, ImageMotion, Model, EARTH_RATE_RAD_S, GM_M3_S2};
-pub use mtf::{mtf_drift, mtf_mismatch, sinc, StageRule};
+pub use mtf::{mtf_drift, mtf_mismatch, sinc, smear_mtf, StageRule};
 pub use orbit::StateVector;
 pub use real::{Real, Scalar};
 

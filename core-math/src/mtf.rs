@@ -2,7 +2,17 @@
 //!
 //! At the Nyquist frequency f_c = 1/(2A) a relative velocity mismatch dv/v over M TDI
 //! stages smears the image by s = A M dv/v (Eq. 18), and
-//! MTF_mismatch = sinc(x) = sin(x)/x with x = pi M (dv/v) / 2 (Eq. 19).
+//! MTF_mismatch = |sinc(x)| = |sin(x)/x| with x = pi M (dv/v) / 2 (Eq. 19).
+//!
+//! The MTF is the modulus of the optical transfer function: a uniform smear's OTF is
+//! sinc, and past its first zero (x = pi) the contrast comes back with its phase
+//! reversed, weaker (|sinc| <= 0.2172 there), not negative and not gone. So both factors
+//! here, mismatch and drift smear, are |sinc| (`../shared/EARTH-MODEL.md` defines the
+//! drift's as |sinc(d/2)|, docs/derivation.md section 19). The stage limit
+//! ([`StageRule`]) is the largest M whose MTF meets the floor at every count up to M:
+//! floors are at least [`MIN_MTF_FLOOR`] (0.25), above every later lobe, so a count past
+//! either factor's first zero never meets one, and the limit is also the largest count
+//! that meets it at all.
 
 use crate::error::{ModelError, Param};
 use crate::real::Real;
@@ -78,26 +88,37 @@ fn sinc_beyond_pi<T: Real>(x: T) -> T {
     x.sin() / x
 }
 
-/// MTF_mismatch at Nyquist for `stages` TDI stages and a relative mismatch dv/v (Eq. 19).
-/// Negative values are the sinc's contrast reversal beyond x = pi, returned as they are.
+/// The MTF of a uniform smear at `x` = pi/2 times its length in pixels: |sinc(x)|, the
+/// modulus of its transfer function (past x = pi the contrast is reversed, and counted
+/// by its size). In [0, 1] in f32 and f64 (sinc never exceeds 1: tested).
+#[inline(always)]
+pub fn smear_mtf<T: Real>(x: T) -> T {
+    sinc(x).abs()
+}
+
+/// MTF_mismatch at Nyquist for `stages` TDI stages and a relative mismatch dv/v (Eq. 19):
+/// |sinc(pi M dv/v / 2)|, the modulus (beyond x = pi the contrast is reversed, at most
+/// 0.2172 of it left; the module's note).
 pub fn mtf_mismatch<T: Real>(stages: u32, rel_mismatch: T) -> Result<T, ModelError> {
     if !rel_mismatch.is_finite() {
         return Err(ModelError::NonFinite(Param::RelativeMismatch));
     }
-    Ok(sinc(
+    Ok(smear_mtf(
         T::from_f64(HALF_PI) * T::from_u32(stages) * rel_mismatch,
     ))
 }
 
 /// MTF of the drift smear at Nyquist (`../shared/EARTH-MODEL.md`, derived outputs): over
 /// `stages` TDI stages an image moving at `tan_drift` across the line smears by
-/// d = M |tan drift| pixels, and MTF = sinc(pi d / 2) (sinc(x) = sin(x)/x). The same
-/// function of M x as [`mtf_mismatch`]; negative values are returned as they are.
+/// d = M |tan drift| pixels, and MTF = |sinc(pi d / 2)| (sinc(x) = sin(x)/x). The same
+/// function of M x as [`mtf_mismatch`].
 pub fn mtf_drift<T: Real>(stages: u32, tan_drift: T) -> Result<T, ModelError> {
     if !tan_drift.is_finite() {
         return Err(ModelError::NonFinite(Param::Drift));
     }
-    Ok(sinc(T::from_f64(HALF_PI) * T::from_u32(stages) * tan_drift))
+    Ok(smear_mtf(
+        T::from_f64(HALF_PI) * T::from_u32(stages) * tan_drift,
+    ))
 }
 
 /// Smallest and largest MTF floor a [`StageRule`] accepts.
@@ -226,8 +247,11 @@ impl<T: Real> StageRule<T> {
     }
 
     /// The largest M in 0..=min(`stage_limit`, [`MAX_STAGE_LIMIT`]) whose combined MTF,
-    /// mismatch times drift smear, sinc(pi/2 M e) sinc(pi/2 M t), meets the floor, for a
-    /// relative mismatch e and a drift tangent t.
+    /// mismatch times drift smear, |sinc(pi/2 M e)| |sinc(pi/2 M t)|, meets the floor at
+    /// every count up to M, for a relative mismatch e and a drift tangent t. (Past
+    /// either factor's first zero the product is at most 0.2172, under every floor:
+    /// the signed product the search evaluates meets the floor exactly where the
+    /// modulus does, and no later lobe ever does.)
     ///
     /// Guessed, then checked: the continuous root of sinc(x e) sinc(x t) = floor is
     /// close to x_f / (d sqrt(1 + kappa r^2)), d = max(e, t), r = min/max, a form exact

@@ -20,7 +20,7 @@ fn sinc_polynomial_matches_libm() {
     assert_eq!(sinc(0.0f64), 1.0);
     // Beyond pi the direct quotient is used; check it too.
     assert!((sinc(4.0f64) - libm::sin(4.0) / 4.0).abs() < 1e-15);
-    // Never above 1 in f32 (the controller's MTF clamps only below): every f32 in
+    // Never above 1 in f32 (the MTF, |sinc|, is not clamped): every f32 in
     // [0, pi] near 0 and a dense grid beyond, and the quotient past pi.
     let mut x = 0.0f32;
     while x < 1e-3 {
@@ -32,6 +32,44 @@ fn sinc_polynomial_matches_libm() {
         assert!(sinc(x) <= 1.0, "{x}");
     }
     assert_eq!(sinc(0.0f32), 1.0);
+}
+
+/// Issue 25, item 2: past the first zero the MTF is the modulus of the sinc, not 0 and
+/// not negative (`../shared/EARTH-MODEL.md`: |sinc(d/2)|). The derivation's test case:
+/// 48 stages at a drift of 0.0624 rad smear 3.0 pixels, MTF 0.212.
+#[test]
+fn the_mtf_is_the_modulus_past_the_first_zero() {
+    let tan = libm::tan(0.0624);
+    let x = std::f64::consts::FRAC_PI_2 * 48.0 * tan;
+    let want = libm::fabs(libm::sin(x) / x);
+    assert!((want - 0.212).abs() < 5e-4, "{want}");
+    let drift64 = core_math::mtf_drift(48, tan).unwrap();
+    let drift32 = core_math::mtf_drift(48, tan as f32).unwrap();
+    assert!((drift64 - want).abs() < 1e-12, "f64 {drift64} vs {want}");
+    assert!(
+        (f64::from(drift32) - want).abs() < 1e-6,
+        "f32 {drift32} vs {want}"
+    );
+    // Mismatch and drift are the same function of M x.
+    assert_eq!(mtf_mismatch(48, tan).unwrap(), drift64);
+    // Over the first lobes, both signs: in [0, 1] and |sin(x)/x|.
+    for i in 1..=40_000 {
+        let x = i as f64 * 1e-3;
+        let want = libm::fabs(libm::sin(x) / x);
+        for x in [x, -x] {
+            let got64 = core_math::smear_mtf(x);
+            let got32 = core_math::smear_mtf(x as f32);
+            assert!(
+                (got64 - want).abs() < 1e-10,
+                "f64 at {x}: {got64} vs {want}"
+            );
+            assert!(
+                (f64::from(got32) - want).abs() < 3e-7,
+                "f32 at {x}: {got32} vs {want}"
+            );
+            assert!((0.0..=1.0).contains(&got32) && (0.0..=1.0).contains(&got64));
+        }
+    }
 }
 
 #[test]
@@ -237,8 +275,15 @@ fn dual_numbers_differentiate_exactly() {
 /// does not (or the limit is reached), over mismatches and drifts from none to large.
 #[test]
 fn stage_limit_with_drift_is_the_largest_count_meeting_the_floor() {
+    // The combined MTF: each factor the modulus |sin(x)/x|.
     let product = |m: u32, e: f64, t: f64| {
-        let s = |x: f64| if x == 0.0 { 1.0 } else { libm::sin(x) / x };
+        let s = |x: f64| {
+            if x == 0.0 {
+                1.0
+            } else {
+                libm::fabs(libm::sin(x) / x)
+            }
+        };
         let h = std::f64::consts::FRAC_PI_2 * m as f64;
         s(h * e) * s(h * t)
     };
@@ -257,12 +302,17 @@ fn stage_limit_with_drift_is_the_largest_count_meeting_the_floor() {
             let e = 10f64.powf(-6.0 + 5.0 * next()) * if next() < 0.1 { 0.0 } else { 1.0 };
             let t = 10f64.powf(-6.0 + 5.0 * next()) * if next() < 0.1 { 0.0 } else { 1.0 };
             let limit = 1 + (next() * 300.0) as u32;
-            // Brute force: the largest M meeting the floor (the product falls on the
-            // main lobe, and nothing past its first failure comes back above 0.25).
+            // Brute force: the largest M meeting the floor at every count up to it;
+            // and no later count meets it either (the later lobes stay under 0.25),
+            // so it is also the largest count that meets it at all.
             let mut expect = 0;
             while expect < limit && product(expect + 1, e, t) >= floor {
                 expect += 1;
             }
+            assert!(
+                (expect + 1..=limit).all(|m| product(m, e, t) < floor),
+                "floor {floor}, e {e:e}, t {t:e}: a later lobe meets the floor"
+            );
             let got = rule.max_stages_with_drift(e, t, limit).unwrap();
             assert_eq!(
                 got, expect,

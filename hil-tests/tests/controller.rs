@@ -156,13 +156,8 @@ fn check_stages(name: &str, c: &Controller, o: &controller::SegmentOutput, w: &m
         if x == 0.0 {
             1.0
         } else {
-            // Each factor clamped at its first zero, as the controller reports it.
-            let s = libm::sin(x) / x;
-            if s > 0.0 {
-                s
-            } else {
-                0.0
-            }
+            // Each factor the modulus |sin(x)/x|, as the controller reports it.
+            libm::fabs(libm::sin(x) / x)
         }
     };
     let product = |m: u32| {
