@@ -11,6 +11,9 @@
 //!
 //! `cargo test --release -p core-math --test bus_costs -- --nocapture` prints them.
 
+mod dem_tile;
+use dem_tile::tile_data;
+
 use core_math::earth::bus::{
     bus_geometry, AttitudeFrame, BusAttitude, BusState, BusTime, StateFrame, IDENTITY_QUATERNION,
 };
@@ -24,8 +27,6 @@ use core_math::{
     EarthCamera, EarthGeometry, EarthReference, Ellipsoid, ImageMotion, StateVector,
     EARTH_RATE_RAD_S, GM_M3_S2,
 };
-
-const TILE_CSV: &str = include_str!("data/dem_tile.csv");
 
 /// Speed of light (m/s).
 const C_MPS: f64 = 299_792_458.0;
@@ -241,32 +242,6 @@ fn turned(g: &InertialGeometry<f64>, m: &Mat3) -> InertialGeometry<f64> {
 
 // ---------------------------------------------------------------------------------
 // DEM tiles.
-
-fn tile_data() -> (DemGrid, Vec<f64>) {
-    let mut lines = TILE_CSV.lines();
-    assert_eq!(
-        lines.next().unwrap(),
-        "lat0_deg,lon0_deg,dlat_deg,dlon_deg,nrows,ncols"
-    );
-    let g: Vec<f64> = lines
-        .next()
-        .unwrap()
-        .split(',')
-        .map(|x| x.parse().unwrap())
-        .collect();
-    let grid = DemGrid {
-        lat0_deg: g[0],
-        lon0_deg: g[1],
-        dlat_deg: g[2],
-        dlon_deg: g[3],
-        nrows: g[4] as usize,
-        ncols: g[5] as usize,
-    };
-    let heights: Vec<f64> = lines
-        .flat_map(|l| l.split(',').map(|x| x.parse::<f64>().unwrap()))
-        .collect();
-    (grid, heights)
-}
 
 /// Nodes per side of the mirrored tile.
 const MIRRORED_NODES: usize = 4_096;

@@ -15,6 +15,9 @@
 //! `cargo test --release -p core-math --test dem -- --nocapture` prints the measured
 //! maxima quoted in `docs/earth-model.md`.
 
+mod dem_tile;
+use dem_tile::tile_data;
+
 use core_math::earth::bus::{
     bus_geometry, dps_to_rad_s, AttitudeFrame, BusAttitude, BusState, BusTime, StateFrame,
 };
@@ -29,7 +32,6 @@ use core_math::{
     GENERAL_F64,
 };
 
-const TILE_CSV: &str = include_str!("data/dem_tile.csv");
 const CASES_CSV: &str = include_str!("data/dem_cases.csv");
 
 /// Golden tolerances: the ground point (m, f64 backends), the motion relative to |v|
@@ -40,32 +42,6 @@ const GROUND_F64_M: f64 = 0.01;
 const MOTION_F64_REL: f64 = 1.0e-9;
 const MOTION_F32_REL: f64 = 5.0e-6;
 const GROUND_F32_M: f64 = 10.0;
-
-fn tile_data() -> (DemGrid, Vec<f64>) {
-    let mut lines = TILE_CSV.lines();
-    assert_eq!(
-        lines.next().unwrap(),
-        "lat0_deg,lon0_deg,dlat_deg,dlon_deg,nrows,ncols"
-    );
-    let g: Vec<f64> = lines
-        .next()
-        .unwrap()
-        .split(',')
-        .map(|x| x.parse().unwrap())
-        .collect();
-    let grid = DemGrid {
-        lat0_deg: g[0],
-        lon0_deg: g[1],
-        dlat_deg: g[2],
-        dlon_deg: g[3],
-        nrows: g[4] as usize,
-        ncols: g[5] as usize,
-    };
-    let heights: Vec<f64> = lines
-        .flat_map(|l| l.split(',').map(|x| x.parse::<f64>().unwrap()))
-        .collect();
-    (grid, heights)
-}
 
 struct Case {
     case: u32,

@@ -42,7 +42,13 @@ pub fn c2ixys(x: f64, y: f64, s: f64) -> Mat3 {
 /// dates give a finite rotation); [`c2t`] is the checked entry.
 pub fn c2t_from_dates(tt: &JulianDays, ut1: &JulianDays) -> Mat3 {
     let t = tt.centuries();
-    // Bias-precession-nutation (iauPnm06a with iauNut00b for iauNut00a).
+    let (x, y) = cip(t);
+    c2t_from_cio(x, y, s06(t, x, y), era00(ut1), sp00(t))
+}
+
+/// The CIP's X, Y at `t` Julian centuries TT since J2000.0: bias-precession-nutation
+/// (`iauPnm06a` with `iauNut00b` for `iauNut00a`), then `iauBpn2xy`.
+fn cip(t: f64) -> (f64, f64) {
     let fw = pfw06(t);
     let (dpsi, deps) = nut06b(t);
     let npb = fw2m(
@@ -51,9 +57,7 @@ pub fn c2t_from_dates(tt: &JulianDays, ut1: &JulianDays) -> Mat3 {
         fw.psib_rad + dpsi,
         fw.epsa_rad + deps,
     );
-    // The CIP (iauBpn2xy), then s and the rotations.
-    let (x, y) = (npb[2][0], npb[2][1]);
-    c2t_from_cio(x, y, s06(t, x, y), era00(ut1), sp00(t))
+    (npb[2][0], npb[2][1])
 }
 
 /// C2T = R3(s') R3(ERA) C2I(X, Y, s) from the CIP's X, Y, the CIO locator s, the Earth
@@ -100,15 +104,7 @@ impl CelestialPole {
         let tt = tt_from_gps_s(gps_s)?;
         scales.validate()?;
         let t = tt.centuries();
-        let fw = pfw06(t);
-        let (dpsi, deps) = nut06b(t);
-        let npb = fw2m(
-            fw.gamb_rad,
-            fw.phib_rad,
-            fw.psib_rad + dpsi,
-            fw.epsa_rad + deps,
-        );
-        let (x, y) = (npb[2][0], npb[2][1]);
+        let (x, y) = cip(t);
         Ok(CelestialPole {
             gps_s,
             c2i: c2ixys(x, y, s06(t, x, y)),
