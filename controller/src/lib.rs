@@ -5,7 +5,8 @@
 //! telemetry in ([`frame`], [`nav`]) -> frames to state ([`intake`]; the scene and its
 //! plan: [`scene`], [`plan`]) -> the controller's state ([`control`], its settings in
 //! [`config`]) -> state to periods ([`update`]: core-math's general real-Earth form) ->
-//! line periods out ([`sink`], [`report`]).
+//! line periods out ([`sink`], [`report`]; whole frames into the transmit queue:
+//! [`downlink`]).
 #![no_std]
 #![forbid(unsafe_code)]
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
@@ -14,6 +15,7 @@ pub mod bytes;
 pub mod config;
 pub mod control;
 pub mod crc;
+pub mod downlink;
 pub mod fault;
 pub mod frame;
 #[cfg(feature = "reference")]

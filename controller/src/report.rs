@@ -12,8 +12,9 @@ use crate::scene::MAX_SEGMENTS;
 /// then one [`RECORD_LEN`]-byte record per segment in force.
 pub const PERIODS_HEADER_LEN: usize = 8;
 pub const RECORD_LEN: usize = 28;
-/// STATUS payload length.
-pub const STATUS_LEN: usize = 20 + 4 * Fault::COUNT;
+/// STATUS payload length: the header and four counters, one counter per [`Fault`], and
+/// the downlink frames dropped (84 bytes).
+pub const STATUS_LEN: usize = 20 + 4 * Fault::COUNT + 4;
 
 /// Flag bit of a record: the value is the last good one, held over a fault.
 pub const FLAG_HELD: u8 = 1;
@@ -95,9 +96,15 @@ impl Periods {
 
 /// Writes the STATUS payload: mode, last fault (0xFF: none), 2 reserved, frames
 /// accepted, updates run, bytes skipped by the decoder, time re-synchronisations, then
-/// one u32 counter per [`Fault`] in [`Fault::ALL`] order. What each counts, and the
-/// identities between them: docs/telemetry.md, "Counters".
-pub fn encode_status(c: &Controller, skipped_bytes: u32, out: &mut [u8]) -> Option<usize> {
+/// one u32 counter per [`Fault`] in [`Fault::ALL`] order, then the downlink frames the
+/// transmit queue had no room for (dropped whole: [`crate::downlink`]). What each
+/// counts, and the identities between them: docs/telemetry.md, "Counters".
+pub fn encode_status(
+    c: &Controller,
+    skipped_bytes: u32,
+    downlink_dropped: u32,
+    out: &mut [u8],
+) -> Option<usize> {
     let mut w = Writer::new(out);
     w.put(&[c.mode() as u8, c.last_fault.map_or(0xFF, |f| f as u8), 0, 0])?;
     w.put(&c.frames_accepted.to_le_bytes())?;
@@ -107,6 +114,7 @@ pub fn encode_status(c: &Controller, skipped_bytes: u32, out: &mut [u8]) -> Opti
     for n in c.counters.as_array() {
         w.put(&n.to_le_bytes())?;
     }
+    w.put(&downlink_dropped.to_le_bytes())?;
     Some(w.len())
 }
 
@@ -119,6 +127,8 @@ pub struct Status {
     pub skipped_bytes: u32,
     pub time_resyncs: u32,
     pub counts: [u32; Fault::COUNT],
+    /// Downlink frames dropped whole because the transmit queue had no room for them.
+    pub downlink_dropped: u32,
 }
 
 impl Status {
@@ -135,6 +145,7 @@ impl Status {
         for c in counts.iter_mut() {
             *c = r.u32()?;
         }
+        let downlink_dropped = r.u32()?;
         let last_fault = Fault::ALL.get(usize::from(last)).copied();
         r.is_done().then_some(Status {
             mode,
@@ -144,6 +155,7 @@ impl Status {
             skipped_bytes,
             time_resyncs,
             counts,
+            downlink_dropped,
         })
     }
 

@@ -8,6 +8,11 @@
 //!
 //! Bytes are processed one at a time (the decoder sees every byte alone), so that the
 //! outputs do not depend on how the bytes were chunked by the link.
+//!
+//! Frames go out through a `send` closure. One that returns nothing takes every frame; one
+//! that returns a `bool` says whether it took the frame (a transmit queue without room,
+//! [`crate::downlink`]), and the session counts each refused frame in STATUS (*downlink
+//! frames dropped*, [`Session::downlink_dropped`]).
 
 use crate::control::Controller;
 use crate::fault::Fault;
@@ -17,6 +22,25 @@ use crate::sink::LinePeriodSink;
 
 /// Time between STATUS frames (controller time, us).
 pub const STATUS_PERIOD_US: u64 = 1_000_000;
+
+/// What a `send` closure returns: nothing (the frame was taken), or whether the link took
+/// the frame.
+pub trait Sent {
+    /// True if the frame was taken.
+    fn taken(self) -> bool;
+}
+
+impl Sent for () {
+    fn taken(self) -> bool {
+        true
+    }
+}
+
+impl Sent for bool {
+    fn taken(self) -> bool {
+        self
+    }
+}
 
 /// The controller, its decoder and the downlink's state.
 pub struct Session {
@@ -31,6 +55,9 @@ pub struct Session {
     /// Downlink frames that could not be encoded (never expected: the payloads are
     /// bounded by construction).
     pub encode_failures: u32,
+    /// Downlink frames the link refused (a full transmit queue), each dropped whole:
+    /// reported in STATUS.
+    pub downlink_dropped: u32,
 }
 
 impl Session {
@@ -44,6 +71,7 @@ impl Session {
             end_requested: false,
             ended: false,
             encode_failures: 0,
+            downlink_dropped: 0,
         }
     }
 
@@ -53,13 +81,14 @@ impl Session {
     }
 
     /// Feeds received bytes; `sink` receives the line periods, `send` every downlink
-    /// frame (whole, ready for the link). Returns true when the pass has ended (an END
-    /// frame arrived): the final STATUS has been sent and later bytes are ignored.
-    pub fn feed<S: LinePeriodSink>(
+    /// frame (whole, ready for the link; it may refuse one: [`Sent`]). Returns true when
+    /// the pass has ended (an END frame arrived): the final STATUS has been sent and
+    /// later bytes are ignored.
+    pub fn feed<S: LinePeriodSink, R: Sent>(
         &mut self,
         bytes: &[u8],
         sink: &mut S,
-        mut send: impl FnMut(&[u8]),
+        mut send: impl FnMut(&[u8]) -> R,
     ) -> bool {
         for &b in bytes {
             if self.ended {
@@ -70,11 +99,11 @@ impl Session {
         self.ended
     }
 
-    fn feed_byte<S: LinePeriodSink>(
+    fn feed_byte<S: LinePeriodSink, R: Sent>(
         &mut self,
         byte: u8,
         sink: &mut S,
-        send: &mut impl FnMut(&[u8]),
+        send: &mut impl FnMut(&[u8]) -> R,
     ) {
         let Session {
             decoder,
@@ -82,6 +111,7 @@ impl Session {
             sequence,
             end_requested,
             encode_failures,
+            downlink_dropped,
             ..
         } = self;
         // Only an accepted frame moves the clock, so only it can make an update or a
@@ -109,7 +139,12 @@ impl Session {
                     if controller.frames_accepted != before {
                         accepted = true;
                         let now = controller.now_us();
-                        advance(controller, now, sink, sequence, encode_failures, send);
+                        let out = Out {
+                            sequence,
+                            encode_failures,
+                            downlink_dropped,
+                        };
+                        advance(controller, now, sink, out, send);
                     }
                 }
             }
@@ -123,27 +158,25 @@ impl Session {
     /// timer), with the same consequences as a frame's time tag: the update that is
     /// due, its PERIODS frame, a STATUS frame when one is due. Under QEMU the telemetry
     /// is the only time source and this is not called.
-    pub fn tick<S: LinePeriodSink>(
+    pub fn tick<S: LinePeriodSink, R: Sent>(
         &mut self,
         now_us: u64,
         sink: &mut S,
-        mut send: impl FnMut(&[u8]),
+        mut send: impl FnMut(&[u8]) -> R,
     ) {
         if self.ended {
             return;
         }
-        advance(
-            &mut self.controller,
-            now_us,
-            sink,
-            &mut self.sequence,
-            &mut self.encode_failures,
-            &mut send,
-        );
+        let out = Out {
+            sequence: &mut self.sequence,
+            encode_failures: &mut self.encode_failures,
+            downlink_dropped: &mut self.downlink_dropped,
+        };
+        advance(&mut self.controller, now_us, sink, out, &mut send);
         self.status_if_due(&mut send);
     }
 
-    fn status_if_due(&mut self, send: &mut impl FnMut(&[u8])) {
+    fn status_if_due<R: Sent>(&mut self, send: &mut impl FnMut(&[u8]) -> R) {
         let now = self.controller.now_us();
         // A re-synchronisation is reported at once, and restarts the schedule (the
         // clock may have gone back).
@@ -160,34 +193,68 @@ impl Session {
     }
 
     /// Sends a STATUS frame (time tag: the controller's clock).
-    pub fn send_status(&mut self, send: &mut impl FnMut(&[u8])) {
+    pub fn send_status<R: Sent>(&mut self, send: &mut impl FnMut(&[u8]) -> R) {
         let mut payload = [0u8; MAX_PAYLOAD];
         let skipped = self.decoder.skipped_bytes;
+        let dropped = self.downlink_dropped;
         let now = self.controller.now_us();
-        let sent = encode_status(&self.controller, skipped, &mut payload).and_then(|n| {
-            send_frame(
-                kind::STATUS,
-                &mut self.sequence,
-                now,
-                payload.get(..n)?,
-                send,
-            )
+        let out = Out {
+            sequence: &mut self.sequence,
+            encode_failures: &mut self.encode_failures,
+            downlink_dropped: &mut self.downlink_dropped,
+        };
+        let encoded = encode_status(&self.controller, skipped, dropped, &mut payload);
+        out.send(
+            kind::STATUS,
+            now,
+            encoded.and_then(|n| payload.get(..n)),
+            send,
+        );
+    }
+}
+
+/// The session's downlink counters, for sending one frame.
+struct Out<'a> {
+    sequence: &'a mut u16,
+    encode_failures: &'a mut u32,
+    downlink_dropped: &'a mut u32,
+}
+
+impl Out<'_> {
+    /// Encodes one frame of `payload` (None: it could not be encoded) with the next
+    /// sequence number and hands it to `send`; counts a frame that could not be encoded,
+    /// and one that `send` refused.
+    fn send<R: Sent>(
+        self,
+        kind: u8,
+        time_us: u64,
+        payload: Option<&[u8]>,
+        send: &mut impl FnMut(&[u8]) -> R,
+    ) {
+        let mut frame = [0u8; MAX_FRAME];
+        let encoded = payload.and_then(|p| {
+            let n = encode(kind, *self.sequence, time_us, p, &mut frame)?;
+            frame.get(..n)
         });
-        if sent.is_none() {
-            self.encode_failures = self.encode_failures.saturating_add(1);
+        let Some(bytes) = encoded else {
+            *self.encode_failures = self.encode_failures.saturating_add(1);
+            return;
+        };
+        *self.sequence = self.sequence.wrapping_add(1);
+        if !send(bytes).taken() {
+            *self.downlink_dropped = self.downlink_dropped.saturating_add(1);
         }
     }
 }
 
 /// Runs the update due at `now_us`, if any, and sends its PERIODS frame (time tag: the
 /// update instant).
-fn advance<S: LinePeriodSink>(
+fn advance<S: LinePeriodSink, R: Sent>(
     controller: &mut Controller,
     now_us: u64,
     sink: &mut S,
-    sequence: &mut u16,
-    encode_failures: &mut u32,
-    send: &mut impl FnMut(&[u8]),
+    out: Out<'_>,
+    send: &mut impl FnMut(&[u8]) -> R,
 ) {
     if !controller.advance(now_us, sink) {
         return;
@@ -196,24 +263,11 @@ fn advance<S: LinePeriodSink>(
         return;
     };
     let mut payload = [0u8; MAX_PAYLOAD];
-    let sent = encode_periods(controller, &mut payload)
-        .and_then(|n| send_frame(kind::PERIODS, sequence, t, payload.get(..n)?, send));
-    if sent.is_none() {
-        *encode_failures = encode_failures.saturating_add(1);
-    }
-}
-
-/// Encodes one frame with the next sequence number and hands it to `send`.
-fn send_frame(
-    kind: u8,
-    sequence: &mut u16,
-    time_us: u64,
-    payload: &[u8],
-    send: &mut impl FnMut(&[u8]),
-) -> Option<()> {
-    let mut frame = [0u8; MAX_FRAME];
-    let n = encode(kind, *sequence, time_us, payload, &mut frame)?;
-    *sequence = sequence.wrapping_add(1);
-    send(frame.get(..n)?);
-    Some(())
+    let encoded = encode_periods(controller, &mut payload);
+    out.send(
+        kind::PERIODS,
+        t,
+        encoded.and_then(|n| payload.get(..n)),
+        send,
+    );
 }

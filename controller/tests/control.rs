@@ -539,9 +539,10 @@ fn periods_and_status_frames_round_trip() {
     assert_eq!(p.mode, Mode::Nominal as u8);
     let mine: Vec<_> = c.outputs().copied().collect();
     assert_eq!(p.records(), &mine[..]);
-    let n = controller::report::encode_status(&c, 7, &mut buf).unwrap();
+    let n = controller::report::encode_status(&c, 7, 3, &mut buf).unwrap();
     assert_eq!(n, controller::report::STATUS_LEN);
     let s = controller::report::Status::decode(&buf[..n]).unwrap();
+    assert_eq!(s.downlink_dropped, 3);
     assert_eq!(s.count(Fault::BadCrc), 1);
     assert_eq!(s.last_fault, Some(Fault::BadCrc));
     assert_eq!(s.skipped_bytes, 7);

@@ -100,3 +100,79 @@ fn an_end_frame_with_a_payload_is_refused() {
     assert!(!ended);
     assert_eq!(s.controller.counters.get(Fault::BadLength), 1);
 }
+
+/// Frames through a transmit queue that drains slower than the session sends: every
+/// frame the ground receives is whole, every other one was dropped whole and counted,
+/// and STATUS reports the count.
+#[test]
+fn a_full_transmit_queue_drops_whole_frames_and_status_counts_them() {
+    use controller::downlink::FrameQueue;
+    use heapless::spsc::Queue;
+
+    let bytes = uplink();
+    // The END frame and the TIME frame after it, 18 bytes each.
+    let (body, end) = bytes.split_at(bytes.len() - 36);
+    let c = Controller::new(Config::default(), Scene::paper_default()).unwrap();
+    let mut s = Session::new(c);
+    let mut q: Queue<u8, 1024> = Queue::new();
+    let (producer, mut consumer) = q.split();
+    let mut tx = FrameQueue::<1024>::new(producer);
+    let mut wire = Vec::new();
+    let mut sent = 0u32;
+    // 8 bytes leave per byte received: about 210 per 20 ms tick, for 306 sent.
+    for &b in body {
+        s.feed(&[b], &mut Accept, |f| {
+            sent += 1;
+            tx.push(f)
+        });
+        wire.extend((0..8).map_while(|_| consumer.dequeue()));
+    }
+    // The link catches up before END, so that the final STATUS goes out.
+    wire.extend(core::iter::from_fn(|| consumer.dequeue()));
+    assert!(s.feed(end, &mut Accept, |f| {
+        sent += 1;
+        tx.push(f)
+    }));
+    wire.extend(core::iter::from_fn(|| consumer.dequeue()));
+
+    let mut received = 0u32;
+    let mut last_status = None;
+    let mut d = Decoder::new();
+    d.feed(&wire, |e| match e {
+        Event::Frame(f) if f.kind == kind::PERIODS => {
+            received += 1;
+            assert!(Periods::decode(f.payload).is_some());
+        }
+        Event::Frame(f) if f.kind == kind::STATUS => {
+            received += 1;
+            last_status = Some(Status::decode(f.payload).unwrap());
+        }
+        other => panic!("a frame was cut: {other:?}"),
+    });
+    assert_eq!(d.skipped_bytes, 0);
+    assert_eq!(sent, 105, "101 PERIODS and 4 STATUS");
+    assert!(s.downlink_dropped > 0, "the queue never overflowed");
+    assert_eq!(s.downlink_dropped, tx.dropped());
+    assert_eq!(received + s.downlink_dropped, sent);
+    assert_eq!(last_status.unwrap().downlink_dropped, s.downlink_dropped);
+}
+
+#[test]
+fn a_link_that_takes_every_frame_drops_none() {
+    let c = Controller::new(Config::default(), Scene::paper_default()).unwrap();
+    let mut s = Session::new(c);
+    let mut status = None;
+    s.feed(&uplink(), &mut Accept, |f| {
+        let mut d = Decoder::new();
+        d.feed(f, |e| {
+            if let Event::Frame(f) = e {
+                if f.kind == kind::STATUS {
+                    status = Some(Status::decode(f.payload).unwrap());
+                }
+            }
+        });
+        true
+    });
+    assert_eq!(s.downlink_dropped, 0);
+    assert_eq!(status.unwrap().downlink_dropped, 0);
+}

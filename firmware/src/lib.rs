@@ -3,8 +3,9 @@
 //! The firmware (`src/main.rs`) is the telemetry-driven line-rate controller, one
 //! module per step of the story:
 //! - telemetry in: [`link`] (an `embedded-hal-nb` serial port, byte by byte, never
-//!   waiting) and [`telemetry`] (the loop: bytes through the `controller` crate's
-//!   `Session`, frames back out);
+//!   waiting; whole frames out) and [`telemetry`] (the loop: bytes through the
+//!   `controller` crate's `Session`, frames back out); the UART's interrupts serve the
+//!   receive queue ([`rx`]) and the transmit queue ([`tx`]);
 //! - scene and math: the `controller` crate (the scene in force, its plan, the updates,
 //!   on core-math's real-Earth general form in f32, `GENERAL_F32`); no hardware in it;
 //! - line periods out: [`line_clock`] (the `controller::LinePeriodSink`: segment 0's
@@ -34,6 +35,7 @@ pub mod rx;
 pub mod stack;
 pub mod synthetic;
 pub mod telemetry;
+pub mod tx;
 
 use core_math::ModelError;
 

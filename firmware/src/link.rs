@@ -1,12 +1,17 @@
-//! The telemetry link as the rest of the firmware sees it: an `embedded-hal-nb` serial
-//! port of bytes (`serial::Read<u8>` and `serial::Write<u8>`, never blocking: a busy
-//! or empty port answers `WouldBlock`), plus [`RxWait`], the one thing those traits
-//! lack: a way to sleep until a byte may have arrived. Both boards read the port
-//! from their receive interrupt into a queue ([`crate::rx`]); the loop reads the queue.
-//! Any board's UART driver, or a host test double, provides it (the boards:
+//! The telemetry link as the rest of the firmware sees it: the receiver, an
+//! `embedded-hal-nb` serial port of bytes (`serial::Read<u8>`, never blocking: an empty
+//! port answers `WouldBlock`), plus [`RxWait`], the one thing those traits lack: a way
+//! to sleep until a byte may have arrived; and the transmitter, [`FrameTx`]: whole
+//! frames into a transmit queue, never waiting. Both boards read the port from their
+//! receive interrupt into a queue ([`crate::rx`]) and write it from their transmit
+//! interrupt out of another ([`crate::tx`]), each UART's transmitter behind
+//! `serial::Write<u8>` ([`crate::tx::TxPort`]); the loop reads one queue and fills the
+//! other. Any board's UART driver, or a host test double, provides it (the boards:
 //! [`crate::board`]).
 
-use embedded_hal_nb::serial::{self, ErrorKind, ErrorType, Read, Write};
+use embedded_hal_nb::serial::{self, ErrorKind, ErrorType, Read};
+
+use crate::tx::TxStats;
 
 /// Sleeping until the receiver may have something. A UART with a receive interrupt
 /// sleeps here (WFI); a plain polled link returns at once.
@@ -14,10 +19,30 @@ pub trait RxWait {
     fn wait_for_rx(&mut self);
 }
 
-/// Everything the telemetry loop needs of a link.
-pub trait Link: ErrorType<Error = LinkError> + Read<u8> + Write<u8> + RxWait {}
+/// The downlink: whole frames into a transmit queue that the UART's transmit interrupt
+/// drains. Nothing here waits for the UART.
+pub trait FrameTx {
+    /// Queues `frame` whole, or, if the queue has no room for all of it, drops it whole.
+    /// True if it was queued.
+    fn send_frame(&mut self, frame: &[u8]) -> bool;
+    /// Bytes the queue can take now (at least).
+    fn tx_room(&self) -> usize;
+    /// Sleeps until the transmit interrupt has run, unless the queue has room for
+    /// `bytes` bytes. False if sleeping could not end that way (the receive side holds
+    /// the transmit interrupt back until the next byte is read: `tx::TxQueue::wait_for_room`).
+    fn wait_for_tx_room(&mut self, bytes: usize) -> bool;
+    /// True when everything queued has left the UART.
+    fn tx_drained(&self) -> bool;
+    /// Sleeps until the transmit interrupt has run, unless everything has left.
+    fn wait_for_tx_drained(&mut self);
+    /// The transmit queue's statistics so far.
+    fn tx_stats(&self) -> TxStats;
+}
 
-impl<T: ErrorType<Error = LinkError> + Read<u8> + Write<u8> + RxWait> Link for T {}
+/// Everything the telemetry loop needs of a link.
+pub trait Link: ErrorType<Error = LinkError> + Read<u8> + RxWait + FrameTx {}
+
+impl<T: ErrorType<Error = LinkError> + Read<u8> + RxWait + FrameTx> Link for T {}
 
 /// Why a link lost bytes: what the UART reports, and the receive queue's overflow.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -79,52 +104,4 @@ impl serial::Error for LinkError {
             LinkError::Other => ErrorKind::Other,
         }
     }
-}
-
-/// How many times [`send_bounded`] polls a busy transmitter for one byte before it
-/// gives the frame up. Under QEMU a byte leaves in a few polls unless the host stops
-/// reading; on a board size it from the baud rate (one byte at 115 200 Bd is 87 us).
-pub const TX_POLL_LIMIT: u32 = 1_000_000;
-
-/// Why a frame was not sent whole.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum TxError {
-    /// The transmitter stayed busy for [`TX_POLL_LIMIT`] polls: the rest of the frame
-    /// was dropped.
-    Timeout,
-    /// The port reported an error: the rest of the frame was dropped.
-    Link,
-}
-
-/// Sends `bytes`, polling a busy transmitter at most [`TX_POLL_LIMIT`] times per byte:
-/// a link nobody reads costs a bounded delay and the frame, never the main loop.
-pub fn send_bounded<L: Write<u8>>(link: &mut L, bytes: &[u8]) -> Result<(), TxError> {
-    for &b in bytes {
-        let mut polls = 0u32;
-        loop {
-            match link.write(b) {
-                Ok(()) => break,
-                Err(nb::Error::WouldBlock) => {
-                    polls += 1;
-                    if polls >= TX_POLL_LIMIT {
-                        return Err(TxError::Timeout);
-                    }
-                }
-                Err(nb::Error::Other(_)) => return Err(TxError::Link),
-            }
-        }
-    }
-    Ok(())
-}
-
-/// Waits (bounded as [`send_bounded`]) until the transmitter has sent everything; false
-/// if it never did, or reported an error.
-pub fn flush_bounded<L: Write<u8>>(link: &mut L) -> bool {
-    (0..TX_POLL_LIMIT)
-        .find_map(|_| match link.flush() {
-            Ok(()) => Some(true),
-            Err(nb::Error::WouldBlock) => None,
-            Err(nb::Error::Other(_)) => Some(false),
-        })
-        .unwrap_or(false)
 }

@@ -14,7 +14,8 @@ use controller::{Config, Controller, Scene};
 use cortex_m_rt::entry;
 use firmware::board::{self, Parts};
 use firmware::line_clock::LineClocks;
-use firmware::{platform, rx, stack, telemetry};
+use firmware::link::FrameTx;
+use firmware::{platform, rx, stack, telemetry, tx};
 use static_cell::StaticCell;
 
 /// The controller and its link state live here, not on `main`'s stack: the stack
@@ -77,12 +78,26 @@ fn main() -> ! {
                 rx::QUEUE_SLOTS - 1,
                 queue.stalls
             );
-            if summary.tx_dropped == 0 && summary.rx_errors == 0 && clocks.errors == 0 {
+            let sent = link.tx_stats();
+            defmt::info!(
+                "transmit queue: at most {=u32} of {=usize} bytes held, the loop slept {=u32} times for room, {=u32} frames dropped whole, {=u32} transmit errors",
+                sent.high_water,
+                tx::QUEUE_SLOTS - 1,
+                summary.tx_waits,
+                sent.dropped,
+                sent.errors
+            );
+            if summary.tx_dropped == 0
+                && sent.errors == 0
+                && summary.rx_errors == 0
+                && clocks.errors == 0
+            {
                 0
             } else {
                 defmt::error!(
-                    "{=u32} downlink frames dropped, {=u32} receive errors, {=u32} line clock writes refused",
+                    "{=u32} downlink frames dropped, {=u32} transmit errors, {=u32} receive errors, {=u32} line clock writes refused",
                     summary.tx_dropped,
+                    sent.errors,
                     summary.rx_errors,
                     clocks.errors
                 );

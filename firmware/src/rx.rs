@@ -210,6 +210,12 @@ impl<I: InterruptNumber> RxQueue<I> {
         Ok(byte)
     }
 
+    /// True if the receive interrupt has masked `line` because the queue was full (the
+    /// next [`RxQueue::read`] unmasks it): `line` is this queue's, and it stalled.
+    pub fn holds(&self, line: u16) -> bool {
+        self.line.number() == line && SHARED.stalled.load(Ordering::Acquire)
+    }
+
     fn next_error(&mut self) -> Option<LinkError> {
         LinkError::ALL
             .into_iter()

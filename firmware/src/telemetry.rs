@@ -3,23 +3,30 @@
 //! line periods to the sink), and the frames it answers with (PERIODS after each
 //! update, STATUS every second and at the end) go back out on the same link.
 //!
-//! The loop never waits on the link for long: it polls the receiver and, when it is
-//! empty, sleeps until the receive interrupt is pending (a new byte, and nothing else,
-//! can wake it: there is nothing else to do before one arrives), and a transmitter that stops taking bytes costs at most
-//! [`crate::link::TX_POLL_LIMIT`] polls per frame, after which the frame is dropped and
-//! counted. The controller's time comes from the telemetry's time tags (NAV and TIME
-//! frames): under QEMU the host player is the time source, which keeps a pass
+//! The loop never polls the link: when the receive queue is empty it sleeps until the
+//! receive interrupt is pending (a new byte, and nothing else, can wake it: there is
+//! nothing else to do before one arrives); it hands every frame whole to the transmit
+//! queue, which the UART's transmit interrupt drains ([`crate::tx`]), a frame the queue
+//! has no room for being dropped whole and counted in STATUS (*downlink frames
+//! dropped*); and before it takes the next byte it makes sure the transmit queue has
+//! room for everything that byte can make the session send, sleeping until the
+//! transmit interrupt has made it if not, so that a slow downlink holds the uplink back
+//! instead of losing frames (docs/telemetry.md, "The transmit queue"). At the end of a
+//! pass it sleeps until the queue has drained, so that the final STATUS leaves before
+//! the firmware exits. The controller's time comes from the telemetry's time tags (NAV
+//! and TIME frames): under QEMU the host player is the time source, which keeps a pass
 //! reproducible to the bit. The board's [`Monotonic`] clock times the loop instead: the
 //! longest step (one byte through the session: an update and its PERIODS frame at
 //! worst) is reported at the end of the pass, the figure that says whether a polled
 //! receiver keeps up on a real board. (Letting the board's clock also drive updates
 //! between frames, [`Session::tick`], needs a clock whose rate is right: not QEMU's.)
 
+use controller::downlink::MAX_STEP_OUTPUT;
 use controller::session::Session;
 use controller::{LinePeriodSink, Mode};
 
 use crate::board::Monotonic;
-use crate::link::{flush_bounded, send_bounded, Link};
+use crate::link::Link;
 
 /// The words of the firmware's first log line that say the link is up: the host's pass
 /// player waits for them before it sends a byte (xtask/src/qemu/pass.rs).
@@ -28,8 +35,11 @@ pub const READY: &str = "telemetry link ready";
 /// How a pass ended.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Summary {
-    /// Downlink frames given up because the transmitter stayed busy or failed.
+    /// Downlink frames dropped whole because the transmit queue had no room for them.
     pub tx_dropped: u32,
+    /// Times the loop found less room in the transmit queue than one step may need, and
+    /// slept until the transmit interrupt had made some.
+    pub tx_waits: u32,
     /// Errors the receiver reported (overrun, framing, noise, parity): bytes lost, which
     /// the decoder then counts as a broken frame.
     pub rx_errors: u32,
@@ -46,6 +56,7 @@ pub fn run<L: Link, S: LinePeriodSink, C: Monotonic>(
 ) -> Summary {
     let mut summary = Summary {
         tx_dropped: 0,
+        tx_waits: 0,
         rx_errors: 0,
         longest_step_us: 0,
     };
@@ -53,6 +64,13 @@ pub fn run<L: Link, S: LinePeriodSink, C: Monotonic>(
     let mut mode = session.controller.mode();
     let started_us = clock.now_us();
     loop {
+        // Room first for everything the next byte can make the session send (a PERIODS
+        // and a STATUS frame): the downlink paces the uplink, as the receive queue's
+        // stall paces the ground (docs/telemetry.md, "The transmit queue").
+        if link.tx_room() < MAX_STEP_OUTPUT && link.wait_for_tx_room(MAX_STEP_OUTPUT) {
+            summary.tx_waits = summary.tx_waits.saturating_add(1);
+            continue;
+        }
         let byte = match link.read() {
             Ok(byte) => byte,
             Err(nb::Error::WouldBlock) => {
@@ -72,18 +90,13 @@ pub fn run<L: Link, S: LinePeriodSink, C: Monotonic>(
             }
         };
         let step_start_us = clock.now_us();
-        let ended = session.feed(&[byte], sink, |frame| {
-            if send_bounded(link, frame).is_err() {
-                summary.tx_dropped = summary.tx_dropped.saturating_add(1);
-            }
-        });
+        let ended = session.feed(&[byte], sink, |frame| link.send_frame(frame));
         let step_us = clock.now_us().saturating_sub(step_start_us);
         summary.longest_step_us = summary.longest_step_us.max(step_us);
         report_changes(session, &mut faults, &mut mode);
         if ended {
-            if !flush_bounded(link) {
-                summary.tx_dropped = summary.tx_dropped.saturating_add(1);
-            }
+            drain(link);
+            summary.tx_dropped = session.downlink_dropped;
             let c = &session.controller;
             defmt::info!(
                 "end of pass at t = {=u64} us: {=u32} frames accepted, {=u32} updates, {=u32} faults, {=u32} noise bytes skipped, {=u32} downlink frames dropped",
@@ -101,6 +114,17 @@ pub fn run<L: Link, S: LinePeriodSink, C: Monotonic>(
             );
             return summary;
         }
+    }
+}
+
+/// Waits until every queued byte has left the UART, sleeping between transmit interrupts.
+/// Bytes that still arrive are read and ignored (the pass has ended): reading them lets
+/// a receive side that stalled its queue unmask its line, which on the STM32F405 is the
+/// transmitter's too.
+fn drain<L: Link>(link: &mut L) {
+    while !link.tx_drained() {
+        while link.read().is_ok() {}
+        link.wait_for_tx_drained();
     }
 }
 

@@ -965,6 +965,8 @@ impl Harness {
         assert_eq!(s.skipped_bytes, self.model.skipped_bytes);
         assert_eq!(s.time_resyncs, self.model.time_resyncs);
         assert_eq!(&s.counts, c.counters.as_array());
+        // The model's link takes every frame.
+        assert_eq!(s.downlink_dropped, 0);
         self.check();
     }
 }

@@ -16,7 +16,9 @@
 //! full while the host end of the chardev does not accept the byte. On silicon the
 //! receive side overruns instead (STATE.RXOVERRUN) if a byte is not read within one
 //! character time: so the receive interrupt reads every byte into the queue of
-//! [`crate::rx`], and the loop takes them from there.
+//! [`crate::rx`], and the loop takes them from there. The transmit interrupt (raised when
+//! TXFULL goes from set to clear with CTRL.TXINTEN, latched in INTSTATUS.TX) writes the
+//! bytes the loop queued ([`crate::tx`]).
 
 use core::marker::PhantomData;
 use core::ops::Deref;
@@ -26,8 +28,9 @@ use embedded_hal_nb::serial::{ErrorKind, ErrorType, Read, Write};
 
 use super::{Extended, Monotonic};
 use crate::line_clock::ReloadRegister;
-use crate::link::{LinkError, RxWait};
+use crate::link::{FrameTx, LinkError, RxWait};
 use crate::rx::{self, RxQueue};
+use crate::tx::{self, TxPort, TxQueue, TxStats};
 
 /// The APB UART's registers (TRM, "APB UART"; QEMU hw/char/cmsdk-apb-uart.c).
 pub mod uart {
@@ -70,8 +73,12 @@ pub mod uart {
     pub const CTRL_TX_EN: u32 = 1 << 0;
     /// CTRL: receiver enable.
     pub const CTRL_RX_EN: u32 = 1 << 1;
+    /// CTRL: transmit interrupt enable.
+    pub const CTRL_TX_INTEN: u32 = 1 << 2;
     /// CTRL: receive interrupt enable.
     pub const CTRL_RX_INTEN: u32 = 1 << 3;
+    /// INTSTATUS / INTCLEAR: transmit interrupt.
+    pub const INT_TX: u32 = 1 << 0;
     /// INTSTATUS / INTCLEAR: receive interrupt.
     pub const INT_RX: u32 = 1 << 1;
     /// The smallest BAUDDIV the UART accepts (QEMU ignores smaller values).
@@ -157,75 +164,126 @@ pub type UartRegisters<const ADDR: usize> = Peripheral<uart::RegisterBlock, ADDR
 /// The registers of the CMSDK APB timer at `ADDR`.
 pub type TimerRegisters<const ADDR: usize> = Peripheral<timer::RegisterBlock, ADDR>;
 
-/// A CMSDK APB UART at `ADDR`, the loop's side: the transmitter, and the receive queue
-/// that the receive interrupt (line `I`) fills.
-pub struct Uart<const ADDR: usize, I> {
-    /// Used for DATA writes and STATE.TXFULL only; the receive registers are the
-    /// interrupt's ([`UartRx`]).
-    tx: UartRegisters<ADDR>,
-    rx: RxQueue<I>,
+/// A CMSDK APB UART at `ADDR`, the loop's side: the receive queue that the receive
+/// interrupt (line `R`) fills, and the transmit queue that the transmit interrupt (line
+/// `T`) drains. The registers are the interrupts' ([`UartRx`], [`UartTx`]).
+pub struct Uart<const ADDR: usize, R, T> {
+    rx: RxQueue<R>,
+    tx: TxQueue<T>,
 }
 
 /// The receiver of the UART at `ADDR`, read by the receive interrupt only: DATA reads,
-/// STATE's receive bits, INTSTATUS (the transmitter's DATA writes and STATE.TXFULL are
-/// the loop's; the status bits are write-1-to-clear, so the two sides never undo each
-/// other's writes).
+/// STATE's receive bits, INTSTATUS.RX (the transmitter's DATA writes, STATE.TXFULL and
+/// INTSTATUS.TX are the transmit interrupt's; the status bits are write-1-to-clear, so
+/// the two sides never undo each other's writes).
 pub struct UartRx<const ADDR: usize> {
     regs: UartRegisters<ADDR>,
 }
 
-impl<const ADDR: usize, I: InterruptNumber> Uart<ADDR, I> {
+/// The transmitter of the UART at `ADDR`, written by the transmit interrupt only: DATA
+/// writes, STATE.TXFULL, INTSTATUS.TX.
+pub struct UartTx<const ADDR: usize> {
+    regs: UartRegisters<ADDR>,
+}
+
+impl<const ADDR: usize, R: InterruptNumber, T: InterruptNumber> Uart<ADDR, R, T> {
     /// The UART, enabled for transmit and receive at `baud` (8N1) from the APB clock
-    /// `pclk_hz`, its receive interrupt `line` feeding the receive queue through
-    /// `handler` (the line's interrupt handler must call `handler.run()`). None if the
-    /// queue was taken before.
+    /// `pclk_hz`, its receive interrupt `rx_line` feeding the receive queue through
+    /// `rx_handler`, its transmit interrupt `tx_line` draining the transmit queue through
+    /// `tx_handler` (each line's interrupt handler must call its handler's `run()`).
+    /// None if a queue was taken before.
     ///
     /// # Safety
     /// A CMSDK APB UART must be mapped at `ADDR`, and the caller must be its only owner.
     pub unsafe fn start(
         pclk_hz: u32,
         baud: u32,
-        handler: &'static rx::Handler<UartRx<ADDR>, I>,
-        line: I,
+        (rx_handler, rx_line): (&'static rx::Handler<UartRx<ADDR>, R>, R),
+        (tx_handler, tx_line): (&'static tx::Handler<UartTx<ADDR>>, T),
     ) -> Option<Self> {
-        // SAFETY: the caller's contract; this handle and the receiver's below split the
-        // UART's registers as their types document.
-        let (tx, regs) = unsafe { (UartRegisters::new(), UartRegisters::new()) };
+        // SAFETY: the caller's contract; the three handles split the UART's registers as
+        // their types document (set-up here, then the receiver's and the transmitter's).
+        let (regs, rx_regs, tx_regs): (UartRegisters<ADDR>, _, _) = unsafe {
+            (
+                UartRegisters::new(),
+                UartRegisters::new(),
+                UartRegisters::new(),
+            )
+        };
         let div = (pclk_hz / baud.max(1)).max(uart::BAUDDIV_MIN);
         // SAFETY: a divider of at least the minimum sets the bit rate, nothing else; the
-        // enables start the transmitter and the receiver with its interrupt, whose
-        // handler (`handler`) is installed, before the line is unmasked, by `rx::start`.
+        // enables start the transmitter and the receiver with their interrupts, whose
+        // handlers are installed, before their lines are unmasked, by `rx::start` and
+        // `tx::start`.
         unsafe {
-            tx.bauddiv.write(div);
-            tx.ctrl
-                .write(uart::CTRL_TX_EN | uart::CTRL_RX_EN | uart::CTRL_RX_INTEN);
+            regs.bauddiv.write(div);
+            regs.ctrl.write(
+                uart::CTRL_TX_EN | uart::CTRL_RX_EN | uart::CTRL_TX_INTEN | uart::CTRL_RX_INTEN,
+            );
         }
-        let rx = rx::start(handler, UartRx { regs }, line)?;
-        Some(Uart { tx, rx })
+        let rx = rx::start(rx_handler, UartRx { regs: rx_regs }, rx_line)?;
+        let tx = tx::start(tx_handler, UartTx { regs: tx_regs }, tx_line)?;
+        Some(Uart { rx, tx })
     }
 }
 
-impl<const ADDR: usize, I> ErrorType for Uart<ADDR, I> {
+impl<const ADDR: usize, R, T> ErrorType for Uart<ADDR, R, T> {
     type Error = LinkError;
 }
 
-impl<const ADDR: usize, I: InterruptNumber> Read<u8> for Uart<ADDR, I> {
+impl<const ADDR: usize, R: InterruptNumber, T> Read<u8> for Uart<ADDR, R, T> {
     fn read(&mut self) -> nb::Result<u8, LinkError> {
         self.rx.read()
     }
 }
 
-impl<const ADDR: usize, I: InterruptNumber> Write<u8> for Uart<ADDR, I> {
-    fn write(&mut self, byte: u8) -> nb::Result<(), LinkError> {
+impl<const ADDR: usize, R: InterruptNumber, T> RxWait for Uart<ADDR, R, T> {
+    fn wait_for_rx(&mut self) {
+        self.rx.wait();
+    }
+}
+
+impl<const ADDR: usize, R: InterruptNumber, T: InterruptNumber> FrameTx for Uart<ADDR, R, T> {
+    fn send_frame(&mut self, frame: &[u8]) -> bool {
+        self.tx.send(frame)
+    }
+    fn tx_room(&self) -> usize {
+        self.tx.room()
+    }
+    fn wait_for_tx_room(&mut self, bytes: usize) -> bool {
+        self.tx.wait_for_room(bytes, &self.rx)
+    }
+    fn tx_drained(&self) -> bool {
+        self.tx.drained()
+    }
+    fn wait_for_tx_drained(&mut self) {
+        self.tx.wait_for_drain();
+    }
+    fn tx_stats(&self) -> TxStats {
+        self.tx.stats()
+    }
+}
+
+impl<const ADDR: usize> ErrorType for UartTx<ADDR> {
+    type Error = ErrorKind;
+}
+
+impl<const ADDR: usize> Write<u8> for UartTx<ADDR> {
+    /// Writes the byte if the one-byte transmit buffer is empty. The transmit
+    /// interrupt's status is cleared first, so the byte's leaving raises it again.
+    fn write(&mut self, byte: u8) -> nb::Result<(), ErrorKind> {
+        // SAFETY: writing 1 clears the transmit interrupt's status bit, the other bits
+        // written 0 are left alone.
+        unsafe { self.regs.intstatus.write(uart::INT_TX) };
         self.flush()?;
         // SAFETY: the transmit buffer is empty (`flush`): DATA takes the byte to send.
-        unsafe { self.tx.data.write(u32::from(byte)) };
+        unsafe { self.regs.data.write(u32::from(byte)) };
         Ok(())
     }
 
     /// Done when the one-byte transmit buffer is empty.
-    fn flush(&mut self) -> nb::Result<(), LinkError> {
-        if self.tx.state.read() & uart::STATE_TX_FULL == 0 {
+    fn flush(&mut self) -> nb::Result<(), ErrorKind> {
+        if self.regs.state.read() & uart::STATE_TX_FULL == 0 {
             Ok(())
         } else {
             Err(nb::Error::WouldBlock)
@@ -233,9 +291,18 @@ impl<const ADDR: usize, I: InterruptNumber> Write<u8> for Uart<ADDR, I> {
     }
 }
 
-impl<const ADDR: usize, I: InterruptNumber> RxWait for Uart<ADDR, I> {
-    fn wait_for_rx(&mut self) {
-        self.rx.wait();
+impl<const ADDR: usize> TxPort for UartTx<ADDR> {
+    /// CTRL.TXINTEN stays set: the UART raises its transmit interrupt when a byte leaves
+    /// the buffer, an event latched in INTSTATUS.TX until cleared. Every `write` clears
+    /// it before it looks at the buffer, so a byte that leaves later raises it anew: to
+    /// be interrupted again nothing is to be done (clearing it here could lose that
+    /// byte's event). Not to be: the buffer is empty, so the status is cleared.
+    fn interrupt(&mut self, on: bool) {
+        if !on {
+            // SAFETY: writing 1 clears the transmit interrupt's status bit, the other
+            // bits written 0 are left alone.
+            unsafe { self.regs.intstatus.write(uart::INT_TX) };
+        }
     }
 }
 

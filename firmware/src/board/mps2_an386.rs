@@ -9,17 +9,17 @@
 
 use core::sync::atomic::{AtomicBool, Ordering};
 
-use super::cmsdk::{FreeRunning, Timer, Uart, UartRx};
+use super::cmsdk::{FreeRunning, Timer, Uart, UartRx, UartTx};
 use super::{BoardError, Parts, LINK_BAUD};
 use crate::platform;
-use crate::rx;
+use crate::{rx, tx};
 
 /// The board's name (the cargo feature).
 pub const NAME: &str = "mps2-an386";
 /// The telemetry link's peripheral.
 pub const LINK: &str = "UART0";
 /// The board's telemetry link, segment 0's line clock and clock.
-pub type Link = Uart<UART0_BASE, Uart0Rx>;
+pub type Link = Uart<UART0_BASE, Uart0Rx, Uart0Tx>;
 pub type LineClock = Timer<TIMER0_BASE>;
 pub type Clock = FreeRunning<TIMER1_BASE, PCLK_HZ>;
 
@@ -34,7 +34,7 @@ const TIMER1_BASE: usize = 0x4000_1000;
 const PCLK_HZ: u32 = 25_000_000;
 
 /// Brings the board up: UART0 at 115 200 Bd, its receive interrupt feeding the receive
-/// queue, TIMER0 stopped until its first period, TIMER1 running. Call once.
+/// queue and its transmit interrupt draining the transmit queue, TIMER0 stopped until its first period, TIMER1 running. Call once.
 pub fn take() -> Result<Parts<Link, LineClock, Clock>, BoardError> {
     // The same guard as a HAL's `Peripherals::take`: a second call gets nothing.
     static TAKEN: AtomicBool = AtomicBool::new(false);
@@ -46,7 +46,8 @@ pub fn take() -> Result<Parts<Link, LineClock, Clock>, BoardError> {
     // TIMER0 or TIMER1.
     let (link, line_clock, clock) = unsafe {
         (
-            Link::start(PCLK_HZ, LINK_BAUD, &RX, Uart0Rx).ok_or(BoardError::Taken)?,
+            Link::start(PCLK_HZ, LINK_BAUD, (&RX, Uart0Rx), (&TX, Uart0Tx))
+                .ok_or(BoardError::Taken)?,
             LineClock::stopped(),
             Clock::start(),
         )
@@ -72,17 +73,35 @@ unsafe impl cortex_m::interrupt::InterruptNumber for Uart0Rx {
     }
 }
 
+/// UART0's transmit interrupt on the mps2-an386 (NVIC line 1: each UART's TX line is
+/// its RX line + 1; QEMU hw/arm/mps2.c).
+#[derive(Clone, Copy)]
+pub struct Uart0Tx;
+
+const UART0_TX_IRQ: u16 = 1;
+
+// SAFETY: 1 is the NVIC line QEMU's mps2-an386 wires UART0's TX interrupt to.
+unsafe impl cortex_m::interrupt::InterruptNumber for Uart0Tx {
+    fn number(self) -> u16 {
+        UART0_TX_IRQ
+    }
+}
+
 /// The receive interrupt's state: UART0's receiver and the queue's producer.
 static RX: rx::Handler<UartRx<UART0_BASE>, Uart0Rx> = rx::Handler::new();
+/// The transmit interrupt's state: UART0's transmitter and the queue's consumer.
+static TX: tx::Handler<UartTx<UART0_BASE>> = tx::Handler::new();
 
 /// Every device interrupt. The mps2-an386 has no peripheral access crate to name its
 /// vectors, so cortex-m-rt's default vector table sends them all here with their
-/// number; only UART0's receive interrupt is ever unmasked. (`unsafe` because
+/// number; only UART0's receive and transmit interrupts are ever unmasked. (`unsafe` because
 /// cortex-m-rt asks it of a `DefaultHandler`; nothing in it is.)
 #[cortex_m_rt::exception]
 unsafe fn DefaultHandler(irqn: i16) {
     if irqn == UART0_RX_IRQ as i16 {
         RX.run();
+    } else if irqn == UART0_TX_IRQ as i16 {
+        TX.run();
     } else {
         defmt::error!("unexpected interrupt {=i16}", irqn);
         platform::exit(platform::EXIT_UNEXPECTED_INTERRUPT)

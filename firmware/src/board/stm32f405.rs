@@ -7,9 +7,10 @@
 //!   run the PLL from a crystal so that a timer counts the scene's 10 MHz line clock
 //!   exactly.
 //! - Link: USART1 on PA9 (TX) and PA10 (RX), 115 200 Bd 8N1, through the HAL's
-//!   `embedded-hal-nb` serial port, split: the receive interrupt (RXNE) reads the
-//!   receiver into the queue of [`crate::rx`], the loop takes the bytes from there and
-//!   keeps the transmitter.
+//!   `embedded-hal-nb` serial port, split: USART1's interrupt reads the receiver (RXNE)
+//!   into the queue of [`crate::rx`] and writes the transmitter (TXE, enabled only while
+//!   bytes wait) from the queue of [`crate::tx`]; the loop takes received bytes from the
+//!   one and puts whole frames in the other.
 //! - Line clock: TIM2 (32-bit) counting the timer clock (PSC 0), segment 0's period in
 //!   its auto-reload register with preload (ARPE), so a new period starts at the end of
 //!   the current line, never in the middle of one.
@@ -25,14 +26,15 @@
 use embedded_hal_nb::serial::{Error as _, ErrorType, Read, Write};
 use stm32f4xx_hal::pac::{self, interrupt, Interrupt};
 use stm32f4xx_hal::prelude::*;
-use stm32f4xx_hal::serial::{Event, Rx, Serial, Tx};
+use stm32f4xx_hal::serial::{Event, Rx, Serial, Tx, TxListen};
 use stm32f4xx_hal::timer::{CounterUs, Timer};
 use stm32f4xx_hal::Listen;
 
 use super::{BoardError, Extended, Monotonic, Parts, LINK_BAUD};
 use crate::line_clock::ReloadRegister;
-use crate::link::{LinkError, RxWait};
+use crate::link::{FrameTx, LinkError, RxWait};
 use crate::rx::{self, RxQueue};
+use crate::tx::{self, TxPort, TxQueue, TxStats};
 
 /// The board's name (the cargo feature).
 pub const NAME: &str = "stm32f405";
@@ -45,14 +47,20 @@ pub type Clock = Tim5Clock;
 
 /// The receive interrupt's state: USART1's receiver and the queue's producer.
 static RX: rx::Handler<Rx<pac::USART1, u8>, Interrupt> = rx::Handler::new();
+/// The transmit interrupt's state: USART1's transmitter and the queue's consumer.
+static TX: tx::Handler<Usart1Tx> = tx::Handler::new();
 
+/// USART1's one interrupt, for both directions. The receive side masks the line while its
+/// queue is full (`rx`), which holds the transmitter back too until the loop takes the
+/// next byte (`tx::TxQueue::wait_for_room`).
 #[interrupt]
 fn USART1() {
     RX.run();
+    TX.run();
 }
 
-/// Brings the board up: HSI clocks, USART1 at 115 200 Bd, its receive interrupt feeding
-/// the receive queue, TIM2 stopped until its first period, TIM5 counting. Call once.
+/// Brings the board up: HSI clocks, USART1 at 115 200 Bd, its interrupt feeding the
+/// receive queue and draining the transmit queue, TIM2 stopped until its first period, TIM5 counting. Call once.
 pub fn take() -> Result<Parts<Link, LineClock, Clock>, BoardError> {
     let dp = pac::Peripherals::take().ok_or(BoardError::Taken)?;
     // The clocks as reset leaves them: HSI 16 MHz, every bus undivided (`freeze` would
@@ -68,8 +76,9 @@ pub fn take() -> Result<Parts<Link, LineClock, Clock>, BoardError> {
         )
         .map_err(|_| BoardError::SerialConfig)?;
     serial.listen(Event::RxNotEmpty);
-    let (tx, receiver) = serial.split();
+    let (transmitter, receiver) = serial.split();
     let rx = rx::start(&RX, receiver, Interrupt::USART1).ok_or(BoardError::Taken)?;
+    let tx = tx::start(&TX, Usart1Tx(transmitter), Interrupt::USART1).ok_or(BoardError::Taken)?;
 
     let timer_clock_hz = rcc.clocks.timclk1().raw();
     let tim2 = Timer::new(dp.TIM2, &mut rcc).release();
@@ -94,12 +103,15 @@ pub fn take() -> Result<Parts<Link, LineClock, Clock>, BoardError> {
     })
 }
 
-/// USART1, the loop's side: the HAL's transmitter, and the receive queue the interrupt
-/// fills.
+/// USART1, the loop's side: the receive queue the interrupt fills and the transmit queue
+/// it drains.
 pub struct Usart1 {
-    tx: Tx<pac::USART1, u8>,
+    tx: TxQueue<Interrupt>,
     rx: RxQueue<Interrupt>,
 }
+
+/// USART1's transmitter, the HAL's, written by the interrupt only.
+pub struct Usart1Tx(Tx<pac::USART1, u8>);
 
 impl ErrorType for Usart1 {
     type Error = LinkError;
@@ -111,16 +123,54 @@ impl Read<u8> for Usart1 {
     }
 }
 
-impl Write<u8> for Usart1 {
+impl FrameTx for Usart1 {
+    fn send_frame(&mut self, frame: &[u8]) -> bool {
+        self.tx.send(frame)
+    }
+    fn tx_room(&self) -> usize {
+        self.tx.room()
+    }
+    fn wait_for_tx_room(&mut self, bytes: usize) -> bool {
+        self.tx.wait_for_room(bytes, &self.rx)
+    }
+    fn tx_drained(&self) -> bool {
+        self.tx.drained()
+    }
+    fn wait_for_tx_drained(&mut self) {
+        self.tx.wait_for_drain();
+    }
+    fn tx_stats(&self) -> TxStats {
+        self.tx.stats()
+    }
+}
+
+impl ErrorType for Usart1Tx {
+    type Error = LinkError;
+}
+
+impl Write<u8> for Usart1Tx {
     fn write(&mut self, byte: u8) -> nb::Result<(), LinkError> {
-        self.tx
+        self.0
             .write(byte)
             .map_err(|e| e.map(|e| LinkError::from_kind(e.kind())))
     }
+    /// Done when the last byte has left the shift register (TC).
     fn flush(&mut self) -> nb::Result<(), LinkError> {
-        self.tx
+        self.0
             .flush()
             .map_err(|e| e.map(|e| LinkError::from_kind(e.kind())))
+    }
+}
+
+impl TxPort for Usart1Tx {
+    /// TXE is a level (the data register is empty), so its interrupt is enabled only
+    /// while bytes wait or the last one is still leaving (one character time).
+    fn interrupt(&mut self, on: bool) {
+        if on {
+            TxListen::listen(&mut self.0);
+        } else {
+            TxListen::unlisten(&mut self.0);
+        }
     }
 }
 

@@ -212,6 +212,15 @@ impl Played {
         if self.compared == 0 {
             problems.push("no period was compared with the reference".into());
         }
+        if let Some(n) = self
+            .final_status
+            .map(|s| s.downlink_dropped)
+            .filter(|&n| n > 0)
+        {
+            problems.push(format!(
+                "the firmware dropped {n} downlink frames whole (its transmit queue had no room: STATUS)"
+            ));
+        }
         problems.extend(self.reference_failures.iter().take(5).cloned());
         problems.extend(self.changed_examples.iter().take(5).cloned());
         problems.extend(self.count_failures.iter().cloned());
