@@ -3,8 +3,10 @@
 
 use std::convert::Infallible;
 
-use controller::frame::{encode, kind, MAX_FRAME};
+use controller::frame::{encode, kind, Decoder, Event, MAX_FRAME};
 use controller::nav::{Attitude, Nav};
+use controller::report::{encode_periods, Periods};
+use controller::{Controller, Fault};
 use core_math::{StateVector, GM_M3_S2};
 
 pub const R: f64 = 6_371_000.0;
@@ -62,4 +64,38 @@ pub fn frame(kind: u8, seq: u16, time_us: u64, payload: &[u8]) -> Vec<u8> {
     let mut buf = [0u8; MAX_FRAME];
     let n = encode(kind, seq, time_us, payload, &mut buf).unwrap();
     buf[..n].to_vec()
+}
+
+/// The orbit the controller tests fly: inclination (deg) and altitude (m).
+pub const I0: f64 = 97.98;
+pub const H: f64 = 645e3;
+
+/// Feeds bytes through a fresh decoder into the controller, counting rejections.
+pub fn feed(c: &mut Controller, bytes: &[u8]) {
+    let mut d = Decoder::new();
+    d.feed(bytes, |e| match e {
+        Event::Frame(f) => c.on_frame(&f),
+        Event::Rejected(r) => c.reject(Fault::from(r)),
+    });
+}
+
+/// A period sink that records every write (segment index, ticks).
+#[derive(Default)]
+pub struct Registers {
+    pub writes: Vec<(u8, u32)>,
+}
+
+impl controller::LinePeriodSink for Registers {
+    type Error = Infallible;
+    fn write_period(&mut self, index: u8, ticks: u32) -> Result<(), Infallible> {
+        self.writes.push((index, ticks));
+        Ok(())
+    }
+}
+
+/// The PERIODS frame the controller would send now, decoded.
+pub fn periods(c: &Controller) -> Periods {
+    let mut buf = [0u8; MAX_FRAME];
+    let n = encode_periods(c, &mut buf).unwrap();
+    Periods::decode(&buf[..n]).unwrap()
 }

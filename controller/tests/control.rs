@@ -4,40 +4,14 @@
 
 mod common;
 
-use std::convert::Infallible;
-
-use common::{nav_frame, roll, state};
-use controller::frame::{encode, kind, Decoder, Event, MAX_FRAME};
+use common::{feed, nav_frame, roll, state, Registers, H, I0};
+use controller::frame::{encode, kind, MAX_FRAME};
 use controller::golden;
 use controller::nav::Attitude;
-use controller::{Config, Controller, Fault, LinePeriodSink, Mode, Scene, Terrain, EARTH};
+use controller::{Config, Controller, Fault, Mode, Scene, Terrain, EARTH};
 use core_math::earth::EarthGeometry;
 use core_math::{Backend, EarthReference};
 use proptest::prelude::*;
-
-#[derive(Default)]
-struct Registers {
-    writes: Vec<(u8, u32)>,
-}
-
-impl LinePeriodSink for Registers {
-    type Error = Infallible;
-    fn write_period(&mut self, index: u8, ticks: u32) -> Result<(), Infallible> {
-        self.writes.push((index, ticks));
-        Ok(())
-    }
-}
-
-const I0: f64 = 97.98;
-const H: f64 = 645e3;
-
-fn feed(c: &mut Controller, bytes: &[u8]) {
-    let mut d = Decoder::new();
-    d.feed(bytes, |e| match e {
-        Event::Frame(f) => c.on_frame(&f),
-        Event::Rejected(r) => c.reject(Fault::from(r)),
-    });
-}
 
 /// An agile imaging scene: the paper's camera as a staggered mosaic (alternate chips
 /// 3 mm ahead of and behind the axis), over mountains.

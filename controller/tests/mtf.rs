@@ -7,22 +7,11 @@
 
 mod common;
 
-use common::{nav_frame, state, Accept};
-use controller::frame::{Decoder, Event};
+use common::{feed, nav_frame, state, Accept, H, I0};
 use controller::nav::Attitude;
-use controller::{Config, Controller, Fault, Scene};
+use controller::{Config, Controller, Scene};
 
-const I0: f64 = 97.98;
-const H: f64 = 645e3;
 const HALF_PI: f64 = std::f64::consts::FRAC_PI_2;
-
-fn feed(c: &mut Controller, bytes: &[u8]) {
-    let mut d = Decoder::new();
-    d.feed(bytes, |e| match e {
-        Event::Frame(f) => c.on_frame(&f),
-        Event::Rejected(r) => c.reject(Fault::from(r)),
-    });
-}
 
 /// |sin(x)/x| in f64, 1 at 0.
 fn modulus_sinc(x: f64) -> f64 {

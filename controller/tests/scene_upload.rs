@@ -5,50 +5,15 @@
 
 mod common;
 
-use std::convert::Infallible;
-
-use common::{nav_frame, roll, state};
-use controller::frame::{encode, kind, Decoder, Event, MAX_FRAME};
-use controller::report::{encode_periods, Periods};
-use controller::{Config, Controller, Fault, LinePeriodSink, Scene, SegmentOutput};
-
-#[derive(Default)]
-struct Registers {
-    writes: Vec<(u8, u32)>,
-}
-
-impl LinePeriodSink for Registers {
-    type Error = Infallible;
-    fn write_period(&mut self, index: u8, ticks: u32) -> Result<(), Infallible> {
-        self.writes.push((index, ticks));
-        Ok(())
-    }
-}
-
-const I0: f64 = 97.98;
-const H: f64 = 645e3;
-
-fn feed(c: &mut Controller, bytes: &[u8]) {
-    let mut d = Decoder::new();
-    d.feed(bytes, |e| match e {
-        Event::Frame(f) => c.on_frame(&f),
-        Event::Rejected(r) => c.reject(Fault::from(r)),
-    });
-}
+use common::{feed, frame, nav_frame, periods, roll, state, Registers, H, I0};
+use controller::frame::kind;
+use controller::report::Periods;
+use controller::{Config, Controller, Fault, Scene, SegmentOutput};
 
 fn scene_frame(scene: &Scene, seq: u16, t_us: u64) -> Vec<u8> {
     let mut payload = [0u8; 400];
     let n = scene.encode(&mut payload).unwrap();
-    let mut buf = [0u8; MAX_FRAME];
-    let len = encode(kind::SCENE, seq, t_us, &payload[..n], &mut buf).unwrap();
-    buf[..len].to_vec()
-}
-
-/// The PERIODS frame the controller would send now, decoded.
-fn periods(c: &Controller) -> Periods {
-    let mut buf = [0u8; MAX_FRAME];
-    let n = encode_periods(c, &mut buf).unwrap();
-    Periods::decode(&buf[..n]).unwrap()
+    frame(kind::SCENE, seq, t_us, &payload[..n])
 }
 
 /// The paper's camera with roll allowed to 1 rad, so that a roll of 55 deg puts the

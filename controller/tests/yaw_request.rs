@@ -7,24 +7,13 @@
 
 mod common;
 
-use common::{nav_frame, state, Accept};
-use controller::frame::{Decoder, Event, MAX_FRAME};
+use common::{feed, nav_frame, state, Accept, H, I0};
+use controller::frame::MAX_FRAME;
 use controller::nav::Attitude;
 use controller::report::{encode_periods, Periods};
-use controller::{Config, Controller, Fault, Scene, EARTH};
+use controller::{Config, Controller, Scene, EARTH};
 use core_math::earth::{EarthCamera, EarthGeometry};
 use core_math::{Backend, EarthReference};
-
-const I0: f64 = 97.98;
-const H: f64 = 645e3;
-
-fn feed(c: &mut Controller, bytes: &[u8]) {
-    let mut d = Decoder::new();
-    d.feed(bytes, |e| match e {
-        Event::Frame(f) => c.on_frame(&f),
-        Event::Rejected(r) => c.reject(Fault::from(r)),
-    });
-}
 
 fn attitude() -> Attitude<f32> {
     Attitude {
