@@ -26,6 +26,7 @@
 #![no_std]
 
 pub mod board;
+pub mod irq;
 pub mod line_clock;
 pub mod link;
 #[cfg(not(feature = "defmt-rtt"))]

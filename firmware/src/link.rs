@@ -11,7 +11,10 @@
 
 use embedded_hal_nb::serial::{self, ErrorKind, ErrorType, Read};
 
-use crate::tx::TxStats;
+use cortex_m::interrupt::InterruptNumber;
+
+use crate::rx::RxQueue;
+use crate::tx::{TxQueue, TxStats};
 
 /// Sleeping until the receiver may have something. A UART with a receive interrupt
 /// sleeps here (WFI); a plain polled link returns at once.
@@ -103,5 +106,57 @@ impl serial::Error for LinkError {
             LinkError::Noise => ErrorKind::Noise,
             LinkError::Other => ErrorKind::Other,
         }
+    }
+}
+
+/// A UART as the loop sees it on either board: the receive queue its receive interrupt
+/// (line `R`) fills and the transmit queue its transmit interrupt (line `T`) drains. The
+/// registers are the interrupts'; each board's start-up builds one
+/// (`board::cmsdk::start_uart`, the STM32F405's `take`).
+pub struct QueuedLink<R, T> {
+    rx: RxQueue<R>,
+    tx: TxQueue<T>,
+}
+
+impl<R, T> QueuedLink<R, T> {
+    pub fn new(rx: RxQueue<R>, tx: TxQueue<T>) -> Self {
+        QueuedLink { rx, tx }
+    }
+}
+
+impl<R, T> ErrorType for QueuedLink<R, T> {
+    type Error = LinkError;
+}
+
+impl<R: InterruptNumber, T> Read<u8> for QueuedLink<R, T> {
+    fn read(&mut self) -> nb::Result<u8, LinkError> {
+        self.rx.read()
+    }
+}
+
+impl<R: InterruptNumber, T> RxWait for QueuedLink<R, T> {
+    fn wait_for_rx(&mut self) {
+        self.rx.wait();
+    }
+}
+
+impl<R: InterruptNumber, T: InterruptNumber> FrameTx for QueuedLink<R, T> {
+    fn send_frame(&mut self, frame: &[u8]) -> bool {
+        self.tx.send(frame)
+    }
+    fn tx_room(&self) -> usize {
+        self.tx.room()
+    }
+    fn wait_for_tx_room(&mut self, bytes: usize) -> bool {
+        self.tx.wait_for_room(bytes, &self.rx)
+    }
+    fn tx_drained(&self) -> bool {
+        self.tx.drained()
+    }
+    fn wait_for_tx_drained(&mut self) {
+        self.tx.wait_for_drain();
+    }
+    fn tx_stats(&self) -> TxStats {
+        self.tx.stats()
     }
 }

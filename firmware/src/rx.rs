@@ -21,12 +21,10 @@
 //! The interrupt's state (the producer and the UART's receive registers) lives in the
 //! board's [`Handler`] static, behind a `critical_section::Mutex`: no `static mut`.
 
-use core::cell::RefCell;
 use core::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 
 use cortex_m::interrupt::InterruptNumber;
 use cortex_m::peripheral::NVIC;
-use critical_section::Mutex;
 use embedded_hal_nb::serial::{Error as _, Read};
 use heapless::spsc::{Consumer, Producer, Queue};
 use static_cell::ConstStaticCell;
@@ -77,13 +75,13 @@ pub fn stats() -> RxStats {
 
 /// The receive interrupt's side: the producer, the UART's receiver and the interrupt
 /// line (to mask it when the queue is full).
-struct RxInterrupt<R, I> {
+pub struct RxInterrupt<R, I> {
     producer: Producer<'static, u8>,
     uart: R,
     line: I,
 }
 
-impl<R: Read<u8>, I: InterruptNumber> RxInterrupt<R, I> {
+impl<R: Read<u8>, I: InterruptNumber> crate::irq::Service for RxInterrupt<R, I> {
     /// Moves every byte the UART holds into the queue, or stalls when it is full.
     fn service(&mut self) {
         // The producer carries the queue's size as a slice length, read from the
@@ -122,30 +120,7 @@ fn count(e: LinkError) {
 }
 
 /// A board's receive interrupt state, for a static: empty until [`start`] fills it.
-pub struct Handler<R, I>(Mutex<RefCell<Option<RxInterrupt<R, I>>>>);
-
-impl<R: Read<u8>, I: InterruptNumber> Handler<R, I> {
-    pub const fn new() -> Self {
-        Handler(Mutex::new(RefCell::new(None)))
-    }
-
-    /// The receive interrupt handler's body.
-    pub fn run(&self) {
-        critical_section::with(|cs| {
-            if let Ok(mut side) = self.0.borrow(cs).try_borrow_mut() {
-                if let Some(side) = side.as_mut() {
-                    side.service();
-                }
-            }
-        });
-    }
-}
-
-impl<R: Read<u8>, I: InterruptNumber> Default for Handler<R, I> {
-    fn default() -> Self {
-        Self::new()
-    }
-}
+pub type Handler<R, I> = crate::irq::Handler<RxInterrupt<R, I>>;
 
 /// Takes the queue, gives its producer and `uart` (the UART's receiver, read only by
 /// the interrupt from now on) to `handler`, and unmasks the receive interrupt `line`,
@@ -157,16 +132,11 @@ pub fn start<R: Read<u8>, I: InterruptNumber>(
     line: I,
 ) -> Option<RxQueue<I>> {
     let (producer, consumer) = QUEUE.try_take()?.split();
-    let installed = critical_section::with(|cs| {
-        let mut side = handler.0.borrow(cs).try_borrow_mut().ok()?;
-        *side = Some(RxInterrupt {
-            producer,
-            uart,
-            line,
-        });
-        Some(())
-    });
-    installed?;
+    handler.install(RxInterrupt {
+        producer,
+        uart,
+        line,
+    })?;
     // Pended, so that a byte that arrived before the handler was installed is read.
     NVIC::pend(line);
     // SAFETY: the firmware's critical sections are PRIMASK's (cortex-m's single-core

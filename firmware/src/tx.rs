@@ -15,13 +15,11 @@
 //! The interrupt's state (the consumer and the UART's transmitter) lives in the board's
 //! [`Handler`] static, behind a `critical_section::Mutex`: no `static mut`.
 
-use core::cell::RefCell;
 use core::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 
 use controller::downlink::FrameQueue;
 use cortex_m::interrupt::InterruptNumber;
 use cortex_m::peripheral::NVIC;
-use critical_section::Mutex;
 use embedded_hal_nb::serial::Write;
 use heapless::spsc::{Consumer, Queue};
 
@@ -64,12 +62,12 @@ static SHARED: Shared = Shared {
 };
 
 /// The transmit interrupt's side: the consumer and the UART's transmitter.
-struct TxInterrupt<T> {
+pub struct TxInterrupt<T> {
     consumer: Consumer<'static, u8>,
     uart: T,
 }
 
-impl<T: TxPort> TxInterrupt<T> {
+impl<T: TxPort> crate::irq::Service for TxInterrupt<T> {
     /// Writes queued bytes while the UART takes them.
     fn service(&mut self) {
         // As in `rx`: lets the optimiser know the queue's size, so that its index
@@ -100,30 +98,7 @@ impl<T: TxPort> TxInterrupt<T> {
 }
 
 /// A board's transmit interrupt state, for a static: empty until [`start`] fills it.
-pub struct Handler<T>(Mutex<RefCell<Option<TxInterrupt<T>>>>);
-
-impl<T: TxPort> Handler<T> {
-    pub const fn new() -> Self {
-        Handler(Mutex::new(RefCell::new(None)))
-    }
-
-    /// The transmit interrupt handler's body.
-    pub fn run(&self) {
-        critical_section::with(|cs| {
-            if let Ok(mut side) = self.0.borrow(cs).try_borrow_mut() {
-                if let Some(side) = side.as_mut() {
-                    side.service();
-                }
-            }
-        });
-    }
-}
-
-impl<T: TxPort> Default for Handler<T> {
-    fn default() -> Self {
-        Self::new()
-    }
-}
+pub type Handler<T> = crate::irq::Handler<TxInterrupt<T>>;
 
 /// Takes the queue, gives its consumer and `uart` (the UART's transmitter, written only
 /// by the interrupt from now on) to `handler`, and unmasks the transmit interrupt `line`,
@@ -135,12 +110,7 @@ pub fn start<T: TxPort, I: InterruptNumber>(
     line: I,
 ) -> Option<TxQueue<I>> {
     let (producer, consumer) = QUEUE.try_take()?.split();
-    let installed = critical_section::with(|cs| {
-        let mut side = handler.0.borrow(cs).try_borrow_mut().ok()?;
-        *side = Some(TxInterrupt { consumer, uart });
-        Some(())
-    });
-    installed?;
+    handler.install(TxInterrupt { consumer, uart })?;
     // SAFETY: as in `rx::start`: the firmware's critical sections are PRIMASK's, never
     // an NVIC mask; the line's handler is installed above.
     unsafe { NVIC::unmask(line) };

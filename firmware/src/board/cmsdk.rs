@@ -28,9 +28,9 @@ use embedded_hal_nb::serial::{ErrorKind, ErrorType, Read, Write};
 
 use super::{Extended, Monotonic};
 use crate::line_clock::ReloadRegister;
-use crate::link::{FrameTx, LinkError, RxWait};
-use crate::rx::{self, RxQueue};
-use crate::tx::{self, TxPort, TxQueue, TxStats};
+use crate::link::QueuedLink;
+use crate::rx;
+use crate::tx::{self, TxPort};
 
 /// The APB UART's registers (TRM, "APB UART"; QEMU hw/char/cmsdk-apb-uart.c).
 pub mod uart {
@@ -164,14 +164,6 @@ pub type UartRegisters<const ADDR: usize> = Peripheral<uart::RegisterBlock, ADDR
 /// The registers of the CMSDK APB timer at `ADDR`.
 pub type TimerRegisters<const ADDR: usize> = Peripheral<timer::RegisterBlock, ADDR>;
 
-/// A CMSDK APB UART at `ADDR`, the loop's side: the receive queue that the receive
-/// interrupt (line `R`) fills, and the transmit queue that the transmit interrupt (line
-/// `T`) drains. The registers are the interrupts' ([`UartRx`], [`UartTx`]).
-pub struct Uart<const ADDR: usize, R, T> {
-    rx: RxQueue<R>,
-    tx: TxQueue<T>,
-}
-
 /// The receiver of the UART at `ADDR`, read by the receive interrupt only: DATA reads,
 /// STATE's receive bits, INTSTATUS.RX (the transmitter's DATA writes, STATE.TXFULL and
 /// INTSTATUS.TX are the transmit interrupt's; the status bits are write-1-to-clear, so
@@ -186,82 +178,42 @@ pub struct UartTx<const ADDR: usize> {
     regs: UartRegisters<ADDR>,
 }
 
-impl<const ADDR: usize, R: InterruptNumber, T: InterruptNumber> Uart<ADDR, R, T> {
-    /// The UART, enabled for transmit and receive at `baud` (8N1) from the APB clock
-    /// `pclk_hz`, its receive interrupt `rx_line` feeding the receive queue through
-    /// `rx_handler`, its transmit interrupt `tx_line` draining the transmit queue through
-    /// `tx_handler` (each line's interrupt handler must call its handler's `run()`).
-    /// None if a queue was taken before.
-    ///
-    /// # Safety
-    /// A CMSDK APB UART must be mapped at `ADDR`, and the caller must be its only owner.
-    pub unsafe fn start(
-        pclk_hz: u32,
-        baud: u32,
-        (rx_handler, rx_line): (&'static rx::Handler<UartRx<ADDR>, R>, R),
-        (tx_handler, tx_line): (&'static tx::Handler<UartTx<ADDR>>, T),
-    ) -> Option<Self> {
-        // SAFETY: the caller's contract; the three handles split the UART's registers as
-        // their types document (set-up here, then the receiver's and the transmitter's).
-        let (regs, rx_regs, tx_regs): (UartRegisters<ADDR>, _, _) = unsafe {
-            (
-                UartRegisters::new(),
-                UartRegisters::new(),
-                UartRegisters::new(),
-            )
-        };
-        let div = (pclk_hz / baud.max(1)).max(uart::BAUDDIV_MIN);
-        // SAFETY: a divider of at least the minimum sets the bit rate, nothing else; the
-        // enables start the transmitter and the receiver with their interrupts, whose
-        // handlers are installed, before their lines are unmasked, by `rx::start` and
-        // `tx::start`.
-        unsafe {
-            regs.bauddiv.write(div);
-            regs.ctrl.write(
-                uart::CTRL_TX_EN | uart::CTRL_RX_EN | uart::CTRL_TX_INTEN | uart::CTRL_RX_INTEN,
-            );
-        }
-        let rx = rx::start(rx_handler, UartRx { regs: rx_regs }, rx_line)?;
-        let tx = tx::start(tx_handler, UartTx { regs: tx_regs }, tx_line)?;
-        Some(Uart { rx, tx })
+/// The CMSDK APB UART at `ADDR` as the loop's link ([`QueuedLink`]): the UART, enabled for transmit and receive at `baud` (8N1) from the APB clock
+/// `pclk_hz`, its receive interrupt `rx_line` feeding the receive queue through
+/// `rx_handler`, its transmit interrupt `tx_line` draining the transmit queue through
+/// `tx_handler` (each line's interrupt handler must call its handler's `run()`).
+/// None if a queue was taken before.
+///
+/// # Safety
+/// A CMSDK APB UART must be mapped at `ADDR`, and the caller must be its only owner.
+pub unsafe fn start_uart<const ADDR: usize, R: InterruptNumber, T: InterruptNumber>(
+    pclk_hz: u32,
+    baud: u32,
+    (rx_handler, rx_line): (&'static rx::Handler<UartRx<ADDR>, R>, R),
+    (tx_handler, tx_line): (&'static tx::Handler<UartTx<ADDR>>, T),
+) -> Option<QueuedLink<R, T>> {
+    // SAFETY: the caller's contract; the three handles split the UART's registers as
+    // their types document (set-up here, then the receiver's and the transmitter's).
+    let (regs, rx_regs, tx_regs): (UartRegisters<ADDR>, _, _) = unsafe {
+        (
+            UartRegisters::new(),
+            UartRegisters::new(),
+            UartRegisters::new(),
+        )
+    };
+    let div = (pclk_hz / baud.max(1)).max(uart::BAUDDIV_MIN);
+    // SAFETY: a divider of at least the minimum sets the bit rate, nothing else; the
+    // enables start the transmitter and the receiver with their interrupts, whose
+    // handlers are installed, before their lines are unmasked, by `rx::start` and
+    // `tx::start`.
+    unsafe {
+        regs.bauddiv.write(div);
+        regs.ctrl
+            .write(uart::CTRL_TX_EN | uart::CTRL_RX_EN | uart::CTRL_TX_INTEN | uart::CTRL_RX_INTEN);
     }
-}
-
-impl<const ADDR: usize, R, T> ErrorType for Uart<ADDR, R, T> {
-    type Error = LinkError;
-}
-
-impl<const ADDR: usize, R: InterruptNumber, T> Read<u8> for Uart<ADDR, R, T> {
-    fn read(&mut self) -> nb::Result<u8, LinkError> {
-        self.rx.read()
-    }
-}
-
-impl<const ADDR: usize, R: InterruptNumber, T> RxWait for Uart<ADDR, R, T> {
-    fn wait_for_rx(&mut self) {
-        self.rx.wait();
-    }
-}
-
-impl<const ADDR: usize, R: InterruptNumber, T: InterruptNumber> FrameTx for Uart<ADDR, R, T> {
-    fn send_frame(&mut self, frame: &[u8]) -> bool {
-        self.tx.send(frame)
-    }
-    fn tx_room(&self) -> usize {
-        self.tx.room()
-    }
-    fn wait_for_tx_room(&mut self, bytes: usize) -> bool {
-        self.tx.wait_for_room(bytes, &self.rx)
-    }
-    fn tx_drained(&self) -> bool {
-        self.tx.drained()
-    }
-    fn wait_for_tx_drained(&mut self) {
-        self.tx.wait_for_drain();
-    }
-    fn tx_stats(&self) -> TxStats {
-        self.tx.stats()
-    }
+    let rx = rx::start(rx_handler, UartRx { regs: rx_regs }, rx_line)?;
+    let tx = tx::start(tx_handler, UartTx { regs: tx_regs }, tx_line)?;
+    Some(QueuedLink::new(rx, tx))
 }
 
 impl<const ADDR: usize> ErrorType for UartTx<ADDR> {

@@ -9,8 +9,9 @@
 
 use core::sync::atomic::{AtomicBool, Ordering};
 
-use super::cmsdk::{FreeRunning, Timer, Uart, UartRx, UartTx};
+use super::cmsdk::{start_uart, FreeRunning, Timer, UartRx, UartTx};
 use super::{BoardError, Parts, LINK_BAUD};
+use crate::link::QueuedLink;
 use crate::platform;
 use crate::{rx, tx};
 
@@ -19,7 +20,7 @@ pub const NAME: &str = "mps2-an386";
 /// The telemetry link's peripheral.
 pub const LINK: &str = "UART0";
 /// The board's telemetry link, segment 0's line clock and clock.
-pub type Link = Uart<UART0_BASE, Uart0Rx, Uart0Tx>;
+pub type Link = QueuedLink<Uart0Rx, Uart0Tx>;
 pub type LineClock = Timer<TIMER0_BASE>;
 pub type Clock = FreeRunning<TIMER1_BASE, PCLK_HZ>;
 
@@ -46,7 +47,7 @@ pub fn take() -> Result<Parts<Link, LineClock, Clock>, BoardError> {
     // TIMER0 or TIMER1.
     let (link, line_clock, clock) = unsafe {
         (
-            Link::start(PCLK_HZ, LINK_BAUD, (&RX, Uart0Rx), (&TX, Uart0Tx))
+            start_uart::<UART0_BASE, _, _>(PCLK_HZ, LINK_BAUD, (&RX, Uart0Rx), (&TX, Uart0Tx))
                 .ok_or(BoardError::Taken)?,
             LineClock::stopped(),
             Clock::start(),

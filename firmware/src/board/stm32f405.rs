@@ -23,7 +23,7 @@
 //! tree: ARR and PSC write and read back (the register path), the rates do not match
 //! the HSI's (the TIM5 "microseconds" run 62.5 times fast).
 
-use embedded_hal_nb::serial::{Error as _, ErrorType, Read, Write};
+use embedded_hal_nb::serial::{Error as _, ErrorType, Write};
 use stm32f4xx_hal::pac::{self, interrupt, Interrupt};
 use stm32f4xx_hal::prelude::*;
 use stm32f4xx_hal::serial::{Event, Rx, Serial, Tx, TxListen};
@@ -32,9 +32,9 @@ use stm32f4xx_hal::Listen;
 
 use super::{BoardError, Extended, Monotonic, Parts, LINK_BAUD};
 use crate::line_clock::ReloadRegister;
-use crate::link::{FrameTx, LinkError, RxWait};
-use crate::rx::{self, RxQueue};
-use crate::tx::{self, TxPort, TxQueue, TxStats};
+use crate::link::{LinkError, QueuedLink};
+use crate::rx;
+use crate::tx::{self, TxPort};
 
 /// The board's name (the cargo feature).
 pub const NAME: &str = "stm32f405";
@@ -93,7 +93,7 @@ pub fn take() -> Result<Parts<Link, LineClock, Clock>, BoardError> {
     let ticks = Extended::new(u64::from(u32::MAX), tim5.now().ticks());
 
     Ok(Parts {
-        link: Usart1 { tx, rx },
+        link: QueuedLink::new(rx, tx),
         line_clock: Tim2Reload { tim: tim2 },
         clock: Tim5Clock {
             counter: tim5,
@@ -105,44 +105,10 @@ pub fn take() -> Result<Parts<Link, LineClock, Clock>, BoardError> {
 
 /// USART1, the loop's side: the receive queue the interrupt fills and the transmit queue
 /// it drains.
-pub struct Usart1 {
-    tx: TxQueue<Interrupt>,
-    rx: RxQueue<Interrupt>,
-}
+pub type Usart1 = QueuedLink<Interrupt, Interrupt>;
 
 /// USART1's transmitter, the HAL's, written by the interrupt only.
 pub struct Usart1Tx(Tx<pac::USART1, u8>);
-
-impl ErrorType for Usart1 {
-    type Error = LinkError;
-}
-
-impl Read<u8> for Usart1 {
-    fn read(&mut self) -> nb::Result<u8, LinkError> {
-        self.rx.read()
-    }
-}
-
-impl FrameTx for Usart1 {
-    fn send_frame(&mut self, frame: &[u8]) -> bool {
-        self.tx.send(frame)
-    }
-    fn tx_room(&self) -> usize {
-        self.tx.room()
-    }
-    fn wait_for_tx_room(&mut self, bytes: usize) -> bool {
-        self.tx.wait_for_room(bytes, &self.rx)
-    }
-    fn tx_drained(&self) -> bool {
-        self.tx.drained()
-    }
-    fn wait_for_tx_drained(&mut self) {
-        self.tx.wait_for_drain();
-    }
-    fn tx_stats(&self) -> TxStats {
-        self.tx.stats()
-    }
-}
 
 impl ErrorType for Usart1Tx {
     type Error = LinkError;
@@ -171,12 +137,6 @@ impl TxPort for Usart1Tx {
         } else {
             TxListen::unlisten(&mut self.0);
         }
-    }
-}
-
-impl RxWait for Usart1 {
-    fn wait_for_rx(&mut self) {
-        self.rx.wait();
     }
 }
 
