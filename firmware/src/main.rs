@@ -15,7 +15,7 @@ use cortex_m_rt::entry;
 use firmware::board::{self, Parts};
 use firmware::line_clock::LineClocks;
 use firmware::link::FrameTx;
-use firmware::{platform, rx, stack, telemetry, tx};
+use firmware::{heartbeat, platform, retained, rx, stack, telemetry, tx};
 use static_cell::StaticCell;
 
 /// The controller and its link state live here, not on `main`'s stack: the stack
@@ -38,6 +38,9 @@ fn main() -> ! {
         mut link,
         line_clock,
         mut clock,
+        mut watchdog,
+        reset_cause,
+        core_clock_hz,
         timer_clock_hz,
     } = match board::take() {
         Ok(parts) => parts,
@@ -55,6 +58,21 @@ fn main() -> ! {
         telemetry::READY,
         board::LINK
     );
+    let boot = retained::boot(reset_cause);
+    defmt::info!(
+        "boot: reset cause {=str}, {=u32} resets since power-on",
+        boot.cause.name(),
+        boot.resets
+    );
+    // SysTick is the core's: nothing else takes the core peripherals.
+    let Some(syst) = cortex_m::Peripherals::take().map(|p| p.SYST) else {
+        defmt::error!("the core peripherals were already taken");
+        platform::exit(3)
+    };
+    if heartbeat::start(syst, core_clock_hz).is_none() {
+        defmt::error!("no heartbeat at a {=u32} Hz core clock", core_clock_hz);
+        platform::exit(3)
+    }
     let mut clocks = LineClocks::new(line_clock);
     let Some(session) = blank_session() else {
         defmt::error!("the session was already taken");
@@ -70,7 +88,8 @@ fn main() -> ! {
                     line_clock_hz
                 );
             }
-            let summary = telemetry::run(&mut link, &mut clocks, &mut clock, session);
+            let summary =
+                telemetry::run(&mut link, &mut clocks, &mut clock, &mut watchdog, session);
             let queue = rx::stats();
             defmt::info!(
                 "receive queue: at most {=u32} of {=usize} bytes held, full {=u32} times (the UART waited)",

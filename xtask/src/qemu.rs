@@ -21,6 +21,7 @@ mod pass;
 mod profile;
 mod runner;
 mod tools;
+mod watchdog;
 
 use anyhow::{anyhow, bail, Context, Result};
 use std::path::{Path, PathBuf};
@@ -105,6 +106,7 @@ pub fn test_target() -> Result<()> {
         }
         e2e_test(board)?;
     }
+    watchdog::watchdog_test(Board::Mps2An386)?;
     eprintln!(
         "xtask: target checks passed on {} in {:.1} s",
         board::names(),
