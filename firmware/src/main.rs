@@ -64,12 +64,16 @@ fn main() -> ! {
         boot.cause.name(),
         boot.resets
     );
-    // SysTick is the core's: nothing else takes the core peripherals.
-    let Some(syst) = cortex_m::Peripherals::take().map(|p| p.SYST) else {
+    // SysTick and the MPU are the core's: nothing else takes the core peripherals.
+    let Some(mut core) = cortex_m::Peripherals::take() else {
         defmt::error!("the core peripherals were already taken");
         platform::exit(3)
     };
-    if heartbeat::start(syst, core_clock_hz).is_none() {
+    if stack::guard(&mut core.MPU).is_none() {
+        defmt::error!("no room for the stack's guard");
+        platform::exit(3)
+    }
+    if heartbeat::start(core.SYST, core_clock_hz).is_none() {
         defmt::error!("no heartbeat at a {=u32} Hz core clock", core_clock_hz);
         platform::exit(3)
     }

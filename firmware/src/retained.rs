@@ -8,7 +8,7 @@
 //! this reads as a power-on reset and starts the count afresh.
 //!
 //! A handler that is about to reset the core (the watchdog's early warning on the
-//! mps2) notes the cause first ([`note_cause`]); the next boot reads it ([`boot`]). A
+//! mps2, the HardFault handler) notes the cause first ([`note_cause`]); the next boot reads it ([`boot`]). A
 //! board whose reset controller keeps its own flags (the STM32F405's RCC_CSR) hands
 //! them to [`boot`], and they win over a noted cause.
 
@@ -23,6 +23,10 @@ pub enum ResetCause {
     Watchdog,
     /// The firmware asked for it (SYSRESETREQ) for a reason it did not note.
     Software,
+    /// The stack ran into its guard (crate::stack).
+    StackOverflow,
+    /// Any other HardFault.
+    Fault,
     /// A reset the firmware did not see coming and the board cannot name (the reset
     /// pin, a debugger).
     Unknown,
@@ -34,6 +38,8 @@ impl ResetCause {
             ResetCause::PowerOn => "power-on",
             ResetCause::Watchdog => "watchdog",
             ResetCause::Software => "software",
+            ResetCause::StackOverflow => "stack overflow",
+            ResetCause::Fault => "hard fault",
             ResetCause::Unknown => "unknown",
         }
     }
@@ -44,6 +50,8 @@ impl ResetCause {
             ResetCause::Watchdog => 2,
             ResetCause::Software => 3,
             ResetCause::Unknown => 4,
+            ResetCause::StackOverflow => 5,
+            ResetCause::Fault => 6,
         }
     }
 
@@ -53,6 +61,8 @@ impl ResetCause {
             ResetCause::Watchdog,
             ResetCause::Software,
             ResetCause::Unknown,
+            ResetCause::StackOverflow,
+            ResetCause::Fault,
         ]
         .into_iter()
         .find(|c| c.code() == code)

@@ -16,12 +16,12 @@
 
 mod bench;
 pub(crate) mod board;
+mod faults;
 mod flash;
 mod pass;
 mod profile;
 mod runner;
 mod tools;
-mod watchdog;
 
 use anyhow::{anyhow, bail, Context, Result};
 use std::path::{Path, PathBuf};
@@ -106,7 +106,7 @@ pub fn test_target() -> Result<()> {
         }
         e2e_test(board)?;
     }
-    watchdog::watchdog_test(Board::Mps2An386)?;
+    faults::faults_test(Board::Mps2An386)?;
     eprintln!(
         "xtask: target checks passed on {} in {:.1} s",
         board::names(),
