@@ -10,9 +10,9 @@
 #![no_main]
 
 use controller::session::Session;
-use controller::{Config, Controller, Scene};
+use controller::{Config, Controller, LinePeriodSink, Scene};
 use cortex_m_rt::entry;
-use firmware::board::{self, Parts};
+use firmware::board::{self, Monotonic, Parts};
 use firmware::line_clock::LineClocks;
 use firmware::link::FrameTx;
 use firmware::{heartbeat, platform, retained, rx, stack, telemetry, tx};
@@ -30,6 +30,59 @@ static SESSION: StaticCell<Session> = StaticCell::new();
 #[inline(never)]
 fn blank_session() -> Option<&'static mut Session> {
     SESSION.try_init_with(|| Session::new(Controller::blank(Config::default())))
+}
+
+/// Puts the snapshot kept before a reset back: the periods into the registers first,
+/// then the scene and heights, every period flagged held until fresh telemetry
+/// (`controller::restart`). Err if it did not check out (then the default scene). Not
+/// inlined, so that its frames are not part of `main`'s through the whole pass.
+#[inline(never)]
+fn restore<C: Monotonic>(
+    session: &mut Session,
+    snapshot: &controller::restart::Snapshot,
+    clocks: &mut LineClocks<board::LineClock>,
+    clock: &mut C,
+) -> Result<(), ()> {
+    let mut timed = FirstWrite {
+        sink: clocks,
+        clock,
+        at_us: None,
+    };
+    match session.controller.restore(snapshot, &mut timed) {
+        Ok(restored) => {
+            defmt::info!(
+                "restored after the reset: {=usize} periods programmed {=u64} us after the board came up, held until fresh telemetry",
+                restored.periods,
+                timed.at_us.unwrap_or(0)
+            );
+            Ok(())
+        }
+        Err(f) => {
+            defmt::warn!(
+                "the kept snapshot was refused ({=str}): default scene",
+                f.name()
+            );
+            Err(())
+        }
+    }
+}
+
+/// A period sink that notes when its first write went through (the board's clock).
+struct FirstWrite<'a, S, C> {
+    sink: &'a mut S,
+    clock: &'a mut C,
+    at_us: Option<u64>,
+}
+
+impl<S: LinePeriodSink, C: Monotonic> LinePeriodSink for FirstWrite<'_, S, C> {
+    type Error = S::Error;
+    fn write_period(&mut self, index: u8, ticks: u32) -> Result<(), S::Error> {
+        let written = self.sink.write_period(index, ticks);
+        if written.is_ok() && self.at_us.is_none() {
+            self.at_us = Some(self.clock.now_us());
+        }
+        written
+    }
 }
 
 #[entry]
@@ -82,7 +135,18 @@ fn main() -> ! {
         defmt::error!("the session was already taken");
         platform::exit(1)
     };
-    let code = match session.controller.set_scene(Scene::paper_default()) {
+    session.controller.note_boot(boot.cause, boot.resets);
+    let in_force = match retained::snapshot(&boot) {
+        Some(snapshot) => restore(session, snapshot, &mut clocks, &mut clock),
+        None => Err(()),
+    };
+    let in_force = in_force.or_else(|()| {
+        session
+            .controller
+            .set_scene(Scene::paper_default())
+            .map_err(|f| defmt::error!("the default scene was refused: {=str}", f.name()))
+    });
+    let code = match in_force {
         Ok(()) => {
             let line_clock_hz = session.controller.plan().line_clock_hz;
             if timer_clock_hz as f32 != line_clock_hz {
@@ -127,10 +191,7 @@ fn main() -> ! {
                 2
             }
         }
-        Err(f) => {
-            defmt::error!("the default scene was refused: {=str}", f.name());
-            1
-        }
+        Err(()) => 1,
     };
     defmt::info!(
         "stack high-water mark: {=usize} bytes (the session, in static memory: {=usize} bytes)",

@@ -2,10 +2,13 @@
 //! layout (`firmware/memory/`), which neither the startup code nor QEMU's image loader
 //! writes, so its contents outlive a watchdog or software reset (not a power cycle).
 //!
-//! Today the record holds why the core was last reset and how many resets there have
-//! been since power-on (docs/target.md, "Faults and resets"). It is trusted only when
-//! its magic, version and CRC check out: after power-on the RAM holds noise, which
-//! this reads as a power-on reset and starts the count afresh.
+//! The record holds why the core was last reset and how many resets there have been
+//! since power-on, and the controller's [`Snapshot`] (the scene, its heights and the
+//! last periods, in the telemetry's encodings: `controller::restart`), kept up to date
+//! by the loop ([`keep`]) and handed back after a reset ([`snapshot`]) (docs/target.md,
+//! "Faults and resets"). Each part is trusted only when its magic, version and CRC
+//! check out: after power-on the RAM holds noise, which this reads as a power-on reset
+//! with nothing kept.
 //!
 //! A handler that is about to reset the core (the watchdog's early warning on the
 //! mps2, the HardFault handler) notes the cause first ([`note_cause`]); the next boot reads it ([`boot`]). A
@@ -13,61 +16,9 @@
 //! them to [`boot`], and they win over a noted cause.
 
 use controller::crc;
-
-/// Why the core last started.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum ResetCause {
-    /// Power-on (or a record that did not check out: RAM contents not to be trusted).
-    PowerOn,
-    /// The watchdog: the main loop stopped making progress.
-    Watchdog,
-    /// The firmware asked for it (SYSRESETREQ) for a reason it did not note.
-    Software,
-    /// The stack ran into its guard (crate::stack).
-    StackOverflow,
-    /// Any other HardFault.
-    Fault,
-    /// A reset the firmware did not see coming and the board cannot name (the reset
-    /// pin, a debugger).
-    Unknown,
-}
-
-impl ResetCause {
-    pub fn name(self) -> &'static str {
-        match self {
-            ResetCause::PowerOn => "power-on",
-            ResetCause::Watchdog => "watchdog",
-            ResetCause::Software => "software",
-            ResetCause::StackOverflow => "stack overflow",
-            ResetCause::Fault => "hard fault",
-            ResetCause::Unknown => "unknown",
-        }
-    }
-
-    fn code(self) -> u32 {
-        match self {
-            ResetCause::PowerOn => 1,
-            ResetCause::Watchdog => 2,
-            ResetCause::Software => 3,
-            ResetCause::Unknown => 4,
-            ResetCause::StackOverflow => 5,
-            ResetCause::Fault => 6,
-        }
-    }
-
-    fn from_code(code: u32) -> Option<ResetCause> {
-        [
-            ResetCause::PowerOn,
-            ResetCause::Watchdog,
-            ResetCause::Software,
-            ResetCause::Unknown,
-            ResetCause::StackOverflow,
-            ResetCause::Fault,
-        ]
-        .into_iter()
-        .find(|c| c.code() == code)
-    }
-}
+pub use controller::restart::ResetCause;
+use controller::restart::{Payload, Snapshot};
+use controller::Controller;
 
 /// What [`boot`] found.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -92,7 +43,7 @@ struct Record {
 }
 
 const MAGIC: u32 = 0x5444_4952; // "TDIR"
-const VERSION: u32 = 1;
+const VERSION: u32 = 2;
 
 impl Record {
     fn crc(&self) -> u32 {
@@ -117,26 +68,101 @@ impl Record {
     }
 }
 
+/// The region's contents: the record, then the snapshot with its two CRCs (one for the
+/// scene and heights, written when they change; one for the periods, written after
+/// every update), each over the payloads' lengths and bytes. `repr(C)`; the snapshot's
+/// fields are `u16`s and bytes, so any contents are a valid value, checked before use.
+#[repr(C)]
+struct Region {
+    record: Record,
+    inputs_crc: u32,
+    periods_crc: u32,
+    snapshot: Snapshot,
+}
+
 extern "C" {
     /// The start of the board's `RETAINED` region (its memory layout defines it).
-    static mut __sretained: Record;
+    static mut __sretained: Region;
     static __eretained: u8;
 }
 
-const _: () = assert!(core::mem::size_of::<Record>() <= 4096);
+const _: () = assert!(core::mem::size_of::<Region>() <= 4096);
 
 fn read() -> Record {
     // SAFETY: `__sretained` is the start of RAM that the memory layout reserves for this
     // module alone (4 KiB, aligned: checked above and by the layout), always mapped; any
     // bit pattern is a valid `Record` of `u32`s. Volatile: the contents come from before
     // the reset, which the compiler cannot know.
-    unsafe { core::ptr::read_volatile(&raw const __sretained) }
+    unsafe { core::ptr::read_volatile(&raw const __sretained.record) }
 }
 
 fn write(record: Record) {
     // SAFETY: as in `read`; only this module writes the region, and the firmware is
     // single-threaded apart from handlers that end in a reset (`note_cause`).
-    unsafe { core::ptr::write_volatile(&raw mut __sretained, record) }
+    unsafe { core::ptr::write_volatile(&raw mut __sretained.record, record) }
+}
+
+/// The region, for the loop's snapshot (`keep`) and the boot's (`snapshot`).
+///
+/// # Safety
+/// No other reference to the region may be alive: callers are the loop and `main`
+/// before it, one at a time, and the handlers that touch the record (`note_cause`)
+/// reset the core before the interrupted code resumes.
+unsafe fn region() -> &'static mut Region {
+    // SAFETY: the caller's contract; the region is mapped RAM of the right size (checked
+    // above) and any contents are a valid `Region`.
+    unsafe { &mut *core::ptr::addr_of_mut!(__sretained) }
+}
+
+fn payload_crc(parts: &[&Payload]) -> u32 {
+    let crc = parts.iter().fold(crc::INIT, |c, p| {
+        let c = crc::update(c, &p.len.to_le_bytes());
+        crc::update(c, p.as_slice())
+    });
+    u32::from(crc)
+}
+
+/// What the loop has last kept ([`keep`]): when to write again.
+#[derive(Clone, Copy, Default)]
+pub struct Kept {
+    inputs_generation: Option<u32>,
+    updates: Option<u32>,
+}
+
+/// Keeps the controller's snapshot up to date in retained RAM: the scene and heights
+/// when they have changed, the periods after each update.
+pub fn keep(c: &Controller, kept: &mut Kept) {
+    // SAFETY: the loop is the only user of the region while it runs (`region`).
+    let region = unsafe { region() };
+    if kept.inputs_generation != Some(c.inputs_generation()) {
+        kept.inputs_generation = Some(c.inputs_generation());
+        region.inputs_crc = if c.snapshot_inputs(&mut region.snapshot) {
+            payload_crc(&[&region.snapshot.scene, &region.snapshot.terrain])
+        } else {
+            // Never for a scene the controller took; a CRC that cannot match says "none".
+            !payload_crc(&[&region.snapshot.scene, &region.snapshot.terrain])
+        };
+    }
+    if kept.updates != Some(c.updates) {
+        kept.updates = Some(c.updates);
+        region.periods_crc = if c.snapshot_periods(&mut region.snapshot.periods) {
+            payload_crc(&[&region.snapshot.periods])
+        } else {
+            !payload_crc(&[&region.snapshot.periods])
+        };
+    }
+}
+
+/// The snapshot kept before the reset, if the record and both CRCs check out and the
+/// core was not powered on (call after [`boot`], before the loop's first [`keep`]).
+pub fn snapshot(boot: &Boot) -> Option<&'static Snapshot> {
+    // SAFETY: called by `main` before the loop runs: no other user (`region`).
+    let region = unsafe { region() };
+    let ok = boot.cause != ResetCause::PowerOn
+        && region.record.checks_out()
+        && region.inputs_crc == payload_crc(&[&region.snapshot.scene, &region.snapshot.terrain])
+        && region.periods_crc == payload_crc(&[&region.snapshot.periods]);
+    ok.then_some(&region.snapshot)
 }
 
 /// Reads (and then renews) the record at boot. `hardware` is the cause the board's
@@ -144,7 +170,9 @@ fn write(record: Record) {
 pub fn boot(hardware: Option<ResetCause>) -> Boot {
     let old = read();
     let (cause, resets) = if old.checks_out() {
-        let noted = ResetCause::from_code(old.noted_cause);
+        let noted = u8::try_from(old.noted_cause)
+            .ok()
+            .and_then(ResetCause::from_u8);
         // The reset controller's flags win, except that a noted cause says more than
         // "software": the firmware's own reset after it noted why.
         let cause = match (hardware, noted) {
@@ -170,6 +198,14 @@ pub fn boot(hardware: Option<ResetCause>) -> Boot {
         }
         .sealed(),
     );
+    if cause == ResetCause::PowerOn {
+        // Noise until the loop keeps a snapshot: make sure no CRC can match it.
+        // SAFETY: called by `main` before the loop runs: no other user (`region`).
+        let region = unsafe { region() };
+        region.snapshot = Snapshot::EMPTY;
+        region.inputs_crc = !payload_crc(&[&region.snapshot.scene, &region.snapshot.terrain]);
+        region.periods_crc = !payload_crc(&[&region.snapshot.periods]);
+    }
     Boot { cause, resets }
 }
 
@@ -178,7 +214,7 @@ pub fn boot(hardware: Option<ResetCause>) -> Boot {
 pub fn note_cause(cause: ResetCause) {
     let mut record = read();
     if record.checks_out() {
-        record.noted_cause = cause.code();
+        record.noted_cause = u32::from(cause as u8);
         write(record.sealed());
     }
 }

@@ -27,6 +27,7 @@ use controller::{LinePeriodSink, Mode};
 
 use crate::board::{Monotonic, Watchdog};
 use crate::link::Link;
+use crate::retained;
 
 /// The words of the firmware's first log line that say the link is up: the host's pass
 /// player waits for them before it sends a byte (xtask/src/qemu/pass.rs).
@@ -65,6 +66,8 @@ pub fn run<L: Link, S: LinePeriodSink, C: Monotonic, W: Watchdog>(
     };
     let mut faults = 0u32;
     let mut mode = session.controller.mode();
+    let mut kept = retained::Kept::default();
+    retained::keep(&session.controller, &mut kept);
     let started_us = clock.now_us();
     loop {
         watchdog.feed();
@@ -95,6 +98,7 @@ pub fn run<L: Link, S: LinePeriodSink, C: Monotonic, W: Watchdog>(
         };
         let step_start_us = clock.now_us();
         let ended = session.feed(&[byte], sink, |frame| link.send_frame(frame));
+        retained::keep(&session.controller, &mut kept);
         let step_us = clock.now_us().saturating_sub(step_start_us);
         summary.longest_step_us = summary.longest_step_us.max(step_us);
         report_changes(session, &mut faults, &mut mode);
