@@ -20,6 +20,7 @@ use crate::config::Config;
 use crate::fault::{Counters, Fault};
 use crate::nav::Propagator;
 use crate::plan::Plan;
+use crate::restart::ResetCause;
 use crate::scene::{Scene, MAX_SEGMENTS};
 
 /// The last accepted NAV state.
@@ -130,6 +131,13 @@ pub struct Controller {
     pub updates: u32,
     /// The mode an update ran in (the one its PERIODS frame reports).
     pub(crate) update_mode: Mode,
+    /// Changes whenever the scene or the ground heights in force change (a SCENE or
+    /// TERRAIN frame accepted, a restore): when to take a new snapshot of them
+    /// ([`crate::restart`]).
+    pub(crate) inputs_generation: u32,
+    /// Why the core last started and the resets since power-on, as the firmware noted
+    /// them ([`Controller::note_boot`]): STATUS reports them.
+    pub(crate) boot: Option<(ResetCause, u32)>,
 }
 
 impl Controller {
@@ -177,6 +185,8 @@ impl Controller {
             yaw_request_rad: None,
             updates: 0,
             update_mode: Mode::WaitingForNav,
+            inputs_generation: 0,
+            boot: None,
         }
     }
 
@@ -204,6 +214,23 @@ impl Controller {
         }
         self.heights_m = scene.segments.map(|s| s.ground_h_m);
         self.scene = scene;
+        self.inputs_generation = self.inputs_generation.wrapping_add(1);
+    }
+
+    /// Notes why the core last started and how many resets there have been since
+    /// power-on, for STATUS.
+    pub fn note_boot(&mut self, cause: ResetCause, resets: u32) {
+        self.boot = Some((cause, resets));
+    }
+
+    /// What [`Controller::note_boot`] noted.
+    pub fn boot(&self) -> Option<(ResetCause, u32)> {
+        self.boot
+    }
+
+    /// Changes whenever the scene or the ground heights in force change.
+    pub fn inputs_generation(&self) -> u32 {
+        self.inputs_generation
     }
 
     pub fn scene(&self) -> &Scene {

@@ -112,6 +112,7 @@ impl Controller {
             kind::TERRAIN => {
                 let terrain = Terrain::decode(frame.payload, &self.scene)?;
                 self.heights_m = terrain.heights_m;
+                self.inputs_generation = self.inputs_generation.wrapping_add(1);
                 Ok(())
             }
             kind::TIME if frame.payload.is_empty() => Ok(()),

@@ -24,6 +24,7 @@ pub mod intake;
 pub mod nav;
 pub mod plan;
 pub mod report;
+pub mod restart;
 pub mod scene;
 pub mod session;
 pub mod sink;

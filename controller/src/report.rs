@@ -6,6 +6,7 @@ use heapless::Vec;
 use crate::bytes::{Reader, Writer};
 use crate::control::{Controller, Mode, SegmentOutput};
 use crate::fault::Fault;
+use crate::restart::ResetCause;
 use crate::scene::MAX_SEGMENTS;
 
 /// PERIODS payload: mode, count, flags, 1 reserved, the yaw steering request (f32, rad),
@@ -94,7 +95,9 @@ impl Periods {
     }
 }
 
-/// Writes the STATUS payload: mode, last fault (0xFF: none), 2 reserved, frames
+/// Writes the STATUS payload: mode, last fault (0xFF: none), the last reset's cause
+/// ([`ResetCause`] as u8; 0: not noted) and the resets since power-on (saturating at
+/// 255), frames
 /// accepted, updates run, bytes skipped by the decoder, time re-synchronisations, then
 /// one u32 counter per [`Fault`] in [`Fault::ALL`] order, then the downlink frames the
 /// transmit queue had no room for (dropped whole: [`crate::downlink`]). What each
@@ -106,7 +109,15 @@ pub fn encode_status(
     out: &mut [u8],
 ) -> Option<usize> {
     let mut w = Writer::new(out);
-    w.put(&[c.mode() as u8, c.last_fault.map_or(0xFF, |f| f as u8), 0, 0])?;
+    let (cause, resets) = c.boot().map_or((0, 0), |(cause, n)| {
+        (cause as u8, u8::try_from(n).unwrap_or(u8::MAX))
+    });
+    w.put(&[
+        c.mode() as u8,
+        c.last_fault.map_or(0xFF, |f| f as u8),
+        cause,
+        resets,
+    ])?;
     w.put(&c.frames_accepted.to_le_bytes())?;
     w.put(&c.updates.to_le_bytes())?;
     w.put(&skipped_bytes.to_le_bytes())?;
@@ -122,6 +133,10 @@ pub fn encode_status(
 pub struct Status {
     pub mode: u8,
     pub last_fault: Option<Fault>,
+    /// Why the core last started (None: not noted, as on a host).
+    pub reset_cause: Option<ResetCause>,
+    /// Resets since power-on (saturating at 255).
+    pub resets: u8,
     pub frames_accepted: u32,
     pub updates: u32,
     pub skipped_bytes: u32,
@@ -136,7 +151,8 @@ impl Status {
         let mut r = Reader::new(payload);
         let mode = r.u8()?;
         let last = r.u8()?;
-        r.u16()?;
+        let reset_cause = ResetCause::from_u8(r.u8()?);
+        let resets = r.u8()?;
         let frames_accepted = r.u32()?;
         let updates = r.u32()?;
         let skipped_bytes = r.u32()?;
@@ -150,6 +166,8 @@ impl Status {
         r.is_done().then_some(Status {
             mode,
             last_fault,
+            reset_cause,
+            resets,
             frames_accepted,
             updates,
             skipped_bytes,

@@ -218,6 +218,8 @@ impl Scene {
     }
 
     /// Parses a SCENE payload; the physical checks are [`Scene::validate`]'s.
+    // Not inlined: SCENE intake and a restore after a reset share one copy.
+    #[inline(never)]
     pub fn decode(payload: &[u8]) -> Result<Scene, Fault> {
         let mut r = Reader::new(payload);
         let bad = Fault::BadLength;
@@ -331,6 +333,8 @@ impl Terrain {
     /// Parses and checks a TERRAIN payload against the scene in force: one height per
     /// table entry (else `invalid_scene`), each finite (`non_finite`) and within
     /// [`MIN_GROUND_H_M`]..=[`MAX_GROUND_H_M`] (`out_of_range`).
+    // Not inlined: TERRAIN intake and a restore after a reset share one copy.
+    #[inline(never)]
     pub fn decode(payload: &[u8], scene: &Scene) -> Result<Terrain, Fault> {
         let mut r = Reader::new(payload);
         let count = r.u8().ok_or(Fault::BadLength)?;

@@ -13,6 +13,9 @@
 //!   frames the session sends;
 //! - the hardware behind those traits: [`board`], one module per board, chosen by cargo
 //!   feature (`mps2-an386`, the default; `stm32f405`); no hardware address outside it;
+//! - [`retained`]: what survives a reset (its cause and count); [`heartbeat`]: the
+//!   periodic wake-up that lets the loop feed the board's watchdog while the link is
+//!   quiet;
 //! - [`platform`]: panic/fault handlers, exit by semihosting; `logger`: the global
 //!   defmt logger (semihosting, never panics; `defmt-rtt` replaces it on a real board);
 //!   [`stack`]: the stack's high-water mark (the firmware's RAM use).
@@ -26,12 +29,14 @@
 #![no_std]
 
 pub mod board;
+pub mod heartbeat;
 pub mod irq;
 pub mod line_clock;
 pub mod link;
 #[cfg(not(feature = "defmt-rtt"))]
 pub mod logger;
 pub mod platform;
+pub mod retained;
 pub mod rx;
 pub mod stack;
 pub mod synthetic;

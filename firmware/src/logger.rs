@@ -17,7 +17,7 @@
 //!   is being formatted. Such a nested frame is dropped whole (its `acquire`, `write`s
 //!   and `release` only count), so the interrupted frame continues intact: the stream
 //!   stays decodable and nothing panics. The HardFault handler's own line is lost in
-//!   that one case; its exit status (102) still says what happened.
+//!   that one case; the cause it notes in retained RAM still says what happened.
 //! - `write` or `release` without `acquire` (a broken contract) does nothing.
 //! - Semihosting errors are ignored ("best effort", as the contract asks); if stdout
 //!   cannot be opened, frames go nowhere and the next `acquire` tries again.

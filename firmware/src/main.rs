@@ -10,12 +10,12 @@
 #![no_main]
 
 use controller::session::Session;
-use controller::{Config, Controller, Scene};
+use controller::{Config, Controller, LinePeriodSink, Scene};
 use cortex_m_rt::entry;
-use firmware::board::{self, Parts};
+use firmware::board::{self, Monotonic, Parts};
 use firmware::line_clock::LineClocks;
 use firmware::link::FrameTx;
-use firmware::{platform, rx, stack, telemetry, tx};
+use firmware::{heartbeat, platform, retained, rx, stack, telemetry, tx};
 use static_cell::StaticCell;
 
 /// The controller and its link state live here, not on `main`'s stack: the stack
@@ -32,12 +32,68 @@ fn blank_session() -> Option<&'static mut Session> {
     SESSION.try_init_with(|| Session::new(Controller::blank(Config::default())))
 }
 
+/// Puts the snapshot kept before a reset back: the periods into the registers first,
+/// then the scene and heights, every period flagged held until fresh telemetry
+/// (`controller::restart`). Err if it did not check out (then the default scene). Not
+/// inlined, so that its frames are not part of `main`'s through the whole pass.
+#[inline(never)]
+fn restore<C: Monotonic>(
+    session: &mut Session,
+    snapshot: &controller::restart::Snapshot,
+    clocks: &mut LineClocks<board::LineClock>,
+    clock: &mut C,
+) -> Result<(), ()> {
+    let mut timed = FirstWrite {
+        sink: clocks,
+        clock,
+        at_us: None,
+    };
+    match session.controller.restore(snapshot, &mut timed) {
+        Ok(restored) => {
+            defmt::info!(
+                "restored after the reset: {=usize} periods programmed {=u64} us after the board came up, held until fresh telemetry",
+                restored.periods,
+                timed.at_us.unwrap_or(0)
+            );
+            Ok(())
+        }
+        Err(f) => {
+            defmt::warn!(
+                "the kept snapshot was refused ({=str}): default scene",
+                f.name()
+            );
+            Err(())
+        }
+    }
+}
+
+/// A period sink that notes when its first write went through (the board's clock).
+struct FirstWrite<'a, S, C> {
+    sink: &'a mut S,
+    clock: &'a mut C,
+    at_us: Option<u64>,
+}
+
+impl<S: LinePeriodSink, C: Monotonic> LinePeriodSink for FirstWrite<'_, S, C> {
+    type Error = S::Error;
+    fn write_period(&mut self, index: u8, ticks: u32) -> Result<(), S::Error> {
+        let written = self.sink.write_period(index, ticks);
+        if written.is_ok() && self.at_us.is_none() {
+            self.at_us = Some(self.clock.now_us());
+        }
+        written
+    }
+}
+
 #[entry]
 fn main() -> ! {
     let Parts {
         mut link,
         line_clock,
         mut clock,
+        mut watchdog,
+        reset_cause,
+        core_clock_hz,
         timer_clock_hz,
     } = match board::take() {
         Ok(parts) => parts,
@@ -55,12 +111,42 @@ fn main() -> ! {
         telemetry::READY,
         board::LINK
     );
+    let boot = retained::boot(reset_cause);
+    defmt::info!(
+        "boot: reset cause {=str}, {=u32} resets since power-on",
+        boot.cause.name(),
+        boot.resets
+    );
+    // SysTick and the MPU are the core's: nothing else takes the core peripherals.
+    let Some(mut core) = cortex_m::Peripherals::take() else {
+        defmt::error!("the core peripherals were already taken");
+        platform::exit(3)
+    };
+    if stack::guard(&mut core.MPU).is_none() {
+        defmt::error!("no room for the stack's guard");
+        platform::exit(3)
+    }
+    if heartbeat::start(core.SYST, core_clock_hz).is_none() {
+        defmt::error!("no heartbeat at a {=u32} Hz core clock", core_clock_hz);
+        platform::exit(3)
+    }
     let mut clocks = LineClocks::new(line_clock);
     let Some(session) = blank_session() else {
         defmt::error!("the session was already taken");
         platform::exit(1)
     };
-    let code = match session.controller.set_scene(Scene::paper_default()) {
+    session.controller.note_boot(boot.cause, boot.resets);
+    let in_force = match retained::snapshot(&boot) {
+        Some(snapshot) => restore(session, snapshot, &mut clocks, &mut clock),
+        None => Err(()),
+    };
+    let in_force = in_force.or_else(|()| {
+        session
+            .controller
+            .set_scene(Scene::paper_default())
+            .map_err(|f| defmt::error!("the default scene was refused: {=str}", f.name()))
+    });
+    let code = match in_force {
         Ok(()) => {
             let line_clock_hz = session.controller.plan().line_clock_hz;
             if timer_clock_hz as f32 != line_clock_hz {
@@ -70,7 +156,8 @@ fn main() -> ! {
                     line_clock_hz
                 );
             }
-            let summary = telemetry::run(&mut link, &mut clocks, &mut clock, session);
+            let summary =
+                telemetry::run(&mut link, &mut clocks, &mut clock, &mut watchdog, session);
             let queue = rx::stats();
             defmt::info!(
                 "receive queue: at most {=u32} of {=usize} bytes held, full {=u32} times (the UART waited)",
@@ -104,10 +191,7 @@ fn main() -> ! {
                 2
             }
         }
-        Err(f) => {
-            defmt::error!("the default scene was refused: {=str}", f.name());
-            1
-        }
+        Err(()) => 1,
     };
     defmt::info!(
         "stack high-water mark: {=usize} bytes (the session, in static memory: {=usize} bytes)",

@@ -9,13 +9,13 @@
 
 use cortex_m as _; // critical-section implementation for the logger
 use cortex_m_rt::{exception, ExceptionFrame};
+
+use crate::retained::{self, ResetCause};
 #[cfg(feature = "defmt-rtt")]
 use defmt_rtt as _; // the global defmt logger on a real board
 
 /// Exit status of a panic (never expected: the firmware's own paths return `Result`).
 pub const EXIT_PANIC: i32 = 101;
-/// Exit status of a HardFault.
-pub const EXIT_HARD_FAULT: i32 = 102;
 /// Exit status of an interrupt the firmware never unmasks (mps2-an386's default handler).
 pub const EXIT_UNEXPECTED_INTERRUPT: i32 = 103;
 
@@ -70,8 +70,28 @@ fn defmt_panic() -> ! {
     unsafe { NO_PANIC_CHECK__a_panic_path_is_reachable__see_docs_no_panic_md(core::ptr::null()) }
 }
 
+/// A HardFault, the stack's guard included (crate::stack): the cause is noted in
+/// retained RAM for the next boot, and the core is reset, as the watchdog would (docs/
+/// target.md, "Faults and resets"). Runs with the MPU off, on the guard's room if the
+/// stack overflowed.
 #[exception]
 unsafe fn HardFault(frame: &ExceptionFrame) -> ! {
-    defmt::error!("hard fault at pc {=u32:#010x}", frame.pc());
-    exit(EXIT_HARD_FAULT)
+    let cause = if crate::stack::overflowed() {
+        ResetCause::StackOverflow
+    } else {
+        ResetCause::Fault
+    };
+    retained::note_cause(cause);
+    // After an overflow the exception frame could not be stacked: no pc to show.
+    let pc = if cause == ResetCause::StackOverflow {
+        0
+    } else {
+        frame.pc()
+    };
+    defmt::error!(
+        "{=str} (pc {=u32:#010x}; 0: none stacked): resetting",
+        cause.name(),
+        pc
+    );
+    cortex_m::peripheral::SCB::sys_reset()
 }

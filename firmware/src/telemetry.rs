@@ -25,8 +25,9 @@ use controller::downlink::MAX_STEP_OUTPUT;
 use controller::session::Session;
 use controller::{LinePeriodSink, Mode};
 
-use crate::board::Monotonic;
+use crate::board::{Monotonic, Watchdog};
 use crate::link::Link;
+use crate::retained;
 
 /// The words of the firmware's first log line that say the link is up: the host's pass
 /// player waits for them before it sends a byte (xtask/src/qemu/pass.rs).
@@ -48,10 +49,13 @@ pub struct Summary {
 }
 
 /// Runs the session's controller on `link` until an END frame; returns how it went.
-pub fn run<L: Link, S: LinePeriodSink, C: Monotonic>(
+/// Feeds `watchdog` once per turn of the loop: a byte handled, a wait for room or for a
+/// byte ended (the heartbeat ends a wait at least every `board::HEARTBEAT_MS`).
+pub fn run<L: Link, S: LinePeriodSink, C: Monotonic, W: Watchdog>(
     link: &mut L,
     sink: &mut S,
     clock: &mut C,
+    watchdog: &mut W,
     session: &mut Session,
 ) -> Summary {
     let mut summary = Summary {
@@ -62,8 +66,11 @@ pub fn run<L: Link, S: LinePeriodSink, C: Monotonic>(
     };
     let mut faults = 0u32;
     let mut mode = session.controller.mode();
+    let mut kept = retained::Kept::default();
+    retained::keep(&session.controller, &mut kept);
     let started_us = clock.now_us();
     loop {
+        watchdog.feed();
         // Room first for everything the next byte can make the session send (a PERIODS
         // and a STATUS frame): the downlink paces the uplink, as the receive queue's
         // stall paces the ground (docs/telemetry.md, "The transmit queue").
@@ -91,11 +98,12 @@ pub fn run<L: Link, S: LinePeriodSink, C: Monotonic>(
         };
         let step_start_us = clock.now_us();
         let ended = session.feed(&[byte], sink, |frame| link.send_frame(frame));
+        retained::keep(&session.controller, &mut kept);
         let step_us = clock.now_us().saturating_sub(step_start_us);
         summary.longest_step_us = summary.longest_step_us.max(step_us);
         report_changes(session, &mut faults, &mut mode);
         if ended {
-            drain(link);
+            drain(link, watchdog);
             summary.tx_dropped = session.downlink_dropped;
             let c = &session.controller;
             defmt::info!(
@@ -121,8 +129,9 @@ pub fn run<L: Link, S: LinePeriodSink, C: Monotonic>(
 /// Bytes that still arrive are read and ignored (the pass has ended): reading them lets
 /// a receive side that stalled its queue unmask its line, which on the STM32F405 is the
 /// transmitter's too.
-fn drain<L: Link>(link: &mut L) {
+fn drain<L: Link, W: Watchdog>(link: &mut L, watchdog: &mut W) {
     while !link.tx_drained() {
+        watchdog.feed();
         while link.read().is_ok() {}
         link.wait_for_tx_drained();
     }

@@ -16,6 +16,7 @@
 
 mod bench;
 pub(crate) mod board;
+mod faults;
 mod flash;
 mod pass;
 mod profile;
@@ -105,6 +106,7 @@ pub fn test_target() -> Result<()> {
         }
         e2e_test(board)?;
     }
+    faults::faults_test(Board::Mps2An386)?;
     eprintln!(
         "xtask: target checks passed on {} in {:.1} s",
         board::names(),

@@ -115,6 +115,53 @@ pub mod timer {
     pub const CTRL_EN: u32 = 1 << 0;
 }
 
+/// The APB watchdog's registers (TRM, "APB watchdog"; QEMU
+/// hw/watchdog/cmsdk-apb-watchdog.c).
+pub mod watchdog {
+    use core::mem::{offset_of, size_of};
+    use volatile_register::RW;
+
+    /// The watchdog's register block, up to LOCK (the integration-test and ID registers
+    /// above it are not used).
+    #[repr(C)]
+    pub struct RegisterBlock {
+        /// 0x000 LOAD: the count the counter restarts from.
+        pub load: RW<u32>,
+        /// 0x004 VALUE: the down-counter (read only).
+        pub value: RW<u32>,
+        /// 0x008 CONTROL: INTEN (also runs the counter), RESEN.
+        pub control: RW<u32>,
+        /// 0x00C INTCLR: any write clears the interrupt and reloads the counter.
+        pub intclr: RW<u32>,
+        /// 0x010 RIS: raw interrupt status.
+        pub ris: RW<u32>,
+        /// 0x014 MIS: masked interrupt status.
+        pub mis: RW<u32>,
+        _reserved: [u32; 762],
+        /// 0xC00 LOCK: writing [`UNLOCK`] allows writes to the others, any other value
+        /// stops them.
+        pub lock: RW<u32>,
+    }
+
+    const _: () = {
+        assert!(offset_of!(RegisterBlock, load) == 0x000);
+        assert!(offset_of!(RegisterBlock, value) == 0x004);
+        assert!(offset_of!(RegisterBlock, control) == 0x008);
+        assert!(offset_of!(RegisterBlock, intclr) == 0x00C);
+        assert!(offset_of!(RegisterBlock, ris) == 0x010);
+        assert!(offset_of!(RegisterBlock, mis) == 0x014);
+        assert!(offset_of!(RegisterBlock, lock) == 0xC00);
+        assert!(size_of::<RegisterBlock>() == 0xC04);
+    };
+
+    /// CONTROL: interrupt enable; the counter runs only while it is set.
+    pub const CONTROL_INTEN: u32 = 1 << 0;
+    /// CONTROL: reset enable: a second time-out with the interrupt still raised resets.
+    pub const CONTROL_RESEN: u32 = 1 << 1;
+    /// LOCK: the key that allows writes.
+    pub const UNLOCK: u32 = 0x1ACC_E551;
+}
+
 /// The register block `B` of the peripheral instance at `ADDR`: a zero-sized handle that
 /// dereferences to the block, as `cortex-m`'s `SYST` or `NVIC` do. Only its constructor is
 /// `unsafe`; reads through it are safe, writes are `volatile_register`'s `unsafe` ones.
@@ -163,6 +210,53 @@ impl<B, const ADDR: usize> Deref for Peripheral<B, ADDR> {
 pub type UartRegisters<const ADDR: usize> = Peripheral<uart::RegisterBlock, ADDR>;
 /// The registers of the CMSDK APB timer at `ADDR`.
 pub type TimerRegisters<const ADDR: usize> = Peripheral<timer::RegisterBlock, ADDR>;
+
+/// The registers of the CMSDK APB watchdog at `ADDR`.
+pub type WatchdogRegisters<const ADDR: usize> = Peripheral<watchdog::RegisterBlock, ADDR>;
+
+/// The CMSDK APB watchdog at `ADDR`, counting down from LOAD on its clock: at zero it
+/// raises its interrupt (the board wires it to the NMI: the early warning) and starts
+/// again; at zero with the interrupt still raised it resets the system. Feeding clears
+/// the interrupt and restarts the count.
+pub struct Watchdog<const ADDR: usize> {
+    regs: WatchdogRegisters<ADDR>,
+}
+
+impl<const ADDR: usize> Watchdog<ADDR> {
+    /// The watchdog, started: the interrupt after `ticks` of its clock without a feed,
+    /// the reset `ticks` later.
+    ///
+    /// # Safety
+    /// A CMSDK APB watchdog must be mapped at `ADDR`, and the caller must be its only
+    /// owner; its interrupt's handler must be installed.
+    pub unsafe fn start(ticks: u32) -> Self {
+        // SAFETY: the caller's contract.
+        let regs = unsafe { WatchdogRegisters::new() };
+        // SAFETY: unlocked, the count set and the counter started with its interrupt
+        // and reset, locked again so that a stray write cannot stop it.
+        unsafe {
+            regs.lock.write(watchdog::UNLOCK);
+            regs.load.write(ticks.max(1));
+            regs.intclr.write(1);
+            regs.control
+                .write(watchdog::CONTROL_INTEN | watchdog::CONTROL_RESEN);
+            regs.lock.write(0);
+        }
+        Watchdog { regs }
+    }
+}
+
+impl<const ADDR: usize> super::Watchdog for Watchdog<ADDR> {
+    fn feed(&mut self) {
+        // SAFETY: unlocked, INTCLR written (clears the interrupt, reloads the counter),
+        // locked again.
+        unsafe {
+            self.regs.lock.write(watchdog::UNLOCK);
+            self.regs.intclr.write(1);
+            self.regs.lock.write(0);
+        }
+    }
+}
 
 /// The receiver of the UART at `ADDR`, read by the receive interrupt only: DATA reads,
 /// STATE's receive bits, INTSTATUS.RX (the transmitter's DATA writes, STATE.TXFULL and

@@ -7,17 +7,19 @@
 //! - segment 0's line clock: a timer's reload register
 //!   ([`crate::line_clock::ReloadRegister`], the project's own trait: embedded-hal 1.0
 //!   has no timer traits);
-//! - time: a [`Monotonic`] microsecond count.
+//! - time: a [`Monotonic`] microsecond count;
+//! - a [`Watchdog`], started, that the loop feeds while it makes progress, and the
+//!   reset cause the board's reset controller reports, if it keeps one.
 //!
 //! Each board module builds these from its hardware and exports the same names: `NAME`,
 //! `LINK`, `take()` and the `Link`, `LineClock` and `Clock` types. The controller, the
 //! session and the telemetry loop see only the traits. No hardware address appears
 //! outside the board modules.
 //!
-//! | feature | module | link | line clock | clock |
-//! |---|---|---|---|---|
-//! | `mps2-an386` (default) | [`mps2_an386`] on [`cmsdk`] | CMSDK UART0 | CMSDK TIMER0 RELOAD | CMSDK TIMER1 |
-//! | `stm32f405` | `stm32f405` (stm32f4xx-hal) | USART1 | TIM2 ARR | TIM5 (1 MHz) |
+//! | feature | module | link | line clock | clock | watchdog |
+//! |---|---|---|---|---|---|
+//! | `mps2-an386` (default) | [`mps2_an386`] on [`cmsdk`] | CMSDK UART0 | CMSDK TIMER0 RELOAD | CMSDK TIMER1 | CMSDK APB watchdog |
+//! | `stm32f405` | `stm32f405` (stm32f4xx-hal) | USART1 | TIM2 ARR | TIM5 (1 MHz) | IWDG |
 
 #[cfg(all(feature = "mps2-an386", feature = "stm32f405"))]
 compile_error!(
@@ -32,12 +34,12 @@ pub mod cmsdk;
 #[cfg(feature = "mps2-an386")]
 pub mod mps2_an386;
 #[cfg(feature = "mps2-an386")]
-pub use mps2_an386::{take, Clock, LineClock, Link, LINK, NAME};
+pub use mps2_an386::{take, Clock, LineClock, Link, Watchdog as BoardWatchdog, LINK, NAME};
 
 #[cfg(feature = "stm32f405")]
 pub mod stm32f405;
 #[cfg(feature = "stm32f405")]
-pub use stm32f405::{take, Clock, LineClock, Link, LINK, NAME};
+pub use stm32f405::{take, Clock, LineClock, Link, Watchdog as BoardWatchdog, LINK, NAME};
 
 /// The telemetry link's speed (baud), 8N1: the ground link's, the same on every board
 /// (QEMU ignores it).
@@ -50,11 +52,36 @@ pub trait Monotonic {
     fn now_us(&mut self) -> u64;
 }
 
+/// How long the main loop may go without progress before the watchdog resets the core
+/// (ms). Long beside the loop's longest step (an update and its PERIODS frame: well
+/// under a millisecond on either core) and beside a host's scheduling gaps under QEMU,
+/// whose watchdog runs on the virtual clock; short beside the seconds a camera can go
+/// without new line periods (docs/target.md, "Faults and resets").
+pub const WATCHDOG_TIMEOUT_MS: u32 = 2_000;
+
+/// How often the core wakes from its sleep even when no byte arrives (ms): the loop
+/// then goes round once and feeds the watchdog, so that a quiet link is not taken for a
+/// hung loop. (SysTick's 24-bit counter holds it up to a 335 MHz core clock.)
+pub const HEARTBEAT_MS: u32 = 50;
+
+/// A started watchdog.
+pub trait Watchdog {
+    /// Restarts the countdown: call only when the main loop has made progress.
+    fn feed(&mut self);
+}
+
 /// What a board hands the application.
-pub struct Parts<L, C, M> {
+pub struct Parts<L, C, M, W> {
     pub link: L,
     pub line_clock: C,
     pub clock: M,
+    /// The watchdog, started with [`WATCHDOG_TIMEOUT_MS`].
+    pub watchdog: W,
+    /// Why the core started, as the board's reset controller reports it (None where it
+    /// keeps no flags: then the record in retained RAM tells, `crate::retained`).
+    pub reset_cause: Option<crate::retained::ResetCause>,
+    /// The core clock (Hz), which the heartbeat (SysTick) counts.
+    pub core_clock_hz: u32,
     /// The frequency segment 0's timer counts at (Hz). On QEMU neither board can count
     /// at the scene's 10 MHz line clock: the reload register path is real, the rate is
     /// not (docs/target.md).

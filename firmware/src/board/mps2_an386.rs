@@ -9,10 +9,11 @@
 
 use core::sync::atomic::{AtomicBool, Ordering};
 
-use super::cmsdk::{start_uart, FreeRunning, Timer, UartRx, UartTx};
-use super::{BoardError, Parts, LINK_BAUD};
+use super::cmsdk::{self, start_uart, FreeRunning, Timer, UartRx, UartTx};
+use super::{BoardError, Parts, LINK_BAUD, WATCHDOG_TIMEOUT_MS};
 use crate::link::QueuedLink;
 use crate::platform;
+use crate::retained::{self, ResetCause};
 use crate::{rx, tx};
 
 /// The board's name (the cargo feature).
@@ -23,6 +24,7 @@ pub const LINK: &str = "UART0";
 pub type Link = QueuedLink<Uart0Rx, Uart0Tx>;
 pub type LineClock = Timer<TIMER0_BASE>;
 pub type Clock = FreeRunning<TIMER1_BASE, PCLK_HZ>;
+pub type Watchdog = cmsdk::Watchdog<WATCHDOG_BASE>;
 
 /// UART0's base address: a CMSDK APB UART.
 const UART0_BASE: usize = 0x4000_4000;
@@ -30,33 +32,45 @@ const UART0_BASE: usize = 0x4000_4000;
 const TIMER0_BASE: usize = 0x4000_0000;
 /// TIMER1's base address: a CMSDK APB timer.
 const TIMER1_BASE: usize = 0x4000_1000;
-/// The APB clock of the UARTs and timers (Hz). TIMER1 at this rate wraps every
+/// The watchdog's base address: a CMSDK APB watchdog, its interrupt wired to the NMI.
+const WATCHDOG_BASE: usize = 0x4000_8000;
+/// The APB clock of the UARTs, timers and watchdog, and the core's clock (Hz). TIMER1 at this rate wraps every
 /// 2^32 / 25 MHz = 172 s.
 const PCLK_HZ: u32 = 25_000_000;
 
 /// Brings the board up: UART0 at 115 200 Bd, its receive interrupt feeding the receive
-/// queue and its transmit interrupt draining the transmit queue, TIMER0 stopped until its first period, TIMER1 running. Call once.
-pub fn take() -> Result<Parts<Link, LineClock, Clock>, BoardError> {
+/// queue and its transmit interrupt draining the transmit queue, TIMER0 stopped until
+/// its first period, TIMER1 running, the watchdog started. Call once.
+pub fn take() -> Result<Parts<Link, LineClock, Clock, Watchdog>, BoardError> {
     // The same guard as a HAL's `Peripherals::take`: a second call gets nothing.
     static TAKEN: AtomicBool = AtomicBool::new(false);
     if TAKEN.swap(true, Ordering::Relaxed) {
         return Err(BoardError::Taken);
     }
-    // SAFETY: the addresses are those of a CMSDK APB UART and two CMSDK APB timers on
-    // this machine, and the guard above lets this run once, so nothing else owns UART0,
-    // TIMER0 or TIMER1.
-    let (link, line_clock, clock) = unsafe {
+    // Half the time-out to the early warning (the NMI, which resets at once), the other
+    // half to the watchdog's own reset if the NMI handler cannot run.
+    let half_timeout_ticks = PCLK_HZ / 1000 * (WATCHDOG_TIMEOUT_MS / 2);
+    // SAFETY: the addresses are those of a CMSDK APB UART, two CMSDK APB timers and the
+    // CMSDK APB watchdog on this machine, and the guard above lets this run once, so
+    // nothing else owns them; the watchdog's NMI handler is below.
+    let (link, line_clock, clock, watchdog) = unsafe {
         (
             start_uart::<UART0_BASE, _, _>(PCLK_HZ, LINK_BAUD, (&RX, Uart0Rx), (&TX, Uart0Tx))
                 .ok_or(BoardError::Taken)?,
             LineClock::stopped(),
             Clock::start(),
+            Watchdog::start(half_timeout_ticks),
         )
     };
     Ok(Parts {
         link,
         line_clock,
         clock,
+        watchdog,
+        // The MPS2's system control keeps no reset flags that QEMU models: the record in
+        // retained RAM tells.
+        reset_cause: None,
+        core_clock_hz: PCLK_HZ,
         timer_clock_hz: PCLK_HZ,
     })
 }
@@ -92,6 +106,16 @@ unsafe impl cortex_m::interrupt::InterruptNumber for Uart0Tx {
 static RX: rx::Handler<UartRx<UART0_BASE>, Uart0Rx> = rx::Handler::new();
 /// The transmit interrupt's state: UART0's transmitter and the queue's consumer.
 static TX: tx::Handler<UartTx<UART0_BASE>> = tx::Handler::new();
+
+/// The watchdog's early warning: the loop has not fed it for half the time-out. The
+/// core is reset now rather than at the watchdog's second time-out, the cause noted for
+/// the next boot (`crate::retained`). (`unsafe` because cortex-m-rt asks it of an NMI
+/// handler, which nothing can mask; this one touches only the retained record.)
+#[cortex_m_rt::exception]
+unsafe fn NonMaskableInt() {
+    retained::note_cause(ResetCause::Watchdog);
+    cortex_m::peripheral::SCB::sys_reset()
+}
 
 /// Every device interrupt. The mps2-an386 has no peripheral access crate to name its
 /// vectors, so cortex-m-rt's default vector table sends them all here with their

@@ -15,6 +15,10 @@
 //!   its auto-reload register with preload (ARPE), so a new period starts at the end of
 //!   the current line, never in the middle of one.
 //! - Clock: TIM5 (32-bit) as the HAL's 1 MHz counter, free-running.
+//! - Watchdog: the IWDG on the 32 kHz LSI, through the HAL; the reset cause from
+//!   RCC_CSR's flags (cleared at each boot). QEMU 7.2 models neither (the IWDG and RCC
+//!   are unimplemented devices there: writes ignored, reads 0, so no reset and no
+//!   flags); on the mps2 QEMU models the watchdog (docs/target.md, "Faults and resets").
 //!
 //! Under QEMU the USART is flow-controlled like the mps2's UART (the host's next byte
 //! waits until DR has been read) but drops bytes that arrive before it is enabled, which
@@ -28,11 +32,13 @@ use stm32f4xx_hal::pac::{self, interrupt, Interrupt};
 use stm32f4xx_hal::prelude::*;
 use stm32f4xx_hal::serial::{Event, Rx, Serial, Tx, TxListen};
 use stm32f4xx_hal::timer::{CounterUs, Timer};
+use stm32f4xx_hal::watchdog::IndependentWatchdog;
 use stm32f4xx_hal::Listen;
 
-use super::{BoardError, Extended, Monotonic, Parts, LINK_BAUD};
+use super::{BoardError, Extended, Monotonic, Parts, LINK_BAUD, WATCHDOG_TIMEOUT_MS};
 use crate::line_clock::ReloadRegister;
 use crate::link::{LinkError, QueuedLink};
+use crate::retained::ResetCause;
 use crate::rx;
 use crate::tx::{self, TxPort};
 
@@ -44,6 +50,7 @@ pub const LINK: &str = "USART1";
 pub type Link = Usart1;
 pub type LineClock = Tim2Reload;
 pub type Clock = Tim5Clock;
+pub type Watchdog = Iwdg;
 
 /// The receive interrupt's state: USART1's receiver and the queue's producer.
 static RX: rx::Handler<Rx<pac::USART1, u8>, Interrupt> = rx::Handler::new();
@@ -60,9 +67,11 @@ fn USART1() {
 }
 
 /// Brings the board up: HSI clocks, USART1 at 115 200 Bd, its interrupt feeding the
-/// receive queue and draining the transmit queue, TIM2 stopped until its first period, TIM5 counting. Call once.
-pub fn take() -> Result<Parts<Link, LineClock, Clock>, BoardError> {
+/// receive queue and draining the transmit queue, TIM2 stopped until its first period,
+/// TIM5 counting, the IWDG started. Call once.
+pub fn take() -> Result<Parts<Link, LineClock, Clock, Watchdog>, BoardError> {
     let dp = pac::Peripherals::take().ok_or(BoardError::Taken)?;
+    let reset_cause = reset_cause(&dp.RCC);
     // The clocks as reset leaves them: HSI 16 MHz, every bus undivided (`freeze` would
     // compute the same from `Config::hsi()`, through PLL set-up code that can panic).
     let mut rcc = dp.RCC.constrain();
@@ -91,6 +100,10 @@ pub fn take() -> Result<Parts<Link, LineClock, Clock>, BoardError> {
     tim5.start(u32::MAX.micros())
         .map_err(|_| BoardError::TimerConfig)?;
     let ticks = Extended::new(u64::from(u32::MAX), tim5.now().ticks());
+    let core_clock_hz = rcc.clocks.sysclk().raw();
+
+    let mut iwdg = IndependentWatchdog::new(dp.IWDG);
+    iwdg.start(WATCHDOG_TIMEOUT_MS.millis());
 
     Ok(Parts {
         link: QueuedLink::new(rx, tx),
@@ -99,8 +112,39 @@ pub fn take() -> Result<Parts<Link, LineClock, Clock>, BoardError> {
             counter: tim5,
             ticks,
         },
+        watchdog: Iwdg(iwdg),
+        reset_cause,
+        core_clock_hz,
         timer_clock_hz,
     })
+}
+
+/// The last reset's cause from RCC_CSR's flags, which are then cleared so that the next
+/// reset's stand alone. None if no flag is set (QEMU, which does not model them).
+fn reset_cause(rcc: &pac::RCC) -> Option<ResetCause> {
+    let csr = rcc.csr().read();
+    let cause = if csr.porrstf().bit_is_set() || csr.borrstf().bit_is_set() {
+        Some(ResetCause::PowerOn)
+    } else if csr.wdgrstf().bit_is_set() || csr.wwdgrstf().bit_is_set() {
+        Some(ResetCause::Watchdog)
+    } else if csr.sftrstf().bit_is_set() {
+        Some(ResetCause::Software)
+    } else if csr.padrstf().bit_is_set() || csr.lpwrrstf().bit_is_set() {
+        Some(ResetCause::Unknown)
+    } else {
+        None
+    };
+    rcc.csr().modify(|_, w| w.rmvf().set_bit());
+    cause
+}
+
+/// The IWDG, started by [`take`].
+pub struct Iwdg(IndependentWatchdog);
+
+impl super::Watchdog for Iwdg {
+    fn feed(&mut self) {
+        self.0.feed();
+    }
 }
 
 /// USART1, the loop's side: the receive queue the interrupt fills and the transmit queue

@@ -65,10 +65,13 @@ impl LinePeriodSink for Accept {
     }
 }
 
-/// The controller the firmware runs (same config, same boot scene).
+/// The controller the firmware runs after power-on (same config, same boot scene, the
+/// boot it notes for STATUS).
 pub fn new_controller() -> Result<Controller> {
-    Controller::new(Config::default(), Scene::paper_default())
-        .map_err(|f| anyhow!("the default scene was refused: {}", f.name()))
+    let mut c = Controller::new(Config::default(), Scene::paper_default())
+        .map_err(|f| anyhow!("the default scene was refused: {}", f.name()))?;
+    c.note_boot(controller::restart::ResetCause::PowerOn, 0);
+    Ok(c)
 }
 
 /// What the controller had in force at one update: the NAV frame and the ground heights.

@@ -1,0 +1,189 @@
+//! What a reset must not lose, and why the core last started.
+//!
+//! A [`Snapshot`] holds the scene in force, its ground heights and the last periods, each
+//! in the telemetry's own encoding (a SCENE, a TERRAIN and a PERIODS payload): the
+//! codecs and checks are the ones the link uses, and the encoding does not depend on how
+//! a build lays out its structures, so a snapshot left by another build is decoded and
+//! checked like any frame from the ground, not misread. The firmware keeps it in RAM that
+//! survives a reset (firmware/src/retained.rs, under a CRC) and, after a reset, hands it
+//! to [`Controller::restore`]: the periods go back into the registers first, then the
+//! scene is planned and the heights put back; every period stays flagged held until
+//! the first update on fresh telemetry (docs/target.md, "Faults and resets").
+
+use crate::control::{Controller, SegmentOutput};
+use crate::fault::Fault;
+use crate::frame::MAX_PAYLOAD;
+use crate::report::{encode_periods, Periods};
+use crate::scene::{Scene, Terrain, MAX_SEGMENTS};
+use crate::sink::LinePeriodSink;
+
+/// Why the core last started, as STATUS reports it (its byte 2; 0: not reported).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u8)]
+pub enum ResetCause {
+    /// Power-on, or a retained record that did not check out.
+    PowerOn = 1,
+    /// The watchdog: the main loop stopped making progress.
+    Watchdog = 2,
+    /// The firmware asked for it without noting why.
+    Software = 3,
+    /// A reset the firmware did not see coming and the board cannot name (the reset
+    /// pin, a debugger).
+    Unknown = 4,
+    /// The stack ran into its guard.
+    StackOverflow = 5,
+    /// Any other HardFault.
+    Fault = 6,
+}
+
+impl ResetCause {
+    pub const ALL: [ResetCause; 6] = [
+        ResetCause::PowerOn,
+        ResetCause::Watchdog,
+        ResetCause::Software,
+        ResetCause::Unknown,
+        ResetCause::StackOverflow,
+        ResetCause::Fault,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            ResetCause::PowerOn => "power-on",
+            ResetCause::Watchdog => "watchdog",
+            ResetCause::Software => "software",
+            ResetCause::Unknown => "unknown",
+            ResetCause::StackOverflow => "stack overflow",
+            ResetCause::Fault => "hard fault",
+        }
+    }
+
+    /// The cause of wire value `code` (None for 0, "not reported", and unknown values).
+    pub fn from_u8(code: u8) -> Option<ResetCause> {
+        ResetCause::ALL.into_iter().find(|c| *c as u8 == code)
+    }
+}
+
+/// One payload and its length. `repr(C)` with only integers, so that RAM kept across a
+/// reset can hold one: any contents are a valid value, checked before use.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(C)]
+pub struct Payload {
+    pub len: u16,
+    pub bytes: [u8; MAX_PAYLOAD],
+}
+
+impl Payload {
+    pub const EMPTY: Payload = Payload {
+        len: 0,
+        bytes: [0; MAX_PAYLOAD],
+    };
+
+    pub fn as_slice(&self) -> &[u8] {
+        self.bytes.get(..usize::from(self.len)).unwrap_or(&[])
+    }
+
+    /// Fills the payload with `encode`'s output; false (and empty) if it did not fit.
+    fn fill(&mut self, encode: impl FnOnce(&mut [u8]) -> Option<usize>) -> bool {
+        let len = encode(&mut self.bytes).and_then(|n| u16::try_from(n).ok());
+        self.len = len.unwrap_or(0);
+        len.is_some()
+    }
+}
+
+/// The state a reset must not lose (see the module's documentation).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(C)]
+pub struct Snapshot {
+    /// The scene in force (a SCENE payload).
+    pub scene: Payload,
+    /// The ground heights in force (a TERRAIN payload).
+    pub terrain: Payload,
+    /// The outputs in force (a PERIODS payload).
+    pub periods: Payload,
+}
+
+impl Snapshot {
+    pub const EMPTY: Snapshot = Snapshot {
+        scene: Payload::EMPTY,
+        terrain: Payload::EMPTY,
+        periods: Payload::EMPTY,
+    };
+}
+
+/// What [`Controller::restore`] put back.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Restored {
+    /// Periods written to the sink (and held).
+    pub periods: usize,
+}
+
+impl Controller {
+    /// Writes the scene and ground heights in force into `out` (they change only with a
+    /// SCENE or TERRAIN frame: [`Controller::inputs_generation`] tells when). False if
+    /// they do not fit (never for a scene the controller accepted).
+    pub fn snapshot_inputs(&self, out: &mut Snapshot) -> bool {
+        let terrain = Terrain {
+            heights_m: self.heights_m,
+            count: self.scene.count,
+        };
+        out.scene.fill(|b| self.scene.encode(b)) && out.terrain.fill(|b| terrain.encode(b))
+    }
+
+    /// Writes the outputs in force into `out` (after every update).
+    pub fn snapshot_periods(&self, out: &mut Payload) -> bool {
+        out.fill(|b| encode_periods(self, b))
+    }
+
+    /// Puts `snapshot` back after a reset: each period into `sink` first (a record whose
+    /// segment the snapshot's scene does not have active, or whose period is 0, is
+    /// skipped), then the scene, planned, and its heights; every output restored is
+    /// flagged held. The NAV state, the clock, the counters stay as they are (a
+    /// controller fresh from [`Controller::blank`]: waiting for NAV).
+    ///
+    /// The checks are those of the frames: a payload that does not decode, a scene the
+    /// planner refuses or heights out of range give that fault and change nothing but
+    /// the registers already written, whose periods the snapshot held in force before.
+    // Not inlined: its frames (a decoded PERIODS payload, a scene) exist only while it
+    // runs, once after a reset, not in every frame of its caller.
+    #[inline(never)]
+    pub fn restore<S: LinePeriodSink>(
+        &mut self,
+        snapshot: &Snapshot,
+        sink: &mut S,
+    ) -> Result<Restored, Fault> {
+        let periods = Periods::decode(snapshot.periods.as_slice()).ok_or(Fault::BadLength)?;
+        let scene = Scene::decode(snapshot.scene.as_slice())?;
+        let active = |index: u8| {
+            scene
+                .active()
+                .any(|(k, _)| usize::from(index) == k && k < MAX_SEGMENTS)
+        };
+        let mut written = [false; MAX_SEGMENTS];
+        for r in periods
+            .records()
+            .iter()
+            .filter(|r| r.ticks != 0 && active(r.index))
+        {
+            if let Some(w) = written.get_mut(usize::from(r.index)) {
+                *w = sink.write_period(r.index, r.ticks).is_ok();
+            }
+        }
+        let terrain = Terrain::decode(snapshot.terrain.as_slice(), &scene)?;
+        self.set_scene(scene)?;
+        self.heights_m = terrain.heights_m;
+        self.inputs_generation = self.inputs_generation.wrapping_add(1);
+        let records = periods.records().iter();
+        for r in records.filter(|r| written.get(usize::from(r.index)) == Some(&true)) {
+            let slot = usize::from(r.index);
+            if let (Some(o), Some(h)) = (self.outputs.get_mut(slot), self.has_output.get_mut(slot))
+            {
+                *o = SegmentOutput { held: true, ..*r };
+                *h = true;
+            }
+        }
+        self.yaw_request_rad = periods.yaw_request_rad;
+        Ok(Restored {
+            periods: written.iter().filter(|w| **w).count(),
+        })
+    }
+}
