@@ -16,12 +16,12 @@ use controller::Scene;
 use core_math::sphere::{Geometry, OrbitState, Reference, CLOSED_F32};
 use core_math::vector::norm;
 use core_math::{
-    mtf_mismatch, Backend, Camera, ImageMotion, ModelError, StageRule, StateVector,
-    EARTH_RATE_RAD_S,
+    mtf_mismatch, Backend, Camera, EarthCamera, Ellipsoid, ImageMotion, ModelError, StageRule,
+    StateVector, EARTH_RATE_RAD_S,
 };
 
 use crate::markdown::{e2, replace_between, signed};
-use motion::{Orbit, Scenario, Spheroid};
+use motion::{circular_roll, general_motion, Orbit, Spheroid};
 
 /// The orbit of the default pass (`cargo xtask run`): circular, 645 km over the
 /// controller's round Earth, sun-synchronous inclination.
@@ -235,24 +235,24 @@ fn case(
     roll_rad: f64,
     n: f64,
 ) -> Result<Errors> {
-    let scenario = |earth| Scenario {
-        earth,
-        earth_rate_rad_s: EARTH_RATE_RAD_S,
-        orbit: *orbit,
-        arg_latitude_rad: u_rad,
-        roll_rad,
+    let cam = EarthCamera {
+        focal_m: camera.focal_m,
+        pixel_m: camera.pixel_m,
+        p1_m: 0.0,
     };
-    let miss = || anyhow!("ellipsoid: pixel {n} misses the Earth");
-    let ell_full = scenario(Spheroid::WGS84)
-        .image_motion(camera, n)
-        .ok_or_else(miss)?;
+    let truth = |ellipsoid| {
+        general_motion(&circular_roll(orbit, u_rad, roll_rad, ellipsoid), &cam, n)
+            .map_err(|e| anyhow!("ellipsoid: pixel {n}: {e:?}"))
+    };
+    let ell_full = truth(Ellipsoid::WGS84)?;
     let ell = ell_full.motion;
     let g = ell_full.ground_m;
     let ground_lat_deg = (g[2] / norm(g)).asin().to_degrees();
-    let sph = scenario(Spheroid::sphere(r_model))
-        .image_motion(camera, n)
-        .ok_or_else(miss)?
-        .motion;
+    let sph = truth(Ellipsoid {
+        a_m: r_model,
+        flattening: 0.0,
+    })?
+    .motion;
 
     let g_round = model_geometry(orbit, u_rad, roll_rad, r_model)?;
     let round = reference(camera, &g_round, n)?;
