@@ -40,23 +40,25 @@ const COSTS_BEGIN: &str = "<!-- ellipsoid-costs:begin (written by `cargo xtask e
 const COSTS_END: &str = "<!-- ellipsoid-costs:end -->";
 const CMD: &str = "`cargo xtask ellipsoid`";
 
-/// Worst case and RMS of one error over a set of cases.
+/// Worst (signed, largest magnitude), range and RMS of one error over a set of cases,
+/// with where the worst is.
 #[derive(Clone, Copy, Debug, Default)]
-struct Stat {
-    /// The error of largest magnitude (signed), and where.
-    worst: f64,
-    at: Where,
+pub struct Stat<W> {
+    pub worst: f64,
+    pub at: W,
     min: f64,
     max: f64,
     sum_sq: f64,
-    count: usize,
+    pub count: usize,
+    /// Cases skipped: a miss or within 0.5 deg of the limb (truth or model).
+    pub skipped: usize,
 }
 
-impl Stat {
-    fn push(&mut self, e: f64, c: &Where) {
+impl<W> Stat<W> {
+    fn push(&mut self, e: f64, at: impl FnOnce() -> W) {
         if self.count == 0 || e.abs() > self.worst.abs() {
             self.worst = e;
-            self.at = *c;
+            self.at = at();
         }
         if self.count == 0 {
             (self.min, self.max) = (e, e);
@@ -67,7 +69,7 @@ impl Stat {
         self.count += 1;
     }
 
-    fn rms(&self) -> f64 {
+    pub fn rms(&self) -> f64 {
         (self.sum_sq / self.count.max(1) as f64).sqrt()
     }
 }
@@ -107,22 +109,22 @@ struct Errors {
 
 #[derive(Clone, Copy, Debug, Default)]
 struct Stats {
-    round: Stat,
-    local: Stat,
-    pixel: Stat,
-    drift: Stat,
-    f32_arith: Stat,
-    validation: Stat,
+    round: Stat<Where>,
+    local: Stat<Where>,
+    pixel: Stat<Where>,
+    drift: Stat<Where>,
+    f32_arith: Stat<Where>,
+    validation: Stat<Where>,
 }
 
 impl Stats {
     fn push(&mut self, e: &Errors, w: &Where) {
-        self.round.push(e.round, w);
-        self.local.push(e.local, w);
-        self.pixel.push(e.pixel, w);
-        self.drift.push(e.drift_rad, w);
-        self.f32_arith.push(e.f32_arith, w);
-        self.validation.push(e.validation, w);
+        self.round.push(e.round, || *w);
+        self.local.push(e.local, || *w);
+        self.pixel.push(e.pixel, || *w);
+        self.drift.push(e.drift_rad, || *w);
+        self.f32_arith.push(e.f32_arith, || *w);
+        self.validation.push(e.validation, || *w);
     }
 }
 

@@ -62,31 +62,8 @@ impl Grid {
     };
 }
 
-/// Worst (signed, largest magnitude) and RMS of one error over a set of cases.
-#[derive(Clone, Debug, Default)]
-pub struct Stat {
-    pub worst: f64,
-    pub at: String,
-    sum_sq: f64,
-    pub count: usize,
-    /// Cases skipped: a miss or within 0.5 deg of the limb (truth or model).
-    pub skipped: usize,
-}
-
-impl Stat {
-    fn push(&mut self, e: f64, at: impl FnOnce() -> String) {
-        if self.count == 0 || e.abs() > self.worst.abs() {
-            self.worst = e;
-            self.at = at();
-        }
-        self.sum_sq += e * e;
-        self.count += 1;
-    }
-
-    pub fn rms(&self) -> f64 {
-        (self.sum_sq / self.count.max(1) as f64).sqrt()
-    }
-}
+/// Worst and RMS of a row's error, with where the worst is.
+pub type Stat = super::Stat<String>;
 
 /// One row of the table.
 #[derive(Clone, Debug)]
