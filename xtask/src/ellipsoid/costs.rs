@@ -12,7 +12,7 @@
 
 use core_math::earth::kepler::Kepler;
 use core_math::earth::{limb_margin_rad, Attitude};
-use core_math::sample::SplitMix64;
+use core_math::sample::{eccentric_state, SplitMix64};
 use core_math::sphere::Reference;
 use core_math::vector::{dot, norm, scale};
 use core_math::{
@@ -22,7 +22,7 @@ use core_math::{
 
 use crate::markdown::signed;
 
-use super::motion::{eccentric_state, envelope_draw, general_motion, Orbit, Spheroid};
+use super::motion::{envelope_draw, general_motion, Orbit, Spheroid};
 use super::round_geometry;
 
 /// The paper's (and the controller's) Earth radius (m).

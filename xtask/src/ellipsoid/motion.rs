@@ -14,7 +14,7 @@
 //! docs/earth-model.md.
 
 use core_math::earth::Attitude;
-use core_math::sample::SplitMix64;
+use core_math::sample::{eccentric_state, SplitMix64};
 use core_math::vector::{add, cross, dot, norm, scale, unit};
 use core_math::{EarthCamera, EarthGeometry, ImageMotion, StateVector, GM_M3_S2};
 use core_math::{Ellipsoid, EARTH_RATE_RAD_S};
@@ -305,30 +305,6 @@ pub fn general_motion(
     n_px: f64,
 ) -> Result<Numerical, Failure> {
     general_motion_step(g, camera, n_px, GENERAL_STEP_S)
-}
-
-/// The inertial state at radius `r_m` on a two-body orbit of eccentricity `e` at true
-/// anomaly `nu_rad`, of inclination, node and argument of latitude as named (the perigee
-/// lies wherever the true anomaly puts it).
-pub fn eccentric_state(
-    r_m: f64,
-    e: f64,
-    nu_rad: f64,
-    incl_rad: f64,
-    raan_rad: f64,
-    arg_lat_rad: f64,
-) -> StateVector {
-    // Perifocal speeds at true anomaly nu: radial sqrt(GM/p) e sin nu, transverse
-    // sqrt(GM/p) (1 + e cos nu), p = r (1 + e cos nu).
-    let p = r_m * (1.0 + e * nu_rad.cos());
-    let k = (GM_M3_S2 / p).sqrt();
-    let (vr, vt) = (k * e * nu_rad.sin(), k * (1.0 + e * nu_rad.cos()));
-    let orbit = Orbit::circular(r_m, incl_rad, raan_rad);
-    let (pos, fr) = orbit.frame(arg_lat_rad);
-    StateVector {
-        position_m: pos,
-        velocity_mps: comb(vr, fr[2], vt, fr[0], 0.0, fr[1]),
-    }
 }
 
 /// The circular `orbit` at argument of latitude `u_rad` over `ellipsoid`, the camera
