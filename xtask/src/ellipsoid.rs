@@ -23,12 +23,23 @@ use core_math::{
 use crate::markdown::{e2, replace_between, signed};
 use motion::{circular_roll, general_motion, Orbit, Spheroid};
 
+/// The paper's (and the controller's) Earth radius.
+const R_PAPER_M: f64 = 6_371e3;
 /// The orbit of the default pass (`cargo xtask run`): circular, 645 km over the
 /// controller's round Earth, sun-synchronous inclination.
 const ALTITUDE_M: f64 = 645e3;
 const INCLINATION_DEG: f64 = 97.98;
 /// Arbitrary: the spheroid is symmetric about the spin axis.
 const RAAN_RAD: f64 = 0.4;
+
+/// The default scene's orbit (both tables).
+fn default_orbit() -> Orbit {
+    Orbit::circular(
+        R_PAPER_M + ALTITUDE_M,
+        INCLINATION_DEG.to_radians(),
+        RAAN_RAD,
+    )
+}
 /// Argument of latitude 0, 1, ..., 359 deg.
 const ORBIT_STEPS: usize = 360;
 const ROLLS_DEG: [f64; 3] = [-25.0, 0.0, 25.0];
@@ -312,8 +323,8 @@ pub fn summary() -> Result<EllipsoidSummary> {
     let scene = Scene::paper_default();
     let camera = scene.camera;
     // The round Earth of the paper's model (the controller's until issue 12).
-    let r_model = 6_371_000.0;
-    let orbit = Orbit::circular(r_model + ALTITUDE_M, INCLINATION_DEG.to_radians(), RAAN_RAD);
+    let r_model = R_PAPER_M;
+    let orbit = default_orbit();
     let mut samples: Vec<f64> = Vec::new();
     for (_, s) in scene.active() {
         let (a, b) = (f64::from(s.first_px), f64::from(s.last_px));
@@ -551,8 +562,8 @@ mod tests {
     #[test]
     fn nadir_error_is_the_altitude_ratio() {
         let camera = Scene::paper_default().camera;
-        let r_model = 6_371e3;
-        let orbit = Orbit::circular(r_model + ALTITUDE_M, INCLINATION_DEG.to_radians(), 0.4);
+        let r_model = R_PAPER_M;
+        let orbit = default_orbit();
         for u_deg in [0.0, 33.0, 90.0, 150.0, 270.0, 301.0] {
             let u = f64::to_radians(u_deg);
             let e = case(&camera, &orbit, r_model, u, 0.0, 0.0).unwrap();

@@ -22,15 +22,9 @@ use core_math::{
 
 use crate::markdown::signed;
 
-use super::motion::{envelope_draw, general_motion, Orbit, Spheroid};
-use super::round_geometry;
+use super::motion::{envelope_draw, general_motion, Spheroid};
+use super::{default_orbit, round_geometry, ALTITUDE_M, INCLINATION_DEG, RAAN_RAD, R_PAPER_M};
 
-/// The paper's (and the controller's) Earth radius (m).
-const R_PAPER_M: f64 = 6_371e3;
-/// The default scene: 645 km over R, sun-synchronous inclination, node arbitrary.
-const RADIUS_M: f64 = R_PAPER_M + 645e3;
-const INCLINATION_DEG: f64 = 97.98;
-const RAAN_RAD: f64 = 0.4;
 const FOCAL_M: f64 = 0.555;
 const PIXEL_M: f64 = 13e-6;
 /// Terrain height of row (b) (m), eccentricity of row (c), stereo pitches of row (d).
@@ -313,7 +307,7 @@ pub fn costs(grid: Grid) -> Costs {
         pixel_m: PIXEL_M,
         p1_m: 0.0,
     };
-    let orbit = Orbit::circular(RADIUS_M, INCLINATION_DEG.to_radians(), RAAN_RAD);
+    let orbit = default_orbit();
     let cases = default_cases(&grid);
     let circ = |c: &Case| orbit.state(c.u_rad);
     let draws = grid.envelope_draws;
@@ -380,7 +374,7 @@ pub fn costs(grid: Grid) -> Costs {
     };
     let ecc = |c: &Case| {
         eccentric_state(
-            RADIUS_M,
+            R_PAPER_M + ALTITUDE_M,
             ECCENTRICITY,
             c.u_rad,
             INCLINATION_DEG.to_radians(),

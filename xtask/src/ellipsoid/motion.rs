@@ -10,8 +10,7 @@
 //! central difference of those projections. Conventions are those of
 //! `core_math::sphere::Reference` (README, "Conventions"). The round-Earth figures of
 //! `cargo xtask ellipsoid` use it on a circular orbit with roll only ([`roll_only`]).
-//! Its error budget ([`general_motion_step`]) and what the tests below measure:
-//! docs/earth-model.md.
+//! Its error budget and what the tests below measure: docs/earth-model.md.
 
 use core_math::earth::Attitude;
 use core_math::sample::{eccentric_state, SplitMix64};
@@ -222,26 +221,11 @@ impl General {
     }
 }
 
-/// The image motion of the definition (`shared/EARTH-MODEL.md`) for pixel `n_px`, by
-/// construction and a finite difference in time, with stencil unit `step_s`:
-///
-/// - the orbit: the exact two-body motion through the state vector by Kepler's equation
-///   ([`Kepler`]);
-/// - L(t) from r(t), v(t); A(t) = Rx(roll(t)) Ry(pitch(t)) Rz(yaw(t)), applied as three
-///   successive rotations of the vector;
-/// - the line of sight E A (p1, p2, -f) at t = 0, its near intersection with the
-///   ellipsoid (a + h, a + h, b + h) ([`Spheroid::intersect_range`]);
-/// - that Earth-fixed point carried by Rz(omega t), its camera coordinates c(t), and
-///   P = -f (c1, c2) / c3 at t = +-h, ..., +-4h;
-/// - (v1, v2) from the nine-point central difference (Richardson to O(h^8)).
-///
-/// Error budget (f64): the projections carry a few 1e-16 of |P| <= ~1 m (the relative
-/// position G(t) - r(t) is formed without cancellation, see `General::project`), so
-/// rounding gives ~ 1e-15 / h m/s; truncation is h^8 |P^(9)| / 630, with P^(9) ~
-/// f 9! w^9 for the line of sight's angular rate w (<= ~0.1 rad/s over the envelope: a
-/// 200 km orbit seen at nadir and three angle rates of 2 deg/s): ~ 1e-17 m/s at
-/// h = 0.1 s. Against the smallest |v| of the envelope (~1e-3 m/s) rounding dominates:
-/// ~1e-11 of |v|. The propagation is exact to rounding ([`Kepler`]).
+/// The image motion of the definition (`shared/EARTH-MODEL.md`) for pixel `n_px`, built
+/// as the module doc says, with stencil unit `step_s`. Its error budget (rounding
+/// ~1e-15 / h m/s, the relative position formed without cancellation in
+/// `General::project`; truncation h^8 |P^(9)| / 630) is worked out in
+/// docs/earth-model.md, "The general numerical model".
 pub fn general_motion_step(
     g: &EarthGeometry<f64>,
     camera: &EarthCamera,
