@@ -16,19 +16,30 @@ use controller::Scene;
 use core_math::sphere::{Geometry, OrbitState, Reference, CLOSED_F32};
 use core_math::vector::norm;
 use core_math::{
-    mtf_mismatch, Backend, Camera, ImageMotion, ModelError, StageRule, StateVector,
-    EARTH_RATE_RAD_S,
+    mtf_mismatch, Backend, Camera, EarthCamera, Ellipsoid, ImageMotion, ModelError, StageRule,
+    StateVector, EARTH_RATE_RAD_S,
 };
 
 use crate::markdown::{e2, replace_between, signed};
-use motion::{Orbit, Scenario, Spheroid};
+use motion::{circular_roll, general_motion, Orbit, Spheroid};
 
+/// The paper's (and the controller's) Earth radius.
+const R_PAPER_M: f64 = 6_371e3;
 /// The orbit of the default pass (`cargo xtask run`): circular, 645 km over the
 /// controller's round Earth, sun-synchronous inclination.
 const ALTITUDE_M: f64 = 645e3;
 const INCLINATION_DEG: f64 = 97.98;
 /// Arbitrary: the spheroid is symmetric about the spin axis.
 const RAAN_RAD: f64 = 0.4;
+
+/// The default scene's orbit (both tables).
+fn default_orbit() -> Orbit {
+    Orbit::circular(
+        R_PAPER_M + ALTITUDE_M,
+        INCLINATION_DEG.to_radians(),
+        RAAN_RAD,
+    )
+}
 /// Argument of latitude 0, 1, ..., 359 deg.
 const ORBIT_STEPS: usize = 360;
 const ROLLS_DEG: [f64; 3] = [-25.0, 0.0, 25.0];
@@ -40,23 +51,25 @@ const COSTS_BEGIN: &str = "<!-- ellipsoid-costs:begin (written by `cargo xtask e
 const COSTS_END: &str = "<!-- ellipsoid-costs:end -->";
 const CMD: &str = "`cargo xtask ellipsoid`";
 
-/// Worst case and RMS of one error over a set of cases.
+/// Worst (signed, largest magnitude), range and RMS of one error over a set of cases,
+/// with where the worst is.
 #[derive(Clone, Copy, Debug, Default)]
-struct Stat {
-    /// The error of largest magnitude (signed), and where.
-    worst: f64,
-    at: Where,
+pub struct Stat<W> {
+    pub worst: f64,
+    pub at: W,
     min: f64,
     max: f64,
     sum_sq: f64,
-    count: usize,
+    pub count: usize,
+    /// Cases skipped: a miss or within 0.5 deg of the limb (truth or model).
+    pub skipped: usize,
 }
 
-impl Stat {
-    fn push(&mut self, e: f64, c: &Where) {
+impl<W> Stat<W> {
+    fn push(&mut self, e: f64, at: impl FnOnce() -> W) {
         if self.count == 0 || e.abs() > self.worst.abs() {
             self.worst = e;
-            self.at = *c;
+            self.at = at();
         }
         if self.count == 0 {
             (self.min, self.max) = (e, e);
@@ -67,7 +80,7 @@ impl Stat {
         self.count += 1;
     }
 
-    fn rms(&self) -> f64 {
+    pub fn rms(&self) -> f64 {
         (self.sum_sq / self.count.max(1) as f64).sqrt()
     }
 }
@@ -107,22 +120,22 @@ struct Errors {
 
 #[derive(Clone, Copy, Debug, Default)]
 struct Stats {
-    round: Stat,
-    local: Stat,
-    pixel: Stat,
-    drift: Stat,
-    f32_arith: Stat,
-    validation: Stat,
+    round: Stat<Where>,
+    local: Stat<Where>,
+    pixel: Stat<Where>,
+    drift: Stat<Where>,
+    f32_arith: Stat<Where>,
+    validation: Stat<Where>,
 }
 
 impl Stats {
     fn push(&mut self, e: &Errors, w: &Where) {
-        self.round.push(e.round, w);
-        self.local.push(e.local, w);
-        self.pixel.push(e.pixel, w);
-        self.drift.push(e.drift_rad, w);
-        self.f32_arith.push(e.f32_arith, w);
-        self.validation.push(e.validation, w);
+        self.round.push(e.round, || *w);
+        self.local.push(e.local, || *w);
+        self.pixel.push(e.pixel, || *w);
+        self.drift.push(e.drift_rad, || *w);
+        self.f32_arith.push(e.f32_arith, || *w);
+        self.validation.push(e.validation, || *w);
     }
 }
 
@@ -235,24 +248,24 @@ fn case(
     roll_rad: f64,
     n: f64,
 ) -> Result<Errors> {
-    let scenario = |earth| Scenario {
-        earth,
-        earth_rate_rad_s: EARTH_RATE_RAD_S,
-        orbit: *orbit,
-        arg_latitude_rad: u_rad,
-        roll_rad,
+    let cam = EarthCamera {
+        focal_m: camera.focal_m,
+        pixel_m: camera.pixel_m,
+        p1_m: 0.0,
     };
-    let miss = || anyhow!("ellipsoid: pixel {n} misses the Earth");
-    let ell_full = scenario(Spheroid::WGS84)
-        .image_motion(camera, n)
-        .ok_or_else(miss)?;
+    let truth = |ellipsoid| {
+        general_motion(&circular_roll(orbit, u_rad, roll_rad, ellipsoid), &cam, n)
+            .map_err(|e| anyhow!("ellipsoid: pixel {n}: {e:?}"))
+    };
+    let ell_full = truth(Ellipsoid::WGS84)?;
     let ell = ell_full.motion;
     let g = ell_full.ground_m;
     let ground_lat_deg = (g[2] / norm(g)).asin().to_degrees();
-    let sph = scenario(Spheroid::sphere(r_model))
-        .image_motion(camera, n)
-        .ok_or_else(miss)?
-        .motion;
+    let sph = truth(Ellipsoid {
+        a_m: r_model,
+        flattening: 0.0,
+    })?
+    .motion;
 
     let g_round = model_geometry(orbit, u_rad, roll_rad, r_model)?;
     let round = reference(camera, &g_round, n)?;
@@ -310,8 +323,8 @@ pub fn summary() -> Result<EllipsoidSummary> {
     let scene = Scene::paper_default();
     let camera = scene.camera;
     // The round Earth of the paper's model (the controller's until issue 12).
-    let r_model = 6_371_000.0;
-    let orbit = Orbit::circular(r_model + ALTITUDE_M, INCLINATION_DEG.to_radians(), RAAN_RAD);
+    let r_model = R_PAPER_M;
+    let orbit = default_orbit();
     let mut samples: Vec<f64> = Vec::new();
     for (_, s) in scene.active() {
         let (a, b) = (f64::from(s.first_px), f64::from(s.last_px));
@@ -549,8 +562,8 @@ mod tests {
     #[test]
     fn nadir_error_is_the_altitude_ratio() {
         let camera = Scene::paper_default().camera;
-        let r_model = 6_371e3;
-        let orbit = Orbit::circular(r_model + ALTITUDE_M, INCLINATION_DEG.to_radians(), 0.4);
+        let r_model = R_PAPER_M;
+        let orbit = default_orbit();
         for u_deg in [0.0, 33.0, 90.0, 150.0, 270.0, 301.0] {
             let u = f64::to_radians(u_deg);
             let e = case(&camera, &orbit, r_model, u, 0.0, 0.0).unwrap();

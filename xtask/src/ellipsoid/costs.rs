@@ -12,7 +12,7 @@
 
 use core_math::earth::kepler::Kepler;
 use core_math::earth::{limb_margin_rad, Attitude};
-use core_math::sample::SplitMix64;
+use core_math::sample::{eccentric_state, SplitMix64};
 use core_math::sphere::Reference;
 use core_math::vector::{dot, norm, scale};
 use core_math::{
@@ -22,15 +22,9 @@ use core_math::{
 
 use crate::markdown::signed;
 
-use super::motion::{eccentric_state, envelope_draw, general_motion, Orbit, Spheroid};
-use super::round_geometry;
+use super::motion::{envelope_draw, general_motion, Spheroid};
+use super::{default_orbit, round_geometry, ALTITUDE_M, INCLINATION_DEG, RAAN_RAD, R_PAPER_M};
 
-/// The paper's (and the controller's) Earth radius (m).
-const R_PAPER_M: f64 = 6_371e3;
-/// The default scene: 645 km over R, sun-synchronous inclination, node arbitrary.
-const RADIUS_M: f64 = R_PAPER_M + 645e3;
-const INCLINATION_DEG: f64 = 97.98;
-const RAAN_RAD: f64 = 0.4;
 const FOCAL_M: f64 = 0.555;
 const PIXEL_M: f64 = 13e-6;
 /// Terrain height of row (b) (m), eccentricity of row (c), stereo pitches of row (d).
@@ -62,31 +56,8 @@ impl Grid {
     };
 }
 
-/// Worst (signed, largest magnitude) and RMS of one error over a set of cases.
-#[derive(Clone, Debug, Default)]
-pub struct Stat {
-    pub worst: f64,
-    pub at: String,
-    sum_sq: f64,
-    pub count: usize,
-    /// Cases skipped: a miss or within 0.5 deg of the limb (truth or model).
-    pub skipped: usize,
-}
-
-impl Stat {
-    fn push(&mut self, e: f64, at: impl FnOnce() -> String) {
-        if self.count == 0 || e.abs() > self.worst.abs() {
-            self.worst = e;
-            self.at = at();
-        }
-        self.sum_sq += e * e;
-        self.count += 1;
-    }
-
-    pub fn rms(&self) -> f64 {
-        (self.sum_sq / self.count.max(1) as f64).sqrt()
-    }
-}
+/// Worst and RMS of a row's error, with where the worst is.
+pub type Stat = super::Stat<String>;
 
 /// One row of the table.
 #[derive(Clone, Debug)]
@@ -336,7 +307,7 @@ pub fn costs(grid: Grid) -> Costs {
         pixel_m: PIXEL_M,
         p1_m: 0.0,
     };
-    let orbit = Orbit::circular(RADIUS_M, INCLINATION_DEG.to_radians(), RAAN_RAD);
+    let orbit = default_orbit();
     let cases = default_cases(&grid);
     let circ = |c: &Case| orbit.state(c.u_rad);
     let draws = grid.envelope_draws;
@@ -403,7 +374,7 @@ pub fn costs(grid: Grid) -> Costs {
     };
     let ecc = |c: &Case| {
         eccentric_state(
-            RADIUS_M,
+            R_PAPER_M + ALTITUDE_M,
             ECCENTRICITY,
             c.u_rad,
             INCLINATION_DEG.to_radians(),

@@ -6,6 +6,7 @@ use std::path::Path;
 
 use crate::markdown::{e2, f2, sig, table};
 
+use super::grid;
 use super::maps::{Cell, Map};
 use super::point::{Outcome, Point, INPUTS};
 use super::{C_F32, C_FIXED};
@@ -29,18 +30,7 @@ pub fn describe(pt: &Point, o: &Outcome) -> String {
     )
 }
 
-/// One panel of a map: file suffix, title, colour-bar label, z range (log10 unless
-/// `linear`), the value, and which sample's location to mark.
-struct Panel {
-    suffix: &'static str,
-    title: &'static str,
-    z_label: &'static str,
-    z_range: (f64, f64),
-    linear: bool,
-    value: fn(&Cell) -> f64,
-    /// A line across the colour bar (the stated bound), in plotted units.
-    bound: Option<f64>,
-}
+type Panel = grid::Panel<Cell>;
 
 const ERR_RANGE: (f64, f64) = (-10.0, -3.0);
 const RATIO_RANGE: (f64, f64) = (-3.0, 1.0);
@@ -139,31 +129,15 @@ fn kappa_panel(map: &Map) -> Panel {
     }
 }
 
-/// Writes the PNGs of `map` into `dir`; returns the file names in panel order.
-pub fn write_pngs(map: &Map, dir: &Path) -> Result<Vec<String>> {
-    let mut names = Vec::new();
-    let extra = if map.spec.key == "inclination-latitude" {
-        Some(&V1_TERMS)
-    } else {
-        None
-    };
-    for panel in PANELS.iter().chain(extra) {
-        let name = format!("{}-{}.png", map.spec.key, panel.suffix);
-        let panel = if panel.suffix == "kappa" {
-            &kappa_panel(map)
-        } else {
-            panel
-        };
-        map.heatmap(
-            (panel.title, panel.z_label),
-            (panel.z_range, !panel.linear),
-            panel.value,
-            panel.bound.map(f64::log10),
-        )
-        .save(&dir.join(&name))?;
-        names.push(name);
-    }
-    Ok(names)
+/// Writes the PNGs of `map` into `dir`: the panels, the kappa panel fitted to the map,
+/// and the inclination map's v1 panel.
+pub fn write_pngs(map: &Map, dir: &Path) -> Result<()> {
+    let kappa = kappa_panel(map);
+    let extra = (map.spec.key == "inclination-latitude").then_some(&V1_TERMS);
+    map.write_pngs(
+        std::iter::once(&kappa).chain(&PANELS[1..]).chain(extra),
+        dir,
+    )
 }
 
 const AGG_HEADER: [&str; 12] = [

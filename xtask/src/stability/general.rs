@@ -22,7 +22,7 @@ use std::path::Path;
 use crate::markdown::{e2, sig, table};
 
 use super::doc::lg;
-use super::grid::{self, Cell as _, Spec};
+use super::grid::{self, take, Cell as _, Panel, Spec};
 use super::maps::I0_SSO_DEG;
 use super::point::U_F32;
 
@@ -306,12 +306,6 @@ impl grid::Cell for GCell {
             self.err_v1_steady = o.err_v1_steady;
             self.steady = o.steady;
         }
-        let take = |best: &mut f64, slot: &mut Option<(EarthCase, GOutcome)>, v: f64, w| {
-            if slot.is_none() || v > *best {
-                *best = v;
-                *slot = w;
-            }
-        };
         take(&mut self.ratio, &mut self.worst, o.ratio, o.worst);
         take(&mut self.kappa, &mut self.max_kappa, o.kappa, o.max_kappa);
         take(&mut self.err, &mut self.max_err, o.err, o.max_err);
@@ -353,16 +347,11 @@ impl GCell {
             self.err_v1_steady = o.err_v1;
             self.steady = Some((*c, *o));
         }
-        let keep = |best: &mut f64, slot: &mut Option<(EarthCase, GOutcome)>, v: f64| {
-            if slot.is_none() || v > *best {
-                *best = v;
-                *slot = Some((*c, *o));
-            }
-        };
-        keep(&mut self.ratio, &mut self.worst, o.ratio());
-        keep(&mut self.kappa, &mut self.max_kappa, o.kappa);
-        keep(&mut self.err, &mut self.max_err, o.err);
-        keep(&mut self.err_v1, &mut self.max_err_v1, o.err_v1);
+        let w = Some((*c, *o));
+        take(&mut self.ratio, &mut self.worst, o.ratio(), w);
+        take(&mut self.kappa, &mut self.max_kappa, o.kappa, w);
+        take(&mut self.err, &mut self.max_err, o.err, w);
+        take(&mut self.err_v1, &mut self.max_err_v1, o.err_v1, w);
     }
 }
 
@@ -434,54 +423,41 @@ pub fn describe(c: &EarthCase, o: &GOutcome) -> String {
 
 /// Writes the map's three PNGs (kappa, f32 error, err/(kappa u)) into `dir`.
 pub fn write_pngs(m: &GMap, dir: &Path) -> Result<()> {
-    let s = m.spec;
     let kmax = m
         .cells
         .iter()
         .filter(|c| c.n > 0)
         .fold(1.0f64, |a, c| a.max(c.kappa));
-    type Value = fn(&GCell) -> f64;
-    /// File suffix, title, colour-bar label, z range (log10), value, bound on the bar.
-    type Panel = (
-        &'static str,
-        &'static str,
-        &'static str,
-        (f64, f64),
-        Value,
-        Option<f64>,
-    );
-    let panels: [Panel; 3] = [
-        (
-            "kappa",
-            "condition number kappa",
-            "kappa",
-            (0.0, lg(kmax).ceil().max(2.0)),
-            |c| lg(c.kappa),
-            Some(lg(EARTH_F32_KAPPA_LIMIT)),
-        ),
-        (
-            "err-f32",
-            "f32 error |dv|/|v|",
-            "rel. error",
-            (-9.0, -3.0),
-            |c| lg(c.err),
-            Some(lg(EARTH_F32_REL_TOLERANCE)),
-        ),
-        (
-            "ratio-f32",
-            "f32: err / (kappa u)",
-            "err / (kappa u)",
-            (-3.0, 1.0),
-            |c| lg(c.ratio),
-            Some(lg(EARTH_F32_KAPPA_C)),
-        ),
+    let panels: [Panel<GCell>; 3] = [
+        Panel {
+            suffix: "kappa",
+            title: "condition number kappa",
+            z_label: "kappa",
+            z_range: (0.0, lg(kmax).ceil().max(2.0)),
+            linear: false,
+            value: |c| lg(c.kappa),
+            bound: Some(EARTH_F32_KAPPA_LIMIT),
+        },
+        Panel {
+            suffix: "err-f32",
+            title: "f32 error |dv|/|v|",
+            z_label: "rel. error",
+            z_range: (-9.0, -3.0),
+            linear: false,
+            value: |c| lg(c.err),
+            bound: Some(EARTH_F32_REL_TOLERANCE),
+        },
+        Panel {
+            suffix: "ratio-f32",
+            title: "f32: err / (kappa u)",
+            z_label: "err / (kappa u)",
+            z_range: (-3.0, 1.0),
+            linear: false,
+            value: |c| lg(c.ratio),
+            bound: Some(EARTH_F32_KAPPA_C),
+        },
     ];
-    for (suffix, title, z_label, z, value, bound) in panels {
-        let h = m.heatmap((title, z_label), (z, true), value, bound);
-        let name = format!("{}-{suffix}.png", s.key);
-        h.save(&dir.join(name))?;
-    }
-    Ok(())
+    m.write_pngs(&panels, dir)
 }
 
 /// A 96-stage segment's line-period mismatch budget, 0.351 / 96 (`docs/derivation.md`).

@@ -2,6 +2,9 @@
 //! envelope, the sweep of its cells (each the worst of a few sub-samples) over every
 //! core, the cells' lookup and their heatmaps.
 
+use anyhow::Result;
+use std::path::Path;
+
 use crate::plot::heatmap::Heatmap;
 
 /// One 2-D map of the envelope, whose samples are points of type `P`.
@@ -27,6 +30,27 @@ pub struct Spec<P> {
     pub others: &'static str,
     /// Label of the grey cells (no sample there).
     pub missing: &'static str,
+}
+
+/// One PNG of a map: file suffix, title, colour-bar label, z range (log10 unless
+/// `linear`), the plotted value of a cell, and a line across the colour bar (the stated
+/// bound, in the value's units before the log).
+pub struct Panel<C> {
+    pub suffix: &'static str,
+    pub title: &'static str,
+    pub z_label: &'static str,
+    pub z_range: (f64, f64),
+    pub linear: bool,
+    pub value: fn(&C) -> f64,
+    pub bound: Option<f64>,
+}
+
+/// `best` and `slot` become `v` and `w` when there is no sample yet or `v` is larger.
+pub fn take<T>(best: &mut f64, slot: &mut Option<T>, v: f64, w: Option<T>) {
+    if slot.is_none() || v > *best {
+        *best = v;
+        *slot = w;
+    }
 }
 
 /// A map cell: what it keeps of its sub-samples.
@@ -155,6 +179,25 @@ impl<C: Cell> Map<C> {
             h = h.mark(x, y);
         }
         h
+    }
+}
+
+impl<C: Cell> Map<C> {
+    /// Writes one PNG per panel into `dir`, named `<key>-<suffix>.png`.
+    pub fn write_pngs<'a>(
+        &self,
+        panels: impl IntoIterator<Item = &'a Panel<C>>,
+        dir: &Path,
+    ) -> Result<()>
+    where
+        C: 'a,
+    {
+        for p in panels {
+            let bound = p.bound.map(|b| if p.linear { b } else { b.log10() });
+            let h = self.heatmap((p.title, p.z_label), (p.z_range, !p.linear), p.value, bound);
+            h.save(&dir.join(format!("{}-{}.png", self.spec.key, p.suffix)))?;
+        }
+        Ok(())
     }
 }
 

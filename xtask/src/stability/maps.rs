@@ -1,7 +1,7 @@
 //! The three maps of the paper's round Earth: which variables span each, where the
 //! others sit, and what a cell keeps.
 
-use super::grid::{self, Spec};
+use super::grid::{self, take, Spec};
 use super::point::{evaluate, Outcome, Point, RelErrors, Skip, EARTH_RADIUS_M};
 
 /// Sun-synchronous inclination of the paper's orbit (deg).
@@ -140,14 +140,6 @@ pub struct Cell {
     pub worst_f32_in: Option<(Point, Outcome)>,
     pub worst_fixed: Option<(Point, Outcome)>,
     pub max_kappa: Option<(Point, Outcome)>,
-}
-
-/// `slot` and `best` become `w` and `v` when there is no sample yet or `v` is larger.
-fn take(best: &mut f64, slot: &mut Option<(Point, Outcome)>, v: f64, w: Option<(Point, Outcome)>) {
-    if slot.is_none() || v > *best {
-        *best = v;
-        *slot = w;
-    }
 }
 
 impl grid::Cell for Cell {
