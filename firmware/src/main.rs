@@ -102,6 +102,19 @@ fn main() -> ! {
             platform::exit(3)
         }
     };
+    // After a reset the last periods go back into the registers first, before anything
+    // else that takes time (logging included): docs/target.md, "Faults and resets".
+    let boot = retained::boot(reset_cause);
+    let mut clocks = LineClocks::new(line_clock);
+    let Some(session) = blank_session() else {
+        defmt::error!("the session was already taken");
+        platform::exit(1)
+    };
+    session.controller.note_boot(boot.cause, boot.resets);
+    let restored = match retained::snapshot(&boot) {
+        Some(snapshot) => restore(session, snapshot, &mut clocks, &mut clock),
+        None => Err(()),
+    };
     // The host's pass player starts sending when it reads this line (a link that is not
     // enabled yet may drop bytes): keep `telemetry::READY` in it.
     defmt::info!(
@@ -111,7 +124,6 @@ fn main() -> ! {
         telemetry::READY,
         board::LINK
     );
-    let boot = retained::boot(reset_cause);
     defmt::info!(
         "boot: reset cause {=str}, {=u32} resets since power-on",
         boot.cause.name(),
@@ -130,17 +142,7 @@ fn main() -> ! {
         defmt::error!("no heartbeat at a {=u32} Hz core clock", core_clock_hz);
         platform::exit(3)
     }
-    let mut clocks = LineClocks::new(line_clock);
-    let Some(session) = blank_session() else {
-        defmt::error!("the session was already taken");
-        platform::exit(1)
-    };
-    session.controller.note_boot(boot.cause, boot.resets);
-    let in_force = match retained::snapshot(&boot) {
-        Some(snapshot) => restore(session, snapshot, &mut clocks, &mut clock),
-        None => Err(()),
-    };
-    let in_force = in_force.or_else(|()| {
+    let in_force = restored.or_else(|()| {
         session
             .controller
             .set_scene(Scene::paper_default())

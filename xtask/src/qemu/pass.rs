@@ -18,6 +18,7 @@
 
 mod check;
 mod plots;
+mod reset;
 mod scenario;
 mod stream;
 mod truth;
@@ -77,6 +78,10 @@ pub struct RunArgs {
     /// Only write the default pass's NAV samples as telemetry CSV
     #[arg(long, value_name = "FILE.csv")]
     export_telemetry: Option<PathBuf>,
+    /// Reset the firmware (QEMU's system_reset, as its reset line) after its first
+    /// update at or after this pass time, and report what the reset cost
+    #[arg(long, value_name = "SECONDS")]
+    reset_at: Option<f64>,
 }
 
 /// Segment indices given on the command line (one value, not a list of arguments).
@@ -115,9 +120,12 @@ pub fn run(args: &RunArgs) -> Result<()> {
         None if args.short => scenario::short_pass(tick_us)?,
         None => scenario::default_pass(tick_us)?,
     };
+    if let Some(at_s) = args.reset_at {
+        reset::check_instant(at_s, pass.end_us)?;
+    }
     ensure_target_tools()?;
     let elf = build_firmware(board, "firmware", release, &[], &[])?;
-    let result = play(&elf, &pass)?;
+    let result = play(&elf, &pass, args.reset_at)?;
     let segments = args.segments.as_ref().map_or(&TABLE_SEGMENTS[..], |s| &s.0);
     print_table(&pass, &result, args.every, segments);
     let plot = args
@@ -157,7 +165,7 @@ pub fn e2e_test(board: Board) -> Result<()> {
     let started = Instant::now();
     let pass = scenario::short_pass(Config::default().update_period_us)?;
     let elf = build_firmware(board, "firmware", true, &[], &[])?;
-    let result = play(&elf, &pass)?;
+    let result = play(&elf, &pass, None)?;
     result.finish()?;
     eprintln!(
         "xtask: end-to-end pass test passed on {} in {:.1} s",
@@ -166,6 +174,25 @@ pub fn e2e_test(board: Board) -> Result<()> {
     );
     Ok(())
 }
+
+/// The reset test (`cargo xtask test`): the short pass with the firmware reset after
+/// its update at 30 s; the recovery checked against the run without the reset.
+pub fn reset_test(board: Board) -> Result<()> {
+    let started = Instant::now();
+    let pass = scenario::short_pass(Config::default().update_period_us)?;
+    let elf = build_firmware(board, "firmware", true, &[], &[])?;
+    let result = play(&elf, &pass, Some(RESET_TEST_AT_S))?;
+    result.finish()?;
+    eprintln!(
+        "xtask: reset test passed on {} in {:.1} s",
+        board.name(),
+        started.elapsed().as_secs_f64()
+    );
+    Ok(())
+}
+
+/// Where the reset test resets the firmware: in the roll slew of the short pass.
+const RESET_TEST_AT_S: f64 = 30.0;
 
 /// Everything a played pass gave, and the verdicts.
 struct Played {
@@ -189,6 +216,8 @@ struct Played {
     count_failures: Vec<String>,
     /// The truth checks of a built-in pass (none for a user's telemetry).
     truth: Option<truth::Report>,
+    /// With `--reset-at`: what the reset cost.
+    reset: Option<reset::Report>,
 }
 
 impl Played {
@@ -203,7 +232,11 @@ impl Played {
         if self.status != 0 {
             problems.push(format!("the firmware exited with status {}", self.status));
         }
-        if self.firmware.bad_frames > 0 || self.firmware.skipped_bytes > 0 {
+        // A reset cuts the frame that was on the wire: at most one, at most a frame long.
+        let cut_by_reset = self.reset.is_some()
+            && self.firmware.bad_frames <= 1
+            && self.firmware.skipped_bytes as usize <= controller::frame::MAX_FRAME;
+        if !cut_by_reset && (self.firmware.bad_frames > 0 || self.firmware.skipped_bytes > 0) {
             problems.push(format!(
                 "the downlink had {} bad frames and {} stray bytes",
                 self.firmware.bad_frames, self.firmware.skipped_bytes
@@ -248,6 +281,10 @@ impl Played {
             t.print();
             problems.extend(t.problems());
         }
+        if let Some(r) = &self.reset {
+            r.print();
+            problems.extend(r.problems());
+        }
         println!(
             "faults: injected {counted}, rejected {}, outputs changed by faults {}",
             self.rejected(),
@@ -261,8 +298,10 @@ impl Played {
     }
 }
 
-/// Plays `pass` through the firmware `elf` and runs every check.
-fn play(elf: &Path, pass: &Pass) -> Result<Played> {
+/// Plays `pass` through the firmware `elf` and runs every check; with `reset_at_s`,
+/// resets the firmware at that pass time and checks the recovery instead of the fault
+/// counters (which start afresh at the reset).
+fn play(elf: &Path, pass: &Pass, reset_at_s: Option<f64>) -> Result<Played> {
     let stream = stream::build(pass)?;
     let uplink = stream.faulty();
     println!(
@@ -274,7 +313,18 @@ fn play(elf: &Path, pass: &Pass) -> Result<Played> {
         elf.display()
     );
     let t_qemu = Instant::now();
-    let (status, downlink_bytes) = run_qemu(elf, &uplink)?;
+    let trigger = reset_at_s.map(|at_s| {
+        reset::Trigger::new(
+            at_s,
+            std::env::temp_dir().join(format!("tdi-qmp-{}.sock", std::process::id())),
+        )
+    });
+    let QemuRun {
+        status,
+        downlink: downlink_bytes,
+        log,
+        reset_after_us,
+    } = run_qemu(elf, &uplink, trigger)?;
     let firmware = Downlink::decode(&downlink_bytes);
     let t_twin = Instant::now();
 
@@ -284,7 +334,15 @@ fn play(elf: &Path, pass: &Pass) -> Result<Played> {
     let (faulty_twin, _) = check::twin(&uplink)?;
     let twin_s = t_twin.elapsed().as_secs_f64();
 
-    let (changed, changed_examples) = compare_with_twin(&firmware, &twin);
+    let reset = match (reset_at_s, reset_after_us) {
+        (None, _) => None,
+        (Some(_), Some(t_us)) => Some(reset::Report::new(t_us, &firmware, &twin, &log)),
+        (Some(at_s), None) => bail!("the pass never reached {at_s} s: no reset was made"),
+    };
+    let (changed, changed_examples) = match &reset {
+        None => compare_with_twin(&firmware, &twin),
+        Some(r) => (r.changed, Vec::new()),
+    };
     let controller = check::new_controller()?;
     let t_check = Instant::now();
     let (max_rel, max_ticks, compared, reference_failures) =
@@ -303,6 +361,8 @@ fn play(elf: &Path, pass: &Pass) -> Result<Played> {
     let faulty_twin_status = faulty_twin.final_status().copied();
     let mut count_failures = Vec::new();
     match (&final_status, &faulty_twin_status) {
+        // The counters start afresh at a reset: the recovery's own checks replace these.
+        _ if reset.is_some() => {}
         (Some(fw), Some(host)) => {
             for f in Fault::ALL {
                 let expected = stream
@@ -342,6 +402,7 @@ fn play(elf: &Path, pass: &Pass) -> Result<Played> {
         final_status,
         count_failures,
         truth,
+        reset,
     })
 }
 
@@ -449,9 +510,21 @@ fn reference_check(
     Ok((max_rel, max_ticks, compared, failures))
 }
 
-/// Starts QEMU with UART0 on a unix socket, sends `uplink`, returns the firmware's
-/// exit status and everything it sent.
-fn run_qemu(elf: &Path, uplink: &[u8]) -> Result<(i32, Vec<u8>)> {
+/// What a QEMU run of a pass gave.
+struct QemuRun {
+    /// The firmware's exit status.
+    status: i32,
+    /// Everything it sent.
+    downlink: Vec<u8>,
+    /// Its decoded log (kept only with a reset trigger).
+    log: Vec<String>,
+    /// With a reset trigger: the update instant after which the machine was reset.
+    reset_after_us: Option<u64>,
+}
+
+/// Starts QEMU with UART0 on a unix socket, sends `uplink`, and returns what the run
+/// gave ([`QemuRun`]).
+fn run_qemu(elf: &Path, uplink: &[u8], mut trigger: Option<reset::Trigger>) -> Result<QemuRun> {
     let socket = std::env::temp_dir().join(format!(
         "tdi-pass-{}-{}.sock",
         std::process::id(),
@@ -463,13 +536,18 @@ fn run_qemu(elf: &Path, uplink: &[u8]) -> Result<(i32, Vec<u8>)> {
     let listener = UnixListener::bind(&socket)
         .with_context(|| format!("cannot listen on {}", socket.display()))?;
     let (link_ready, ready) = std::sync::mpsc::channel();
+    let mut extra_args = vec![
+        "-chardev".into(),
+        format!("socket,id=telemetry,path={}", socket.display()),
+    ];
+    if let Some(t) = &trigger {
+        let _ = std::fs::remove_file(&t.qmp);
+        extra_args.extend(t.qemu_args());
+    }
     let options = runner::Options {
-        extra_args: vec![
-            "-chardev".into(),
-            format!("socket,id=telemetry,path={}", socket.display()),
-        ],
+        extra_args,
         serial: Some("chardev:telemetry".into()),
-        capture: false,
+        capture: trigger.is_some(),
         log_to_stderr: false,
         link_ready: Some(link_ready),
     };
@@ -520,7 +598,10 @@ fn run_qemu(elf: &Path, uplink: &[u8]) -> Result<(i32, Vec<u8>)> {
     });
     let mut downlink = Vec::new();
     let mut reader = conn;
-    let read = reader.read_to_end(&mut downlink);
+    let read = match &mut trigger {
+        None => reader.read_to_end(&mut downlink).map(|_| ()),
+        Some(t) => read_watching(&mut reader, &mut downlink, t),
+    };
     let outcome = emulator
         .join()
         .map_err(|_| anyhow!("the QEMU thread panicked"))??;
@@ -531,7 +612,36 @@ fn run_qemu(elf: &Path, uplink: &[u8]) -> Result<(i32, Vec<u8>)> {
     if let Err(e) = sent {
         bail!("{e:#} (the firmware exited with status {})", outcome.status);
     }
-    Ok((outcome.status, downlink))
+    let reset_after_us = trigger.as_ref().and_then(|t| {
+        let _ = std::fs::remove_file(&t.qmp);
+        t.done_after_us
+    });
+    Ok(QemuRun {
+        status: outcome.status,
+        downlink,
+        log: outcome.messages,
+        reset_after_us,
+    })
+}
+
+/// Reads the downlink to its end, showing each chunk to `trigger` as it comes.
+fn read_watching(
+    reader: &mut impl Read,
+    downlink: &mut Vec<u8>,
+    trigger: &mut reset::Trigger,
+) -> std::io::Result<()> {
+    let mut chunk = [0u8; 4096];
+    loop {
+        let n = reader.read(&mut chunk)?;
+        if n == 0 {
+            return Ok(());
+        }
+        let bytes = chunk.get(..n).unwrap_or_default();
+        downlink.extend_from_slice(bytes);
+        trigger
+            .watch(bytes)
+            .map_err(|e| std::io::Error::other(format!("{e:#}")))?;
+    }
 }
 
 fn mode_name(m: u8) -> &'static str {
