@@ -50,6 +50,9 @@ pub mod envelope {
     pub const MAX_W_RAD_S: f64 = 0.125;
     /// Each component of V_B / |r| (rad/s): 2^-9, about 12.7 km/s at 6 500 km.
     pub const MAX_V_OVER_R_RAD_S: f64 = 1.0 / 512.0;
+    /// Each component of a unit vector (n_B): 1 and the rounding of a rotation's axes
+    /// (Part II accepts axes within 1e-5 of orthonormal).
+    pub const MAX_UNIT: f64 = 1.001;
 }
 
 /// The fixed-point real-Earth backend.
@@ -77,9 +80,9 @@ pub struct EarthFixedPixel {
 /// Constants of one instant (build with [`Backend::update`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct EarthFixedUpdate {
-    /// n_B (the spin axis in B), Q30.
+    /// n_B (the spin axis in B), Q30, |.| <= 1.001.
     n: [i32; 3],
-    /// rho_B / |r|, Q30, |.| <= 1.025.
+    /// rho_B / |r|, Q30, |.| <= 1.026.
     rho: [i32; 3],
     /// kappa^2 - 1, Q36, within [0, 0.025].
     k2m1: i32,
@@ -179,11 +182,11 @@ impl EarthFixed {
         let mut w = [0; 3];
         let mut v = [0; 3];
         for k in 0..3 {
-            n[k] = to_q(up.n_b[k], 30, 1.0, unit)?;
+            n[k] = to_q(up.n_b[k], 30, envelope::MAX_UNIT, unit)?;
             rho[k] = to_q(
                 up.rho_b_m[k] / r_m,
                 30,
-                1.0 + envelope::MAX_STRETCH2_MINUS_1,
+                envelope::MAX_UNIT + envelope::MAX_STRETCH2_MINUS_1,
                 unit,
             )?;
             w[k] = to_q(
@@ -300,7 +303,7 @@ impl Backend<Earth> for EarthFixed {
     ) -> Result<ImageMotion<I24F40>, ModelError> {
         let mul = |a: i32, b: i32| a as i64 * b as i64;
         let (t1, t2) = (px.t1, px.t2);
-        // beta = rho.u', Q60, |.| <= 1.025 sqrt(3) < 1.78 (2^60.8).
+        // beta = rho.u', Q60, |.| <= 1.026 sqrt(3) < 1.78 (2^60.8).
         let beta = mul(up.rho[0], t1) + mul(up.rho[1], t2) - ((up.rho[2] as i64) << 30);
         // Both roots share the sign of -beta (C > 0): a ray with beta >= 0 looks away.
         if beta >= 0 {
@@ -308,7 +311,7 @@ impl Backend<Earth> for EarthFixed {
         }
         // |beta|, Q31, < 2^31.9.
         let b31 = ((beta.unsigned_abs() + (1 << 28)) >> 29) as u32;
-        // n.u', Q60 -> Q30, |.| < 1.74.
+        // n.u', Q60 -> Q30, |.| <= 1.001 sqrt(3) < 1.74.
         let nu60 = mul(up.n[0], t1) + mul(up.n[1], t2) - ((up.n[2] as i64) << 30);
         let nu30 = ((nu60 + (1 << 29)) >> 30) as i32;
         // (n.u')^2, Q30, < 3.03 (2^31.6).
