@@ -10,6 +10,7 @@
 //! `cargo test` builds core-math with overflow checks and debug assertions: every draw
 //! below also checks the range analysis (any wrap panics).
 
+use core_math::accuracy::{earth_kappa, EARTH_F32_KAPPA_LIMIT};
 use core_math::earth::fixed::{geometry_from_f64, motion_to_f64};
 use core_math::earth::{limb_margin_rad, Attitude, EarthCamera, EarthGeometry};
 use core_math::sample::{EarthCase, SplitMix64};
@@ -22,9 +23,37 @@ use core_math::{
 const EITHER_DEG: f64 = 1e-4;
 
 /// The targets: relative error of |v| from 1 deg inside the limb outward, and
-/// from 0.01 deg.
+/// from 0.01 deg, where the problem's condition number is at most
+/// `EARTH_F32_KAPPA_LIMIT` (30; as for the f32 form, `core_math::accuracy`): beyond it
+/// the problem amplifies the roundings of any finite format (rates cancelling most of
+/// the image motion), and the per-hit bound is what holds.
 const FAR_TARGET: f64 = 2e-6;
 const NEAR_TARGET: f64 = 2e-5;
+
+/// The target of a hit at `margin_deg`, if any.
+fn target(margin_deg: f64) -> Option<f64> {
+    if margin_deg >= 1.0 {
+        Some(FAR_TARGET)
+    } else if margin_deg >= 0.01 {
+        Some(NEAR_TARGET)
+    } else {
+        None
+    }
+}
+
+/// Asserts the target of a hit with error `e`: met, or the case is ill-conditioned
+/// (kappa computed only then: it costs 36 reference evaluations).
+fn assert_target(c: &EarthCase, margin_deg: f64, e: f64) {
+    if let Some(t) = target(margin_deg) {
+        if e > t {
+            let kappa = earth_kappa(&c.camera, &c.geometry, c.n_px).unwrap();
+            assert!(
+                kappa > EARTH_F32_KAPPA_LIMIT,
+                "{e:e} at {margin_deg} deg, kappa {kappa}: {c:?}"
+            );
+        }
+    }
+}
 
 /// The reference's own error against the exact value (the general f64 form and the
 /// reference agree within 1e-12: `tests/earth.rs`).
@@ -170,11 +199,7 @@ fn fixed_matches_the_reference_over_the_envelope() {
                 let x2 = motion_to_f64(&EARTH_FIXED.motion(&up.unwrap(), &px).unwrap());
                 let e2 = rel(&x2, r);
                 assert!(e2 <= b, "Part II: {e2:e} > bound {b:e} at {m} deg: {c:?}");
-                if m >= 1.0 {
-                    assert!(e <= FAR_TARGET, "{e:e} at {m} deg: {c:?}");
-                } else if m >= 0.01 {
-                    assert!(e <= NEAR_TARGET, "{e:e} at {m} deg: {c:?}");
-                }
+                assert_target(&c, m, e);
                 worst[band(m)] = worst[band(m)].max(e);
                 worst_ratio = worst_ratio.max(e / b);
                 hits += 1;
@@ -203,6 +228,7 @@ fn survey() {
     let mut rng = SplitMix64(0x0EA7_2026_1126_5E7F);
     let mut errs: Vec<Vec<f64>> = vec![Vec::new(); BANDS_DEG.len()];
     let mut ratio = [0f64; BANDS_DEG.len()];
+    let mut conditioned = [0f64; BANDS_DEG.len()];
     for _ in 0..400_000 {
         let Some(c) = rng.earth_case() else { continue };
         let o = compare(&c);
@@ -210,10 +236,18 @@ fn survey() {
             let k = band(o.margin_deg);
             errs[k].push(e);
             ratio[k] = ratio[k].max(e / b);
+            // kappa only where it could change the column's maximum.
+            if e > conditioned[k]
+                && earth_kappa(&c.camera, &c.geometry, c.n_px).unwrap() <= EARTH_F32_KAPPA_LIMIT
+            {
+                conditioned[k] = e;
+            }
         }
     }
-    println!("| limb margin (deg) | hits | max rel err \\|v\\| | p99 | max err / bound |");
-    println!("|---|---|---|---|---|");
+    println!(
+        "| limb margin (deg) | hits | max rel err \\|v\\| | max, kappa <= 30 | p99 | max err / bound |"
+    );
+    println!("|---|---|---|---|---|---|");
     for (k, v) in errs.iter_mut().enumerate() {
         v.sort_by(f64::total_cmp);
         let (max, p99) = match v.len() {
@@ -226,9 +260,10 @@ fn survey() {
             format!(" - {}", BANDS_DEG[k - 1])
         };
         println!(
-            "| >= {}{hi} | {} | {max:.2e} | {p99:.2e} | {:.2} |",
+            "| >= {}{hi} | {} | {max:.2e} | {:.2e} | {p99:.2e} | {:.2} |",
             BANDS_DEG[k],
             v.len(),
+            conditioned[k],
             ratio[k]
         );
     }
@@ -303,11 +338,7 @@ fn near_limb_grid_within_bound() {
                                 continue;
                             };
                             assert!(e <= b, "{e:e} > bound {b:e} at {m} deg: {c:?}");
-                            if m >= 1.0 {
-                                assert!(e <= FAR_TARGET, "{e:e} at {m} deg");
-                            } else if m >= 0.01 {
-                                assert!(e <= NEAR_TARGET, "{e:e} at {m} deg");
-                            }
+                            assert_target(&c, m, e);
                             worst[band(m)] = worst[band(m)].max(e);
                             cases[band(m)] += 1;
                         }
