@@ -351,6 +351,87 @@ fn near_limb_grid_within_bound() {
     assert!(cases.iter().all(|&n| n >= 15), "{cases:?}");
 }
 
+/// The corners of the envelope, where the range analysis is tightest: C / |r|^2 at
+/// both ends, every attitude rate at +/-0.04 rad/s, roll and pitch at 0 and +/-45 deg,
+/// |p| / f at 0 and 1 on both axes, f at 0.01 and 1 000 m. In the test profile every
+/// operation is overflow-checked: nothing may wrap; each hit within its bound, each
+/// refusal the general form's (or within 1e-4 deg of the limb).
+#[test]
+fn corners_of_the_envelope() {
+    let a = Ellipsoid::WGS84.a_m;
+    let (mut hits, mut refused) = (0, 0);
+    // C / |r|^2 = 1 - a^2 / r^2 on the equator: just inside 0.05 and 0.5.
+    for c_over_r2 in [0.0505, 0.495] {
+        let radius = a / libm::sqrt(1.0 - c_over_r2);
+        for roll_deg in [-45.0f64, 0.0, 45.0] {
+            for pitch_deg in [-45.0f64, 0.0, 45.0] {
+                for (yaw_deg, sign) in [(0.0f64, 1.0), (90.0, -1.0)] {
+                    for rate_sign in [1.0, -1.0] {
+                        for focal_m in [0.01, 1000.0] {
+                            for t1 in [-1.0, 0.0, 1.0] {
+                                for t2 in [-1.0, 0.0, 1.0] {
+                                    let mut c = scene(0.0, roll_deg);
+                                    c.geometry.state =
+                                        core_math::earth::circular_state(radius, 0.0, 0.7);
+                                    let at = &mut c.geometry.attitude;
+                                    at.pitch_rad = pitch_deg.to_radians();
+                                    at.yaw_rad = yaw_deg.to_radians();
+                                    at.roll_rate_rad_s = 0.04 * rate_sign;
+                                    at.pitch_rate_rad_s = 0.04 * rate_sign * sign;
+                                    at.yaw_rate_rad_s = -0.04 * rate_sign;
+                                    c.camera = EarthCamera {
+                                        focal_m,
+                                        pixel_m: 1e-5,
+                                        p1_m: t1 * focal_m,
+                                    };
+                                    c.n_px = t2 * focal_m / 1e-5;
+                                    let o = compare(&c);
+                                    match (&o.fixed, o.err) {
+                                        (Ok(_), Some((e, b))) => {
+                                            assert!(e <= b, "{e:e} > {b:e}: {c:?}");
+                                            hits += 1;
+                                        }
+                                        (Err(x), _) => {
+                                            // A v1 within the backend's error of 0
+                                            // (a symmetric case's exact 0) may come out
+                                            // as 0: no motion.
+                                            let tiny = match (x, o.general) {
+                                                (ModelError::NoAlongTrackMotion, Ok(g)) => {
+                                                    let gw = geometry_from_f64(&c.geometry)
+                                                        .unwrap()
+                                                        .to_f64();
+                                                    let speed = libm::hypot(g.v1_mps, g.v2_mps);
+                                                    g.v1_mps.abs() <= bound(&c, &gw, &g) * speed
+                                                }
+                                                _ => false,
+                                            };
+                                            assert!(
+                                                o.general.map(|_| ()) == Err(*x)
+                                                    || o.margin_deg.abs() < EITHER_DEG
+                                                    || tiny,
+                                                "{x:?} / {:?}: {c:?}",
+                                                o.general
+                                            );
+                                            refused += 1;
+                                        }
+                                        (Ok(_), None) => assert!(
+                                            o.margin_deg.abs() < EITHER_DEG,
+                                            "{:?}: {c:?}",
+                                            o.reference
+                                        ),
+                                    }
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+    println!("corners: {hits} hits, {refused} refused");
+    assert!(hits > 300 && refused > 100, "{hits} {refused}");
+}
+
 /// The contract's refusals, each the general form's, and the envelope's own.
 #[test]
 fn typed_refusals() {

@@ -294,7 +294,8 @@ impl Backend<Earth> for EarthFixed {
     }
 
     /// Per pixel, integers only. Each line gives the format and the bound over the
-    /// envelope (`docs/fixed-point.md`).
+    /// envelope (`docs/fixed-point.md`). A v1 below the output's last bit (2^-40 m/s)
+    /// is [`ModelError::NoAlongTrackMotion`], where the float forms refuse below 1e-30.
     #[inline]
     fn motion(
         &self,
