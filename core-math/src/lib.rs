@@ -10,6 +10,8 @@
 //! - [`General<f32>`] ([`GENERAL_F32`]): the closed general form in f32, split into a
 //!   per-update and a per-pixel part: the flown path;
 //! - [`General<f64>`] ([`GENERAL_F64`]): the same form in f64;
+//! - `EarthFixed` (`EARTH_FIXED`, feature `earth-fixed`): the same form with the
+//!   per-pixel part in integers only, for cores without an FPU;
 //! - [`EarthReference`] (feature `reference`): the construction evaluated literally on
 //!   dual numbers in f64, independent of the closed form: the golden source.
 //!
@@ -68,3 +70,6 @@ pub use real::{Real, Scalar};
 pub const GENERAL_F32: General<f32> = General::new();
 /// The real-Earth general form in f64.
 pub const GENERAL_F64: General<f64> = General::new();
+/// The real-Earth general form in fixed point (integer-only per pixel).
+#[cfg(feature = "earth-fixed")]
+pub const EARTH_FIXED: earth::fixed::EarthFixed = earth::fixed::EarthFixed;

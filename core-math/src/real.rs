@@ -81,6 +81,16 @@ impl Scalar for f32 {
     }
 }
 
+/// The interface scalar of both fixed-point backends (the round Earth's and the real
+/// Earth's): here, so that either feature alone has it.
+#[cfg(feature = "earth-fixed")]
+impl Scalar for fixed::types::I24F40 {
+    #[inline]
+    fn to_f64(self) -> f64 {
+        self.to_num::<f64>()
+    }
+}
+
 impl Real for f64 {
     const ZERO: Self = 0.0;
     const ONE: Self = 1.0;

@@ -14,6 +14,7 @@ use core_math::earth::bus::{
     BusState, BusTime, StateFrame, IDENTITY_QUATERNION,
 };
 use core_math::earth::dem::{DemGrid, DemTile};
+use core_math::earth::fixed as earth_fixed;
 use core_math::earth::frames::{geodetic_from_itrf, TimeScales};
 use core_math::earth::{Attitude, EarthCamera, EarthGeometry, InertialGeometry};
 use core_math::sphere::fixed_point::{geometry_from_f64, motion_to_f64};
@@ -22,8 +23,8 @@ use core_math::sphere::{
 };
 use core_math::{
     line_period_s, Backend, Camera, Earth, EarthReference, Ellipsoid, General, ImageMotion,
-    Model as MathModel, ModelError, Param, Real, StateVector, EARTH_RATE_RAD_S, GENERAL_F32,
-    GENERAL_F64,
+    Model as MathModel, ModelError, Param, Real, StateVector, EARTH_FIXED, EARTH_RATE_RAD_S,
+    GENERAL_F32, GENERAL_F64,
 };
 
 use crate::csv::{Table, Writer};
@@ -45,7 +46,7 @@ pub struct Args {
     /// The model's Earth
     #[arg(long, value_enum, default_value_t = Model::Sphere)]
     model: Model,
-    /// The implementation to run (earth: no fixed)
+    /// The implementation to run (earth with --dem: no fixed)
     #[arg(long, value_parser = ["reference", "f64", "f32", "fixed"])]
     backend: String,
     /// The cases: a CSV file whose header names the model's input columns (`-`: stdin)
@@ -87,6 +88,10 @@ pub fn eval_csv_on_dem(backend: &str, text: &str, tile: &DemTile<'_, f64>) -> Re
         "reference" => eval_bus_rows(text, dem, |c| evaluate_bus_reference(c, dem)),
         "f64" => eval_bus_rows(text, dem, |c| evaluate_bus_general(&GENERAL_F64, c, dem)),
         "f32" => eval_bus_rows(text, dem, |c| evaluate_bus_general(&GENERAL_F32, c, dem)),
+        "fixed" => bail!(
+            "eval: the fixed-point backend has no DEM ground (its per-pixel work is the \
+             ellipsoid's root): use --dem with reference|f64|f32, or drop --dem"
+        ),
         other => bail!(
             "eval: unknown backend `{other}` for the earth model on a DEM (reference|f64|f32)"
         ),
@@ -101,20 +106,18 @@ pub fn eval_csv(model: Model, backend: &str, text: &str) -> Result<String> {
         (Model::Sphere, "f32") => eval_rows(text, |c| evaluate(&CLOSED_F32, c, |g| g.to())),
         (Model::Sphere, "fixed") => eval_rows(text, evaluate_fixed),
         (Model::Sphere, other) => bail!("unknown backend `{other}` (reference|f64|f32|fixed)"),
-        (Model::Earth, "reference" | "f64" | "f32") if is_part2(text)? => match backend {
+        (Model::Earth, "reference" | "f64" | "f32" | "fixed") if is_part2(text)? => match backend {
             "reference" => eval_bus_rows(text, None, |c| evaluate_bus_reference(c, None)),
             "f64" => eval_bus_rows(text, None, |c| evaluate_bus_general(&GENERAL_F64, c, None)),
+            "fixed" => eval_bus_rows(text, None, evaluate_bus_fixed),
             _ => eval_bus_rows(text, None, |c| evaluate_bus_general(&GENERAL_F32, c, None)),
         },
         (Model::Earth, "reference") => eval_rows(text, |c| evaluate(&EarthReference, c, |g| g)),
         (Model::Earth, "f64") => eval_rows(text, |c| evaluate(&GENERAL_F64, c, |g| g)),
         (Model::Earth, "f32") => eval_rows(text, |c| evaluate(&GENERAL_F32, c, |g| g.to())),
-        (Model::Earth, "fixed") => bail!(
-            "eval: the earth model has no fixed-point backend (use reference|f64|f32, or \
-             --model sphere for fixed)"
-        ),
+        (Model::Earth, "fixed") => eval_rows(text, evaluate_earth_fixed),
         (Model::Earth, other) => {
-            bail!("eval: unknown backend `{other}` for the earth model (reference|f64|f32)")
+            bail!("eval: unknown backend `{other}` for the earth model (reference|f64|f32|fixed)")
         }
     }
 }
@@ -380,6 +383,14 @@ fn evaluate_fixed(case: &Case<Sphere>) -> Result<Vec<String>, RowError> {
     Ok(Sphere::numbers(&case.camera, &m)?)
 }
 
+/// The real Earth's fixed-point backend: the attitude rounded to I24F40, the results
+/// widened to f64 (exact) and printed as f64; |v|, the period and the drift in f64.
+fn evaluate_earth_fixed(case: &Case<Earth>) -> Result<Vec<String>, RowError> {
+    let g = earth_fixed::geometry_from_f64(&case.geometry)?;
+    let m = earth_fixed::motion_to_f64(&EARTH_FIXED.evaluate(&case.camera, &g, case.n_px)?);
+    Ok(Earth::numbers(&case.camera, &m)?)
+}
+
 // Part II (`shared/EARTH-MODEL.md`, "Eval CSV, Part II"): the bus's frames, time and
 #[cfg(test)]
 mod tests {
@@ -470,7 +481,7 @@ garbled,7016137,0,0,0,-1046.6,7464.5,x,0,0,0,0,0,0,0.555,13e-6,0,,
 
     #[test]
     fn earth_one_row_per_input_row_with_typed_errors() {
-        for backend in ["reference", "f64", "f32"] {
+        for backend in ["reference", "f64", "f32", "fixed"] {
             let out = Out::of(Model::Earth, backend, EARTH_CASES);
             assert_eq!(out.rows(), 6);
             assert!(out
@@ -485,11 +496,21 @@ garbled,7016137,0,0,0,-1046.6,7464.5,x,0,0,0,0,0,0,0.555,13e-6,0,,
             assert_eq!(out.field(4, "error"), "invalid_input");
             assert_eq!(out.field(5, "error"), "unparsable_input");
         }
-        assert!(eval_csv(Model::Earth, "fixed", EARTH_CASES)
-            .unwrap_err()
-            .to_string()
-            .contains("no fixed-point"));
         assert!(eval_csv(Model::Earth, "f16", EARTH_CASES).is_err());
+    }
+
+    /// A DEM ground has no fixed-point path: refused with the reason, not evaluated.
+    #[test]
+    fn earth_fixed_on_a_dem_is_refused() {
+        let path = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../core-math/tests/data/dem_tile.csv"
+        );
+        let (grid, heights) = parse_dem(&std::fs::read_to_string(path).unwrap()).unwrap();
+        let tile = DemTile::new(grid, &heights).unwrap();
+        let err = eval_csv_on_dem("fixed", BUS_CASES, &tile).unwrap_err();
+        assert!(err.to_string().contains("no DEM ground"), "{err}");
+        assert!(eval_csv_on_dem("f64", BUS_CASES, &tile).is_ok());
     }
 
     /// The derived outputs follow the definition from v1 and v2, and the backends agree.
@@ -497,7 +518,14 @@ garbled,7016137,0,0,0,-1046.6,7464.5,x,0,0,0,0,0,0,0.555,13e-6,0,,
     fn earth_derived_outputs_and_agreement() {
         let r = Out::of(Model::Earth, "reference", EARTH_CASES);
         let f = Out::of(Model::Earth, "f32", EARTH_CASES);
+        let x = Out::of(Model::Earth, "fixed", EARTH_CASES);
         for row in 0..3 {
+            let d = (x.num(row, "v1_mps") - r.num(row, "v1_mps"))
+                .hypot(x.num(row, "v2_mps") - r.num(row, "v2_mps"));
+            let v = r.num(row, "v_mps");
+            assert!(d / v < 2e-6, "fixed, row {row}: {}", d / v);
+            let t = x.num(row, "line_period_s");
+            assert!((t - 13e-6 / x.num(row, "v1_mps").abs()).abs() <= 1e-15 * t);
             let (v1, v2) = (r.num(row, "v1_mps"), r.num(row, "v2_mps"));
             assert!((r.num(row, "v_mps") - v1.hypot(v2)).abs() <= 1e-16);
             let t = r.num(row, "line_period_s");
@@ -619,7 +647,17 @@ one_rate,itrf,1388000000,,7016137,0,0,0,-1558.2,7464.5,,,,,,,0.70710678,0,0.7071
         let r = Out::of(Model::Earth, "reference", BUS_CASES);
         let f = Out::of(Model::Earth, "f64", BUS_CASES);
         let s = Out::of(Model::Earth, "f32", BUS_CASES);
+        let x = Out::of(Model::Earth, "fixed", BUS_CASES);
         for row in 0..4 {
+            assert_eq!(x.field(row, "error"), "", "row {row}");
+            let d = (x.num(row, "v1_mps") - r.num(row, "v1_mps"))
+                .hypot(x.num(row, "v2_mps") - r.num(row, "v2_mps"));
+            let v = r.num(row, "v_mps");
+            assert!(d / v < 2e-6, "fixed, row {row}: {}", d / v);
+            assert_eq!(
+                x.field(row, "ground_lat_deg"),
+                r.field(row, "ground_lat_deg")
+            );
             let (g, n_px) = bus_geometry_direct(row);
             let p = EarthReference.pixel(&camera, n_px).unwrap();
             let (chain, m64, m32) = match &g {
@@ -662,7 +700,7 @@ one_rate,itrf,1388000000,,7016137,0,0,0,-1558.2,7464.5,,,,,,,0.70710678,0,0.7071
 
     #[test]
     fn bus_rows_typed_errors() {
-        for backend in ["reference", "f64", "f32"] {
+        for backend in ["reference", "f64", "f32", "fixed"] {
             let out = Out::of(Model::Earth, backend, BUS_CASES);
             assert_eq!(out.rows(), 12);
             assert_eq!(out.field(4, "error"), "invalid_quaternion");

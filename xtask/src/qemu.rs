@@ -34,7 +34,7 @@ pub use board::{size, SizeArgs};
 pub use flash::{flash, FlashArgs};
 pub use pass::{e2e_test, reset_test, run, RunArgs};
 pub use runner::qemu;
-pub use tools::ensure_target_tools;
+pub use tools::{ensure_rust_target, ensure_target_tools};
 
 /// The firmware's target: Cortex-M4F, hard-float ABI.
 pub const TARGET: &str = "thumbv7em-none-eabihf";
@@ -79,21 +79,24 @@ pub fn test_target() -> Result<()> {
         args.extend_from_slice(&["--target", TARGET, "--", "-D", "warnings"]);
         cargo(&args)?;
     }
-    // The fixed-point backend alone, for a core without an FPU.
-    cargo(&[
-        "clippy",
-        "--package",
-        "core-math",
-        "--lib",
-        "--no-default-features",
-        "--features",
-        "fixed-point",
-        "--target",
-        NO_FPU_TARGET,
-        "--",
-        "-D",
-        "warnings",
-    ])?;
+    // Each fixed-point backend alone, for a core without an FPU (the real Earth's
+    // without `sphere`, as an FPU-less flight build would link it).
+    for features in ["fixed-point", "earth-fixed"] {
+        cargo(&[
+            "clippy",
+            "--package",
+            "core-math",
+            "--lib",
+            "--no-default-features",
+            "--features",
+            features,
+            "--target",
+            NO_FPU_TARGET,
+            "--",
+            "-D",
+            "warnings",
+        ])?;
+    }
     let runner = runner_config()?;
     for board in Board::ALL {
         let features = board.cargo_features(&[]);

@@ -28,6 +28,7 @@ pub fn run() -> Result<()> {
     // Host unit, property and golden tests; release, since the property tests evaluate
     // the reference chain tens of thousands of times.
     cargo(&["test", "--release"])?;
+    no_float_check()?;
     derivation_check()?;
     crate::qemu::test_target()?;
     crate::no_panic::check()?;
@@ -36,6 +37,14 @@ pub fn run() -> Result<()> {
         t0.elapsed().as_secs_f64()
     );
     Ok(())
+}
+
+/// The real-Earth fixed-point backend's per-pixel function, built for a core without an
+/// FPU, has no floating-point instruction and calls nothing (tools/check-no-float.sh;
+/// docs/fixed-point.md).
+fn no_float_check() -> Result<()> {
+    crate::qemu::ensure_rust_target(crate::qemu::NO_FPU_TARGET)?;
+    run_step("sh", &["tools/check-no-float.sh"])
 }
 
 /// The computer-algebra proof of the derivation (tools/derivation/derive.py).

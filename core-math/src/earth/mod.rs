@@ -17,7 +17,9 @@
 //! - [`EarthReference`] (feature `reference`): the construction evaluated literally on
 //!   dual numbers in f64, the golden source;
 //! - [`General<f64>`] and [`General<f32>`]: the closed general form (`docs/derivation.md`,
-//!   "The general model"), split into a per-update and a per-pixel part.
+//!   "The general model"), split into a per-update and a per-pixel part;
+//! - `fixed::EarthFixed` (feature `earth-fixed`): the same form with an integer-only
+//!   per-pixel part, for cores without an FPU.
 
 use crate::error::{ModelError, Param};
 use crate::model::{domain, Model};
@@ -27,6 +29,8 @@ use crate::vector::{cross, dot, unit};
 
 pub mod bus;
 pub mod dem;
+#[cfg(feature = "earth-fixed")]
+pub mod fixed;
 pub mod frames;
 pub mod general;
 #[cfg(feature = "reference")]

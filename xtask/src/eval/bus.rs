@@ -275,6 +275,18 @@ pub(super) fn evaluate_bus_general<T: Real + Display>(
     Ok(Earth::numbers(&case.camera, &m)?)
 }
 
+/// The real Earth's fixed-point backend on a Part II row: Part I's angles rounded to its
+/// I24F40 input, a quaternion's axes and rates taken in f64 (its update is f64 work).
+pub(super) fn evaluate_bus_fixed(case: &BusCase) -> Result<Vec<String>, RowError> {
+    let p = EARTH_FIXED.pixel(&case.camera, case.n_px)?;
+    let up = match &case.geometry {
+        BusRowGeometry::Angles(g) => EARTH_FIXED.update(&earth_fixed::geometry_from_f64(g)?)?,
+        BusRowGeometry::Quaternion(g) => EARTH_FIXED.update_inertial(g)?,
+    };
+    let m = earth_fixed::motion_to_f64(&EARTH_FIXED.motion(&up, &p)?);
+    Ok(Earth::numbers(&case.camera, &m)?)
+}
+
 /// G's geodetic latitude and longitude (deg) and height (m) on the row's ellipsoid, for
 /// every backend from the f64 reference's chain (`EarthChain::ground_m`, on the DEM
 /// where one is given): I at t is the ITRF at t, so G's coordinates in I are its ITRF

@@ -16,7 +16,8 @@ pub fn ensure_target_tools() -> Result<()> {
     ensure_qemu()
 }
 
-fn ensure_rust_target(target: &str) -> Result<()> {
+/// A Rust target through rustup (or a toolchain that already has its core library).
+pub fn ensure_rust_target(target: &str) -> Result<()> {
     let installed = Command::new("rustup")
         .args(["target", "list", "--installed"])
         .output();

@@ -42,13 +42,6 @@ pub use fixed;
 /// velocities in m/s).
 pub type FixedReal = I24F40;
 
-impl Scalar for I24F40 {
-    #[inline]
-    fn to_f64(self) -> f64 {
-        self.to_num::<f64>()
-    }
-}
-
 /// The envelope the range analysis covers (`docs/fixed-point.md`); everything outside
 /// is refused with [`ModelError::OutOfDomain`]. Inclusive bounds.
 pub mod envelope {

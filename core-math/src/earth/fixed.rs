@@ -1,0 +1,455 @@
+//! The real-Earth general form in fixed point, for controllers without an FPU
+//! (Cortex-M3): [`EarthFixed`], one more [`Backend`]`<`[`Earth`]`>`.
+//!
+//! - `pixel` (boot, scene upload): f64, rounded once to the formats below.
+//! - `update` (per NAV state): the general form's per-update quantities by
+//!   [`General<f64>`] (soft f64 on an M3: one update is a few trigonometric calls and
+//!   divisions, against thousands of pixels), normalised by |r| and rounded to integers.
+//! - `motion` (per pixel): integers only, 32x32 -> 64 products, one 64-bit integer
+//!   square root, no division, no float.
+//!
+//! With u' = u / f = (t1, t2, -1) (t = p / f) and every length divided by |r|, the near
+//! root of the ray/ellipsoid quadratic is 1/sigma = (sqrt(beta^2 - alpha C) - beta) / C
+//! (beta = rho.u', alpha = |u'|^2 + (kappa^2 - 1)(n.u')^2, C = |K r|^2 / |r|^2 - A^2 /
+//! |r|^2), and the image motion is f times
+//!
+//! ```text
+//! v1/f = W2 (1 + t1^2) + W3 t2 - W1 t1 t2 - (V1 + t1 V3) / sigma
+//! v2/f = -W1 (1 + t2^2) - W3 t1 + W2 t1 t2 - (V2 + t2 V3) / sigma
+//! ```
+//!
+//! (W the camera's angular velocity relative to the Earth, V = V_B / |r|, both in rad/s;
+//! [`crate::earth::general`] for the derivation). Formats, range analysis and the error
+//! bound: `docs/fixed-point.md`, "The real-Earth backend". Qn is an integer times 2^-n.
+//!
+//! Every contract error of the general form is kept (its own checks run per update);
+//! what the formats cannot hold is refused as [`ModelError::OutOfDomain`] ([`envelope`]).
+
+use ::fixed::types::I24F40;
+
+use crate::earth::{Attitude, Earth, EarthCamera, EarthGeometry, General, InertialGeometry};
+use crate::error::{ModelError, Param};
+use crate::model::{Backend, ImageMotion};
+use crate::real::Scalar;
+
+/// The envelope the range analysis covers (`docs/fixed-point.md`): everything outside is
+/// refused with [`ModelError::OutOfDomain`], never evaluated into a wrapped value.
+pub mod envelope {
+    /// Focal length (m).
+    pub const FOCAL_M: (f64, f64) = (0.01, 1000.0);
+    /// |p1| / f and |p2| / f: field angles up to 45 deg along either axis.
+    pub const MAX_TAN_FIELD: f64 = 1.0;
+    /// C / |r|^2 = |K r|^2 / |r|^2 - A^2 / |r|^2: about 2 H / |r|; 0.05 is about 165 km
+    /// above the ground, 0.5 about 2 640 km.
+    pub const C_OVER_R2: (f64, f64) = (0.05, 0.5);
+    /// kappa^2 - 1 (WGS 84: 6.7e-3; 0.025 is a flattening of about 0.0124).
+    pub const MAX_STRETCH2_MINUS_1: f64 = 0.025;
+    /// |roll'|, |pitch'|, |yaw'| (rad/s): 0.04 = 2.3 deg/s.
+    pub const MAX_ATTITUDE_RATE_RAD_S: f64 = 0.04;
+    /// Each component of W (rad/s), the camera's angular velocity relative to the Earth.
+    pub const MAX_W_RAD_S: f64 = 0.125;
+    /// Each component of V_B / |r| (rad/s): 2^-9, about 12.7 km/s at 6 500 km.
+    pub const MAX_V_OVER_R_RAD_S: f64 = 1.0 / 512.0;
+    /// Each component of a unit vector (n_B): 1 and the rounding of a rotation's axes
+    /// (Part II accepts axes within 1e-5 of orthonormal).
+    pub const MAX_UNIT: f64 = 1.001;
+}
+
+/// The fixed-point real-Earth backend.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct EarthFixed;
+
+/// Constants of one pixel (build with [`Backend::pixel`]; the range analysis holds for
+/// those values only, hence the private fields).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EarthFixedPixel {
+    /// t1 = p1/f, t2 = p2/f, t1^2, t1 t2, t2^2, Q30, each within [-1, 1].
+    t1: i32,
+    t2: i32,
+    t11: i32,
+    t12: i32,
+    t22: i32,
+    /// |u'|^2 = 1 + t1^2 + t2^2, Q30, within [1, 3].
+    uu: u32,
+    /// f = f_mant 2^-e with f_mant in [2^31, 2^32).
+    f_mant: u32,
+    /// e - 9: the right shift from (v/f in Q63) x f_mant / 2^32 to I24F40 m/s; 13..29.
+    shift: u32,
+}
+
+/// Constants of one instant (build with [`Backend::update`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EarthFixedUpdate {
+    /// n_B (the spin axis in B), Q30, |.| <= 1.001.
+    n: [i32; 3],
+    /// rho_B / |r|, Q30, |.| <= 1.026.
+    rho: [i32; 3],
+    /// kappa^2 - 1, Q36, within [0, 0.025].
+    k2m1: i32,
+    /// C / |r|^2, Q32, within [0.05, 0.5].
+    c: u32,
+    /// |r|^2 / C, Q27, within [2, 20].
+    inv_c: u32,
+    /// W_B (rad/s), Q33, |.| <= 2^-3.
+    w: [i32; 3],
+    /// V_B / |r| (rad/s), Q39, |.| <= 2^-9.
+    v: [i32; 3],
+}
+
+/// x 2^frac rounded to nearest, refused as `err` unless |x| <= max. The caller's `max`
+/// keeps the result within i32 (checked in debug builds).
+fn to_q(x: f64, frac: i32, max: f64, err: ModelError) -> Result<i32, ModelError> {
+    if !(x.abs() <= max) {
+        return Err(err);
+    }
+    let q = libm::round(x * libm::ldexp(1.0, frac));
+    debug_assert!(q.abs() < 2_147_483_648.0, "{x} Q{frac}");
+    Ok(q as i32)
+}
+
+/// As [`to_q`] for a value known to lie in [0, max] with max 2^frac < 2^32.
+fn to_uq(x: f64, frac: i32) -> u32 {
+    let q = libm::round(x * libm::ldexp(1.0, frac));
+    debug_assert!((0.0..4_294_967_296.0).contains(&q), "{x} UQ{frac}");
+    q as u32
+}
+
+/// An [`EarthGeometry<f64>`] with the attitude rounded to the backend's I24F40 (to
+/// nearest; 2^-41 rad and rad/s). Non-finite angles are [`ModelError::NonFinite`],
+/// angles beyond I24F40's range [`ModelError::OutOfDomain`]. Host and boot code only.
+pub fn geometry_from_f64(g: &EarthGeometry<f64>) -> Result<EarthGeometry<I24F40>, ModelError> {
+    let conv = |x: f64, p: Param| -> Result<I24F40, ModelError> {
+        if !x.is_finite() {
+            return Err(ModelError::NonFinite(p));
+        }
+        I24F40::checked_from_num(x).ok_or(ModelError::OutOfDomain(p))
+    };
+    let a = &g.attitude;
+    Ok(EarthGeometry {
+        state: g.state,
+        attitude: Attitude {
+            roll_rad: conv(a.roll_rad, Param::Roll)?,
+            pitch_rad: conv(a.pitch_rad, Param::Pitch)?,
+            yaw_rad: conv(a.yaw_rad, Param::Yaw)?,
+            roll_rate_rad_s: conv(a.roll_rate_rad_s, Param::RollRate)?,
+            pitch_rate_rad_s: conv(a.pitch_rate_rad_s, Param::PitchRate)?,
+            yaw_rate_rad_s: conv(a.yaw_rate_rad_s, Param::YawRate)?,
+        },
+        ground_h_m: g.ground_h_m,
+        ellipsoid: g.ellipsoid,
+        earth_rate_rad_s: g.earth_rate_rad_s,
+    })
+}
+
+/// The backend's output widened to f64 (exact: 40 fraction bits and |v| < 2^23).
+pub fn motion_to_f64(m: &ImageMotion<I24F40>) -> ImageMotion<f64> {
+    ImageMotion {
+        v1_mps: m.v1_mps.to_f64(),
+        v2_mps: m.v2_mps.to_f64(),
+    }
+}
+
+impl EarthFixed {
+    /// [`Backend::update`] for Part II's attitude (the camera's axes in I and its angular
+    /// velocity): [`General::update_inertial`] in f64, then the same rounding. The
+    /// angular velocity is checked through W, the envelope's [`envelope::MAX_W_RAD_S`].
+    pub fn update_inertial(
+        &self,
+        g: &InertialGeometry<f64>,
+    ) -> Result<EarthFixedUpdate, ModelError> {
+        let up = General::<f64>::new().update_inertial(g)?;
+        let p = g.state.position_m;
+        Self::round_update(&up, p[0] * p[0] + p[1] * p[1] + p[2] * p[2])
+    }
+
+    /// The f64 update, every length over |r|, rounded to the per-pixel formats.
+    fn round_update(
+        up: &crate::earth::GeneralUpdate<f64>,
+        r2_m2: f64,
+    ) -> Result<EarthFixedUpdate, ModelError> {
+        let r_m = libm::sqrt(r2_m2);
+        let c = up.c_m2 / r2_m2;
+        let (c_min, c_max) = envelope::C_OVER_R2;
+        if !(c >= c_min && c <= c_max) {
+            return Err(ModelError::OutOfDomain(Param::Position));
+        }
+        if !(up.stretch2_minus_1 <= envelope::MAX_STRETCH2_MINUS_1) {
+            return Err(ModelError::OutOfDomain(Param::Flattening));
+        }
+        let unit = ModelError::OutOfDomain(Param::Position);
+        let mut n = [0; 3];
+        let mut rho = [0; 3];
+        let mut w = [0; 3];
+        let mut v = [0; 3];
+        for k in 0..3 {
+            n[k] = to_q(up.n_b[k], 30, envelope::MAX_UNIT, unit)?;
+            rho[k] = to_q(
+                up.rho_b_m[k] / r_m,
+                30,
+                envelope::MAX_UNIT + envelope::MAX_STRETCH2_MINUS_1,
+                unit,
+            )?;
+            w[k] = to_q(
+                up.w_b_rad_s[k],
+                33,
+                envelope::MAX_W_RAD_S,
+                ModelError::OutOfDomain(Param::AngularVelocity),
+            )?;
+            v[k] = to_q(
+                up.v_b_mps[k] / r_m,
+                39,
+                envelope::MAX_V_OVER_R_RAD_S,
+                ModelError::OutOfDomain(Param::Velocity),
+            )?;
+        }
+        Ok(EarthFixedUpdate {
+            n,
+            rho,
+            k2m1: to_q(
+                up.stretch2_minus_1,
+                36,
+                envelope::MAX_STRETCH2_MINUS_1,
+                unit,
+            )?,
+            c: to_uq(c, 32),
+            inv_c: to_uq(1.0 / c, 27),
+            w,
+            v,
+        })
+    }
+}
+
+impl Backend<Earth> for EarthFixed {
+    type Real = I24F40;
+    type Pixel = EarthFixedPixel;
+    type Update = EarthFixedUpdate;
+
+    /// The general form's checks of the optics, then the envelope's.
+    fn pixel(&self, camera: &EarthCamera, n_px: f64) -> Result<EarthFixedPixel, ModelError> {
+        let (p1, p2) = camera.focal_plane_m(n_px)?;
+        let f = camera.focal_m;
+        let (f_min, f_max) = envelope::FOCAL_M;
+        if !(f >= f_min && f <= f_max) {
+            return Err(ModelError::OutOfDomain(Param::FocalLength));
+        }
+        let (t1, t2) = (p1 / f, p2 / f);
+        let tan = envelope::MAX_TAN_FIELD;
+        let t1q = to_q(t1, 30, tan, ModelError::OutOfDomain(Param::FocalPlaneP1))?;
+        let t2q = to_q(t2, 30, tan, ModelError::OutOfDomain(Param::PixelOffset))?;
+        // f = f_mant 2^-e, f_mant in [2^31, 2^32): e = 31 - floor(log2 f).
+        let (_, exp) = libm::frexp(f); // f = m 2^exp, m in [1/2, 1)
+        let e = 32 - exp;
+        let f_mant = libm::round(libm::ldexp(f, e));
+        // Rounding up to 2^32 (f a hair below a power of two) takes the next exponent.
+        let (f_mant, e) = if f_mant >= 4_294_967_296.0 {
+            (2_147_483_648u32, e - 1)
+        } else {
+            (f_mant as u32, e)
+        };
+        Ok(EarthFixedPixel {
+            t1: t1q,
+            t2: t2q,
+            t11: to_q(
+                t1 * t1,
+                30,
+                1.0,
+                ModelError::OutOfDomain(Param::FocalPlaneP1),
+            )?,
+            t12: to_q(
+                t1 * t2,
+                30,
+                1.0,
+                ModelError::OutOfDomain(Param::PixelOffset),
+            )?,
+            t22: to_q(
+                t2 * t2,
+                30,
+                1.0,
+                ModelError::OutOfDomain(Param::PixelOffset),
+            )?,
+            uu: to_uq(1.0 + t1 * t1 + t2 * t2, 30),
+            f_mant,
+            shift: (e - 9) as u32,
+        })
+    }
+
+    /// The general form's update in f64 (every check of the contract, in its order), then
+    /// the attitude rates against the envelope, then the rounding.
+    fn update(&self, g: &EarthGeometry<I24F40>) -> Result<EarthFixedUpdate, ModelError> {
+        let g = g.to_f64();
+        let up = General::<f64>::new().update(&g)?;
+        let max = envelope::MAX_ATTITUDE_RATE_RAD_S;
+        let a = &g.attitude;
+        for (x, p) in [
+            (a.roll_rate_rad_s, Param::RollRate),
+            (a.pitch_rate_rad_s, Param::PitchRate),
+            (a.yaw_rate_rad_s, Param::YawRate),
+        ] {
+            if !(x.abs() <= max) {
+                return Err(ModelError::OutOfDomain(p));
+            }
+        }
+        let p = g.state.position_m;
+        Self::round_update(&up, p[0] * p[0] + p[1] * p[1] + p[2] * p[2])
+    }
+
+    /// Per pixel, integers only. Each line gives the format and the bound over the
+    /// envelope (`docs/fixed-point.md`). A v1 below the output's last bit (2^-40 m/s)
+    /// is [`ModelError::NoAlongTrackMotion`], where the float forms refuse below 1e-30.
+    #[inline]
+    fn motion(
+        &self,
+        up: &EarthFixedUpdate,
+        px: &EarthFixedPixel,
+    ) -> Result<ImageMotion<I24F40>, ModelError> {
+        let mul = |a: i32, b: i32| a as i64 * b as i64;
+        let (t1, t2) = (px.t1, px.t2);
+        // beta = rho.u', Q60, |.| <= 1.026 sqrt(3) < 1.78 (2^60.8).
+        let beta = mul(up.rho[0], t1) + mul(up.rho[1], t2) - ((up.rho[2] as i64) << 30);
+        // Both roots share the sign of -beta (C > 0): a ray with beta >= 0 looks away.
+        if beta >= 0 {
+            return Err(ModelError::LineOfSightMissesEarth);
+        }
+        // |beta|, Q31, < 2^31.9.
+        let b31 = ((beta.unsigned_abs() + (1 << 28)) >> 29) as u32;
+        // n.u', Q60 -> Q30, |.| <= 1.001 sqrt(3) < 1.74.
+        let nu60 = mul(up.n[0], t1) + mul(up.n[1], t2) - ((up.n[2] as i64) << 30);
+        let nu30 = ((nu60 + (1 << 29)) >> 30) as i32;
+        // (n.u')^2, Q30, < 3.03 (2^31.6).
+        let nn30 = ((nu30 as i64 * nu30 as i64) as u64 >> 30) as u32;
+        // alpha = |u'|^2 + (kappa^2 - 1)(n.u')^2, Q30, < 3.08.
+        let alpha = px.uu + ((up.k2m1 as u64 * nn30 as u64) >> 36) as u32;
+        // beta^2 and alpha C, Q62, < 2^63.7 and 2^62.7.
+        let bb = b31 as u64 * b31 as u64;
+        let ac = alpha as u64 * up.c as u64;
+        if ac > bb {
+            return Err(ModelError::LineOfSightMissesEarth);
+        }
+        // sqrt(disc), Q31, <= |beta| + 2 units.
+        let root = sqrt_u64(bb - ac);
+        // (sqrt(disc) + |beta|) / 2 ... as Q30: the numerator of 1/sigma, < 3.56.
+        let num = ((root + b31 as u64) >> 1) as u32;
+        // 1/sigma = num |r|^2/C: Q57 (< 71.2 = 2^63.2), then Q25 (< 2^31.2).
+        let inv_s = ((num as u64 * up.inv_c as u64) >> 32) as u32;
+        // V_k / sigma, Q39 x Q25 = Q64 (< 2^61.2), rounded to Q33 (< 0.139 = 2^30.2).
+        let e = |vk: i32| ((vk as i64 * inv_s as i64 + (1 << 30)) >> 31) as i32;
+        let (e1, e2, e3) = (e(up.v[0]), e(up.v[1]), e(up.v[2]));
+        let [w1, w2, w3] = up.w;
+        // v/f, Q63: W terms Q33 x Q30, each < 2^60, four of them < 2^62; V terms
+        // < 2 x 0.139 x 2^63 = 2^61.2; sum < 2^62.7.
+        let vf1 = ((w2 as i64) << 30) + mul(w2, px.t11) + mul(w3, t2)
+            - mul(w1, px.t12)
+            - ((e1 as i64) << 30)
+            - mul(t1, e3);
+        let vf2 = -((w1 as i64) << 30) - mul(w1, px.t22) - mul(w3, t1) + mul(w2, px.t12)
+            - ((e2 as i64) << 30)
+            - mul(t2, e3);
+        let v1 = times_focal(vf1, px);
+        if v1 == 0 {
+            return Err(ModelError::NoAlongTrackMotion);
+        }
+        Ok(ImageMotion {
+            v1_mps: I24F40::from_bits(v1),
+            v2_mps: I24F40::from_bits(times_focal(vf2, px)),
+        })
+    }
+}
+
+/// (v/f in Q63) x f as I24F40 bits: x f_mant 2^-e 2^-23, by two 32x32 -> 64 products
+/// (x = hi 2^32 + lo): (x f_mant) >> 32 = hi f_mant + (lo f_mant) >> 32 (< 2^62.7), then
+/// >> (e - 9), in 13..29. Truncated toward -infinity: 2^-40 m/s at most.
+#[inline(always)]
+fn times_focal(x: i64, px: &EarthFixedPixel) -> i64 {
+    let hi = (x >> 32) as i32;
+    let lo = x as u32;
+    let m = px.f_mant;
+    let top = hi as i64 * m as i64 + ((lo as u64 * m as u64) >> 32) as i64;
+    shr(top, px.shift)
+}
+
+/// Seeds r0 = 1/sqrt(f) in Q14 at the centres of the intervals [i/1024, (i+1)/1024)
+/// that split [1/4, 1): isqrt(2^39 / (2i + 1)) < 2^15 (relative error at most 2^-10).
+/// Built at compile time, integer only; entries below 256 are never read (f >= 1/4) and
+/// make the index a 10-bit field with no bounds check. 2 KiB of flash.
+const SEED: [u16; 1024] = {
+    let mut t = [0u16; 1024];
+    let mut i = 256;
+    while i < 1024 {
+        t[i] = ((1u64 << 39) / (2 * i as u64 + 1)).isqrt() as u16;
+        i += 1;
+    }
+    t
+};
+
+/// sqrt(x) to within 2 units, integer only, no division (core's `isqrt` divides, which
+/// is a `__aeabi_uldivmod` call on a 32-bit core). The scheme of the round Earth's
+/// per-pixel root (`docs/fixed-point.md`): normalise x by an even shift z to
+/// xn in [2^62, 2^64), f = hi(xn) in [1/4, 1) (Q32); seed r0 from f's top 10 bits,
+/// one Newton step for 1/sqrt(f) (r1, Q29), s = f r1 (Q31), one Heron correction with
+/// xn's full 64 bits; sqrt(x) = 2 y 2^(-z/2), y = sqrt(xn 2^-64) in Q31.
+#[inline(always)]
+fn sqrt_u64(x: u64) -> u64 {
+    if x == 0 {
+        return 0;
+    }
+    let z = x.leading_zeros() & !1;
+    let xn = x << z;
+    let f = (xn >> 32) as u32; // [2^30, 2^32)
+    let r0 = SEED[(f >> 22) as usize & 1023] as u32; // Q14
+    let u = (3 << 28) - ((f as u64 * (r0 * r0) as u64) >> 32) as u32; // 3 - f r0^2, Q28
+    let r1 = ((r0 as u64 * u as u64) >> 14) as u32; // Q29, < 2^30.1
+    let s = ((f as u64 * r1 as u64) >> 30) as u32; // Q31
+    let d = (xn >> 2) as i64 - (s as u64 * s as u64) as i64; // f - s^2, Q62
+    let corr = (r1 as i64 * (d >> 16)) >> 45; // r1 d / 2, Q31
+    let y = (s as i64 + corr) as u64; // Q31, <= 2^31 + 1
+    (y << 1) >> (z >> 1)
+}
+
+/// x >> sh (arithmetic) for sh in 1..=31, in 32-bit halves: the compiler cannot know
+/// that the shift is below 32 and would otherwise emit the general 64-bit sequence.
+#[inline(always)]
+fn shr(x: i64, sh: u32) -> i64 {
+    debug_assert!((1..32).contains(&sh));
+    let lo = x as u32;
+    let hi = (x >> 32) as i32;
+    let lo = (lo >> (sh & 31)) | ((hi as u32) << ((32 - sh) & 31));
+    (((hi >> (sh & 31)) as i64) << 32) | lo as i64
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Against the exact floor square root (u128 arithmetic, independent of the scheme)
+    /// over every magnitude, the extremes included.
+    #[test]
+    fn sqrt_u64_within_two_units() {
+        let mut x: u64 = 0x9E37_79B9_7F4A_7C15;
+        let mut worst = 0u64;
+        let mut check = |v: u64| {
+            let exact = (v as u128).isqrt() as u64;
+            worst = worst.max(sqrt_u64(v).abs_diff(exact));
+        };
+        for i in 0..2_000_000u32 {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            check(x >> (i % 64));
+        }
+        for v in [
+            0,
+            1,
+            2,
+            3,
+            4,
+            u64::MAX,
+            u64::MAX - 1,
+            1 << 62,
+            (1 << 62) - 1,
+            1 << 63,
+        ] {
+            check(v);
+        }
+        assert!(worst <= 2, "{worst}");
+    }
+}
