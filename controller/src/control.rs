@@ -14,6 +14,7 @@
 //! refused computation leaves that segment's last good period in force, and nothing
 //! outside the physically possible period range is ever written.
 
+use core_math::earth::frames::{CelestialPole, TimeScales};
 use core_math::earth::Attitude;
 
 use crate::config::Config;
@@ -21,6 +22,7 @@ use crate::fault::{Counters, Fault};
 use crate::nav::Propagator;
 use crate::plan::Plan;
 use crate::scene::{Scene, MAX_SEGMENTS};
+use crate::track::{AttitudeState, GnssState};
 
 /// The last accepted NAV state.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -106,6 +108,16 @@ pub struct Controller {
     /// Ground height of each table entry (m): from the scene, then TERRAIN frames.
     pub(crate) heights_m: [f32; MAX_SEGMENTS],
     pub(crate) nav: Option<NavState>,
+    /// The bus's data (version 4), the other source of state: a NAV frame drops them,
+    /// a GNSS or ATTITUDE frame drops the NAV state. Updates run on them when both are
+    /// in force ([`crate::track`]).
+    pub(crate) gnss: Option<GnssState>,
+    pub(crate) attitude: Option<AttitudeState>,
+    /// GPS - UTC and UT1 - UTC in force (TIME_SCALES; the contract's defaults, 18 s
+    /// and 0, from boot).
+    pub(crate) time_scales: TimeScales,
+    /// The slowly moving part of C2T, kept for up to a minute.
+    pub(crate) pole: Option<CelestialPole>,
     /// Time tag of the last accepted frame of any kind (us).
     pub(crate) last_time_us: Option<u64>,
     /// Time tag of the previous frame, when it was refused for its time tag alone: the
@@ -162,6 +174,10 @@ impl Controller {
             plan: Plan::blank(),
             spare_plan: Plan::blank(),
             nav: None,
+            gnss: None,
+            attitude: None,
+            time_scales: TimeScales::DEFAULT,
+            pole: None,
             last_time_us: None,
             resync_candidate_us: None,
             now_us: 0,
@@ -203,7 +219,11 @@ impl Controller {
             *kept = *kept && scene.keeps_output_of(&self.scene, k);
         }
         self.heights_m = scene.segments.map(|s| s.ground_h_m);
+        let remount = scene.mounting_q != self.scene.mounting_q;
         self.scene = scene;
+        if remount {
+            self.rederive_attitude();
+        }
     }
 
     pub fn scene(&self) -> &Scene {
@@ -214,6 +234,18 @@ impl Controller {
     }
     pub fn nav(&self) -> Option<&NavState> {
         self.nav.as_ref()
+    }
+    /// The last GNSS fix in force (bus data).
+    pub fn gnss(&self) -> Option<&GnssState> {
+        self.gnss.as_ref()
+    }
+    /// The last attitude in force (bus data).
+    pub fn bus_attitude(&self) -> Option<&AttitudeState> {
+        self.attitude.as_ref()
+    }
+    /// GPS - UTC and UT1 - UTC in force.
+    pub fn time_scales(&self) -> &TimeScales {
+        &self.time_scales
     }
     /// The ground height in force for each entry of the scene's table (m).
     pub fn heights_m(&self) -> &[f32] {
@@ -248,10 +280,22 @@ impl Controller {
     }
 
     pub(crate) fn mode_at(&self, t_us: u64) -> Mode {
-        match &self.nav {
-            None => Mode::WaitingForNav,
-            Some(n) if t_us.saturating_sub(n.time_us) > self.config.stale_after_us => Mode::Stale,
-            Some(_) => Mode::Nominal,
+        match (&self.nav, &self.gnss, &self.attitude) {
+            (Some(n), _, _) if t_us.saturating_sub(n.time_us) > self.config.stale_after_us => {
+                Mode::Stale
+            }
+            (Some(_), _, _) => Mode::Nominal,
+            (None, Some(g), Some(a)) => {
+                let old = |t0: u64, limit: u64| t_us.saturating_sub(t0) > limit;
+                if old(g.fix_us, self.config.gnss_stale_after_us)
+                    || old(a.received.valid_us, self.config.stale_after_us)
+                {
+                    Mode::Stale
+                } else {
+                    Mode::Nominal
+                }
+            }
+            _ => Mode::WaitingForNav,
         }
     }
 

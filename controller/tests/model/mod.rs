@@ -78,7 +78,14 @@ pub enum Action {
 fn is_known_kind(k: u8) -> bool {
     matches!(
         k,
-        kind::NAV | kind::SCENE | kind::TERRAIN | kind::TIME | kind::END
+        kind::NAV
+            | kind::SCENE
+            | kind::TERRAIN
+            | kind::TIME
+            | kind::END
+            | kind::GNSS
+            | kind::ATTITUDE
+            | kind::TIME_SCALES
     )
 }
 
