@@ -1,5 +1,5 @@
 //! The line-rate controller's state: the scene and its plan in force, the last accepted
-//! NAV state, the clock and the update schedule, the outputs in force and the fault
+//! NAV state or the bus's GNSS fix and attitude, the clock and the update schedule, the outputs in force and the fault
 //! counters, with their accessors. The work on that state is in two modules of its own:
 //! [`crate::intake`] (frames to state, [`Controller::on_frame`]) and [`crate::update`]
 //! (state to periods, [`Controller::advance`]). Both read and write the fields, which
@@ -22,7 +22,7 @@ use crate::fault::{Counters, Fault};
 use crate::nav::Propagator;
 use crate::plan::Plan;
 use crate::scene::{Scene, MAX_SEGMENTS};
-use crate::track::{AttitudeState, GnssState};
+use crate::track::{pole_for, AttitudeState, GnssState};
 
 /// The last accepted NAV state.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -224,6 +224,23 @@ impl Controller {
         if remount {
             self.rederive_attitude();
         }
+    }
+
+    /// The attitude in force derived again after the mounting or the time scales
+    /// changed; dropped (until the next ATTITUDE frame) should it no longer derive.
+    pub(crate) fn rederive_attitude(&mut self) {
+        let Some(a) = self.attitude else { return };
+        let derived = pole_for(self.pole.as_ref(), a.received.valid_us, &self.time_scales)
+            .and_then(|pole| {
+                self.pole = Some(pole);
+                AttitudeState::derive(
+                    &a.received,
+                    &self.scene.mounting_q,
+                    &pole,
+                    &self.time_scales,
+                )
+            });
+        self.attitude = derived.ok();
     }
 
     pub fn scene(&self) -> &Scene {

@@ -227,23 +227,6 @@ impl Controller {
         Ok((state, pole))
     }
 
-    /// The attitude in force derived again after the mounting or the time scales
-    /// changed; dropped (until the next ATTITUDE frame) should it no longer derive.
-    pub(crate) fn rederive_attitude(&mut self) {
-        let Some(a) = self.attitude else { return };
-        let derived = pole_for(self.pole.as_ref(), a.received.valid_us, &self.time_scales)
-            .and_then(|pole| {
-                self.pole = Some(pole);
-                AttitudeState::derive(
-                    &a.received,
-                    &self.scene.mounting_q,
-                    &pole,
-                    &self.time_scales,
-                )
-            });
-        self.attitude = derived.ok();
-    }
-
     /// A NAV frame's checks: finite; an orbital frame; |r| in the altitude band and a
     /// speed of an imaging orbit ([`MIN_SPEED2_RATIO`]..[`MAX_SPEED2_RATIO`] of the
     /// circular speed squared) (`out_of_range`); the attitude inside the scene's

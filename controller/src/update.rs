@@ -1,5 +1,5 @@
-//! The update: state to periods. At every update instant, the NAV state propagated to
-//! it, each active segment's line period, its MTF (mismatch times drift smear) and TDI
+//! The update: state to periods. At every update instant, the NAV state (or the bus's
+//! fix and attitude, [`crate::track`]) carried to it, each active segment's line period, its MTF (mismatch times drift smear) and TDI
 //! stage limit, its drift angles, and the yaw steering request; the periods written
 //! through a [`LinePeriodSink`]. A refused computation leaves that segment's last good
 //! period in force, and nothing outside the physically possible period range is ever
