@@ -496,3 +496,59 @@ fn bad_frame(bus: &Bus, k: usize, tag_us: u64, last_valid_us: u64) -> (Vec<u8>, 
         ),
     }
 }
+
+/// The bus's data go stale as NAV does, each by its own limit: an attitude more than
+/// `stale_after` (1 s) old holds every period and counts one `stale`; a fresh attitude
+/// brings the updates back while the fix is within `gnss_stale_after` (2 s); a NAV
+/// frame then replaces the bus's data, and a GNSS frame the NAV state.
+#[test]
+fn bus_data_go_stale_by_their_own_limits_and_one_source_replaces_the_other() {
+    let bus = Bus::new();
+    let mut c = Controller::new(Config::default(), Scene::paper_default()).unwrap();
+    let mut regs = Registers::default();
+    let mut last_valid_us = 0;
+    for step in clean_stream(&bus) {
+        match step {
+            Step::Frame(_, bytes, _, a) => {
+                feed(&mut c, &bytes);
+                if let Some(a) = a {
+                    last_valid_us = a.valid_us;
+                }
+            }
+            Step::Update(t) => {
+                c.advance(t, &mut regs);
+            }
+        }
+    }
+    assert_eq!(c.counters.total(), 0);
+    let last_fix_us = c.gnss().unwrap().fix_us;
+    // The attitude 1.02 s old, the fix 1.2 s: stale, by the attitude.
+    let t = last_valid_us + 1_020_000;
+    assert!(c.advance(t, &mut regs));
+    assert_eq!(c.update_mode(), Mode::Stale);
+    assert_eq!(c.counters.get(Fault::Stale), 1);
+    assert!(c.outputs().all(|o| o.held));
+    // A fresh attitude: nominal again (the fix is 1.3 s old).
+    let a = bus.attitude(t + 60_000);
+    feed(&mut c, &attitude_frame(500, t + 80_000, &a));
+    assert!(c.advance(t + 100_000, &mut regs));
+    assert_eq!(c.update_mode(), Mode::Nominal);
+    assert!(c.outputs().all(|o| !o.held));
+    // The fix more than 2 s old: stale again, by the fix.
+    let a = bus.attitude(last_fix_us + 2_050_000);
+    feed(&mut c, &attitude_frame(501, last_fix_us + 2_060_000, &a));
+    assert!(c.advance(last_fix_us + 2_060_000, &mut regs));
+    assert_eq!(c.update_mode(), Mode::Stale);
+    assert_eq!(c.counters.get(Fault::Stale), 2);
+    // NAV replaces the bus's data; a GNSS frame then replaces NAV (and waits for an
+    // attitude).
+    let t = last_fix_us + 2_100_000;
+    let nav = common::nav_frame(502, t, orbit_t0(), common::roll(0.1));
+    feed(&mut c, &nav);
+    assert!(c.nav().is_some() && c.gnss().is_none() && c.bus_attitude().is_none());
+    let g = bus.gnss(t + 10_000);
+    feed(&mut c, &gnss_frame(503, t + 20_000, &g));
+    assert!(c.nav().is_none() && c.gnss().is_some());
+    assert_eq!(c.mode(), Mode::WaitingForNav);
+    assert_eq!(c.counters.total(), 2, "{:?}", c.last_fault);
+}
