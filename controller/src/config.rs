@@ -19,6 +19,10 @@ pub struct Config {
     /// updates. It is also how far ahead a NAV frame's attitude is propagated when it
     /// is checked against the scene's envelope.
     pub stale_after_us: u64,
+    /// A GNSS fix older than this (us) at an update is stale, as NAV after
+    /// `stale_after_us`; also the oldest time of fix a GNSS frame may carry. Two
+    /// seconds: one fix of a 1 Hz receiver may be lost.
+    pub gnss_stale_after_us: u64,
     /// Largest step (us) a time tag may take ahead of the controller's clock. A tag
     /// further ahead is refused ([`Fault::TimeJump`](crate::Fault::TimeJump)) unless the next frame confirms
     /// the new time line (a re-synchronisation, docs/telemetry.md "Time").
@@ -34,6 +38,7 @@ impl Default for Config {
         Config {
             update_period_us: 20_000,
             stale_after_us: 1_000_000,
+            gnss_stale_after_us: 2_000_000,
             max_time_jump_us: 5_000_000,
             altitude_range_m: (500e3, 800e3),
         }

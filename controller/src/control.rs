@@ -1,5 +1,5 @@
 //! The line-rate controller's state: the scene and its plan in force, the last accepted
-//! NAV state, the clock and the update schedule, the outputs in force and the fault
+//! NAV state or the bus's GNSS fix and attitude, the clock and the update schedule, the outputs in force and the fault
 //! counters, with their accessors. The work on that state is in two modules of its own:
 //! [`crate::intake`] (frames to state, [`Controller::on_frame`]) and [`crate::update`]
 //! (state to periods, [`Controller::advance`]). Both read and write the fields, which
@@ -14,6 +14,7 @@
 //! refused computation leaves that segment's last good period in force, and nothing
 //! outside the physically possible period range is ever written.
 
+use core_math::earth::frames::{CelestialPole, TimeScales};
 use core_math::earth::Attitude;
 
 use crate::config::Config;
@@ -22,6 +23,7 @@ use crate::nav::Propagator;
 use crate::plan::Plan;
 use crate::restart::ResetCause;
 use crate::scene::{Scene, MAX_SEGMENTS};
+use crate::track::{pole_for, AttitudeState, GnssState};
 
 /// The last accepted NAV state.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -107,6 +109,16 @@ pub struct Controller {
     /// Ground height of each table entry (m): from the scene, then TERRAIN frames.
     pub(crate) heights_m: [f32; MAX_SEGMENTS],
     pub(crate) nav: Option<NavState>,
+    /// The bus's data (version 4), the other source of state: a NAV frame drops them,
+    /// a GNSS or ATTITUDE frame drops the NAV state. Updates run on them when both are
+    /// in force ([`crate::track`]).
+    pub(crate) gnss: Option<GnssState>,
+    pub(crate) attitude: Option<AttitudeState>,
+    /// GPS - UTC and UT1 - UTC in force (TIME_SCALES; the contract's defaults, 18 s
+    /// and 0, from boot).
+    pub(crate) time_scales: TimeScales,
+    /// The slowly moving part of C2T, kept for up to a minute.
+    pub(crate) pole: Option<CelestialPole>,
     /// Time tag of the last accepted frame of any kind (us).
     pub(crate) last_time_us: Option<u64>,
     /// Time tag of the previous frame, when it was refused for its time tag alone: the
@@ -170,6 +182,10 @@ impl Controller {
             plan: Plan::blank(),
             spare_plan: Plan::blank(),
             nav: None,
+            gnss: None,
+            attitude: None,
+            time_scales: TimeScales::DEFAULT,
+            pole: None,
             last_time_us: None,
             resync_candidate_us: None,
             now_us: 0,
@@ -213,8 +229,29 @@ impl Controller {
             *kept = *kept && scene.keeps_output_of(&self.scene, k);
         }
         self.heights_m = scene.segments.map(|s| s.ground_h_m);
+        let remount = scene.mounting_q != self.scene.mounting_q;
         self.scene = scene;
         self.inputs_generation = self.inputs_generation.wrapping_add(1);
+        if remount {
+            self.rederive_attitude();
+        }
+    }
+
+    /// The attitude in force derived again after the mounting or the time scales
+    /// changed; dropped (until the next ATTITUDE frame) should it no longer derive.
+    pub(crate) fn rederive_attitude(&mut self) {
+        let Some(a) = self.attitude else { return };
+        let derived = pole_for(self.pole.as_ref(), a.received.valid_us, &self.time_scales)
+            .and_then(|pole| {
+                self.pole = Some(pole);
+                AttitudeState::derive(
+                    &a.received,
+                    &self.scene.mounting_q,
+                    &pole,
+                    &self.time_scales,
+                )
+            });
+        self.attitude = derived.ok();
     }
 
     /// Notes why the core last started and how many resets there have been since
@@ -241,6 +278,18 @@ impl Controller {
     }
     pub fn nav(&self) -> Option<&NavState> {
         self.nav.as_ref()
+    }
+    /// The last GNSS fix in force (bus data).
+    pub fn gnss(&self) -> Option<&GnssState> {
+        self.gnss.as_ref()
+    }
+    /// The last attitude in force (bus data).
+    pub fn bus_attitude(&self) -> Option<&AttitudeState> {
+        self.attitude.as_ref()
+    }
+    /// GPS - UTC and UT1 - UTC in force.
+    pub fn time_scales(&self) -> &TimeScales {
+        &self.time_scales
     }
     /// The ground height in force for each entry of the scene's table (m).
     pub fn heights_m(&self) -> &[f32] {
@@ -275,10 +324,22 @@ impl Controller {
     }
 
     pub(crate) fn mode_at(&self, t_us: u64) -> Mode {
-        match &self.nav {
-            None => Mode::WaitingForNav,
-            Some(n) if t_us.saturating_sub(n.time_us) > self.config.stale_after_us => Mode::Stale,
-            Some(_) => Mode::Nominal,
+        match (&self.nav, &self.gnss, &self.attitude) {
+            (Some(n), _, _) if t_us.saturating_sub(n.time_us) > self.config.stale_after_us => {
+                Mode::Stale
+            }
+            (Some(_), _, _) => Mode::Nominal,
+            (None, Some(g), Some(a)) => {
+                let old = |t0: u64, limit: u64| t_us.saturating_sub(t0) > limit;
+                if old(g.fix_us, self.config.gnss_stale_after_us)
+                    || old(a.received.valid_us, self.config.stale_after_us)
+                {
+                    Mode::Stale
+                } else {
+                    Mode::Nominal
+                }
+            }
+            _ => Mode::WaitingForNav,
         }
     }
 

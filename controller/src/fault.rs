@@ -40,10 +40,19 @@ pub enum Fault {
     /// Time tag too far ahead of the controller's clock (more than
     /// `Config::max_time_jump_us`), or beyond the largest tag the clock takes.
     TimeJump,
+    /// A quaternion (ATTITUDE, or the mounting in SCENE) whose norm is off 1 by more
+    /// than 1e-3.
+    BadQuaternion,
+    /// A GNSS time of fix or an attitude's time of validity outside the accepted window
+    /// (after the last one taken, not after the frame's tag, not older than the data's
+    /// staleness limit), or outside the Earth-orientation model's years.
+    FixTime,
+    /// Leap seconds (GPS - UTC) outside 0..=60 s, or |UT1 - UTC| of 0.9 s or more.
+    TimeScales,
 }
 
 impl Fault {
-    pub const COUNT: usize = 15;
+    pub const COUNT: usize = 18;
     pub const ALL: [Fault; Fault::COUNT] = [
         Fault::BadCrc,
         Fault::Truncated,
@@ -60,6 +69,9 @@ impl Fault {
         Fault::PeriodOutOfRange,
         Fault::InvalidScene,
         Fault::TimeJump,
+        Fault::BadQuaternion,
+        Fault::FixTime,
+        Fault::TimeScales,
     ];
 
     pub const fn name(self) -> &'static str {
@@ -79,6 +91,9 @@ impl Fault {
             Fault::PeriodOutOfRange => "period_out_of_range",
             Fault::InvalidScene => "invalid_scene",
             Fault::TimeJump => "time_jump",
+            Fault::BadQuaternion => "bad_quaternion",
+            Fault::FixTime => "fix_time",
+            Fault::TimeScales => "time_scales",
         }
     }
 }

@@ -11,10 +11,9 @@ use heapless::Vec;
 use crate::crc;
 
 pub const SYNC: [u8; 2] = [0xEB, 0x90];
-/// 3 since issue 12: the real-Earth controller's SCENE (attitude envelope, stagger,
-/// ground heights), the TERRAIN frame, PERIODS with drift and the yaw steering request
-/// (docs/telemetry.md, "Versions").
-pub const VERSION: u8 = 3;
+/// 4 since issue 23: the bus's own frames (GNSS, ATTITUDE, TIME_SCALES) and the camera
+/// mounting in SCENE (docs/telemetry.md, "Versions").
+pub const VERSION: u8 = 4;
 /// sync (2) + version (1) + kind (1) + length (2) + sequence (2) + time tag (8).
 pub const HEADER_LEN: usize = 16;
 pub const CRC_LEN: usize = 2;
@@ -38,6 +37,14 @@ pub mod kind {
     /// Ground heights of the scene's segments (payload: `scene::Terrain`), in force
     /// from the frame's time tag.
     pub const TERRAIN: u8 = 0x05;
+    /// A GNSS fix: ITRF position and velocity at the time of fix (payload:
+    /// `bus::GNSS_LEN` bytes).
+    pub const GNSS: u8 = 0x06;
+    /// A star tracker's GCRF quaternion with gyro body rates at the time of validity
+    /// (payload: `bus::ATTITUDE_LEN` bytes).
+    pub const ATTITUDE: u8 = 0x07;
+    /// GPS - UTC and UT1 - UTC (payload: `bus::TIME_SCALES_LEN` bytes).
+    pub const TIME_SCALES: u8 = 0x08;
     /// Line periods, one record per active segment.
     pub const PERIODS: u8 = 0x81;
     /// Fault counters and state.

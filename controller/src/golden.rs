@@ -10,9 +10,16 @@
 //! shared is only the definition: the plan's sample pixels and the period of a segment
 //! as the mean of the periods of its fastest and slowest sampled |v1|.
 
+use core_math::earth::bus::{
+    bus_geometry, AttitudeFrame, BusAttitude, BusState, BusTime, StateFrame,
+};
+use core_math::earth::frames::{self, TimeScales};
 use core_math::earth::kepler::Kepler;
-use core_math::earth::{Attitude, EarthCamera, EarthGeometry};
-use core_math::{Backend, EarthReference, ModelError, StateVector, GM_M3_S2};
+use core_math::earth::reference::EarthRefPixel;
+use core_math::earth::{Attitude, EarthCamera, EarthGeometry, InertialGeometry};
+use core_math::{Backend, EarthReference, ImageMotion, ModelError, StateVector, GM_M3_S2};
+
+use crate::bus::{Gnss, StarAttitude};
 
 use crate::config::{EARTH, EARTH_RATE_RAD_S};
 use crate::plan::Plan;
@@ -78,6 +85,133 @@ pub fn update(
         ellipsoid: EARTH,
         earth_rate_rad_s: EARTH_RATE_RAD_S,
     };
+    let evaluate =
+        |camera: &EarthCamera, h_m: f32, n: f64| EarthReference.evaluate(camera, &geometry(h_m), n);
+    let (segments, yaw_request_rad) = segments_of(scene, plan, heights_m, evaluate)?;
+    Ok(UpdateGolden {
+        segments,
+        yaw_request_rad,
+        state,
+        attitude,
+    })
+}
+
+/// The reference of one update on the bus's data (protocol version 4): the GNSS fix
+/// `gnss` and the attitude `attitude` in force, the time scales `scales`, the update at
+/// `t_us` (us of GPS time).
+///
+/// Independent of [`crate::track`]: the fix's state in I at its time (r, v + w x r)
+/// carried by Kepler's equation, then into I at t by the full C2T at both instants
+/// (`C2T(t) C2T(t_fix)^T`, each with its own precession-nutation series); the attitude
+/// turned by its body rates as a quaternion product (q exp(w dt / 2)); the camera's
+/// axes and Omega from core-math's `bus_geometry` (C2T(t) R(q) R(cam_q)); every image
+/// motion from the construction on dual numbers (`EarthReference::motion_of`). Shared
+/// with the controller: the definitions (Part II) and the plan's samples.
+#[allow(clippy::too_many_arguments)]
+pub fn bus_update(
+    scene: &Scene,
+    plan: &Plan,
+    heights_m: &[f32],
+    gnss: &Gnss,
+    attitude: &StarAttitude,
+    scales: &TimeScales,
+    t_us: u64,
+) -> Result<UpdateGolden, ModelError> {
+    let secs = |us: u64| us as f64 * 1e-6;
+    let t_s = secs(t_us);
+    let (r, v, w) = (gnss.position_m, gnss.velocity_mps, EARTH_RATE_RAD_S);
+    let v_i = [v[0] - w * r[1], v[1] + w * r[0], v[2]];
+    let kepler = Kepler::new(r, v_i, GM_M3_S2).ok_or(ModelError::DegenerateState)?;
+    let carried = kepler.state_at(t_s - secs(gnss.fix_us));
+    let c2t_fix = frames::c2t(secs(gnss.fix_us), scales)?;
+    let c2t_t = frames::c2t(t_s, scales)?;
+    // I at t from I at the fix: C2T(t) C2T(fix)^T.
+    let m: [[f64; 3]; 3] = core::array::from_fn(|i| {
+        core::array::from_fn(|j| (0..3).map(|k| c2t_t[i][k] * c2t_fix[j][k]).sum())
+    });
+    let to_t = |x: [f64; 3]| -> [f64; 3] {
+        core::array::from_fn(|i| m[i][0] * x[0] + m[i][1] * x[1] + m[i][2] * x[2])
+    };
+    let state = StateVector {
+        position_m: to_t(carried.position_m),
+        velocity_mps: to_t(carried.velocity_mps),
+    };
+    let q = quaternion_at(attitude, t_s - secs(attitude.valid_us));
+    let bus_attitude = BusAttitude {
+        q,
+        frame: AttitudeFrame::Gcrf,
+        body_rate_rad_s: attitude.body_rate_rad_s.map(f64::from),
+        camera_q: scene.mounting_q.map(f64::from),
+    };
+    let bus_state = BusState {
+        frame: StateFrame::Inertial,
+        position_m: state.position_m,
+        velocity_mps: state.velocity_mps,
+    };
+    let time = BusTime {
+        gps_s: Some(t_s),
+        scales: *scales,
+    };
+    let geometry = |h_m: f32| -> Result<InertialGeometry<f64>, ModelError> {
+        bus_geometry(
+            &bus_state,
+            &bus_attitude,
+            &time,
+            f64::from(h_m),
+            EARTH,
+            EARTH_RATE_RAD_S,
+        )
+    };
+    let evaluate =
+        |camera: &EarthCamera, h_m: f32, n: f64| -> Result<ImageMotion<f64>, ModelError> {
+            let (p1_m, p2_m) = camera.focal_plane_m(n)?;
+            let pixel = EarthRefPixel {
+                p1_m,
+                p2_m,
+                focal_m: camera.focal_m,
+            };
+            EarthReference::motion_of(&geometry(h_m)?, &pixel)
+        };
+    let (segments, yaw_request_rad) = segments_of(scene, plan, heights_m, evaluate)?;
+    Ok(UpdateGolden {
+        segments,
+        yaw_request_rad,
+        state,
+        // The roll-pitch-yaw attitude is Part I's; the bus's is a quaternion.
+        attitude: Attitude::default(),
+    })
+}
+
+/// The attitude quaternion `dt_s` after its validity, turned at its body rates:
+/// q exp(w dt / 2) (body rates in body axes: the turn multiplies on the right).
+fn quaternion_at(a: &StarAttitude, dt_s: f64) -> [f64; 4] {
+    let q = a.q.map(f64::from);
+    let w = a.body_rate_rad_s.map(f64::from);
+    let rate = libm::sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+    let half = 0.5 * rate * dt_s;
+    let (s, c) = (libm::sin(half), libm::cos(half));
+    let e = if rate > 0.0 {
+        [c, s * w[0] / rate, s * w[1] / rate, s * w[2] / rate]
+    } else {
+        [1.0, 0.0, 0.0, 0.0]
+    };
+    [
+        q[0] * e[0] - q[1] * e[1] - q[2] * e[2] - q[3] * e[3],
+        q[0] * e[1] + q[1] * e[0] + q[2] * e[3] - q[3] * e[2],
+        q[0] * e[2] - q[1] * e[3] + q[2] * e[0] + q[3] * e[1],
+        q[0] * e[3] + q[1] * e[2] - q[2] * e[1] + q[3] * e[0],
+    ]
+}
+
+/// Every active segment's reference and the yaw request, from `evaluate(camera, ground
+/// height, pixel)`: the one definition of a segment's period both references share.
+#[allow(clippy::type_complexity)]
+fn segments_of(
+    scene: &Scene,
+    plan: &Plan,
+    heights_m: &[f32],
+    evaluate: impl Fn(&EarthCamera, f32, f64) -> Result<ImageMotion<f64>, ModelError>,
+) -> Result<([Option<SegmentGolden>; MAX_SEGMENTS], Option<f64>), ModelError> {
     let height = |index: u8| heights_m.get(usize::from(index)).copied().unwrap_or(0.0);
     let mut segments = [None; MAX_SEGMENTS];
     for (slot, seg) in segments.iter_mut().zip(plan.active()) {
@@ -85,14 +219,14 @@ pub fn update(
             continue;
         };
         let camera = scene.earth_camera(spec);
-        let g = geometry(height(seg.index));
+        let h_m = height(seg.index);
         let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
         for n in seg.samples.iter().map(|s| s.px) {
-            let m = EarthReference.evaluate(&camera, &g, f64::from(n))?;
+            let m = evaluate(&camera, h_m, f64::from(n))?;
             lo = lo.min(libm::fabs(m.v1_mps));
             hi = hi.max(libm::fabs(m.v1_mps));
         }
-        let centre = EarthReference.evaluate(&camera, &g, spec.centre_px())?;
+        let centre = evaluate(&camera, h_m, spec.centre_px())?;
         let pixel_m = scene.camera.pixel_m;
         *slot = Some(SegmentGolden {
             index: seg.index,
@@ -106,14 +240,8 @@ pub fn update(
         p1_m: 0.0,
         ..scene.earth_camera(&scene.segments[0])
     };
-    let yaw_request_rad = EarthReference
-        .evaluate(&boresight, &geometry(height(plan.boresight_segment)), 0.0)
+    let yaw_request_rad = evaluate(&boresight, height(plan.boresight_segment), 0.0)
         .ok()
         .map(|m| libm::atan(m.v2_mps / m.v1_mps));
-    Ok(UpdateGolden {
-        segments,
-        yaw_request_rad,
-        state,
-        attitude,
-    })
+    Ok((segments, yaw_request_rad))
 }

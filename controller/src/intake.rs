@@ -4,8 +4,11 @@
 //! planning it, a TERRAIN frame against the scene in force. A refused frame leaves the
 //! state as it was and is counted ([`Controller::reject`]).
 
+use core_math::earth::frames::CelestialPole;
 use core_math::earth::Attitude;
+use core_math::StateVector;
 
+use crate::bus::{decode_time_scales, Gnss, StarAttitude};
 use crate::config::{EARTH, MAX_TIME_TAG_US};
 use crate::control::{Controller, NavState};
 use crate::fault::Fault;
@@ -13,6 +16,7 @@ use crate::frame::{kind, Frame};
 use crate::nav::{Nav, Propagator};
 use crate::plan::{MAX_SPEED2_RATIO, MIN_SPEED2_RATIO};
 use crate::scene::{AttitudeEnvelope, Scene, Terrain};
+use crate::track::{pole_for, AttitudeState, GnssState};
 
 impl Controller {
     /// One decoded frame. Its time tag moves the controller's clock forward.
@@ -87,6 +91,9 @@ impl Controller {
                 self.spare_plan.build_into(&scene, &self.config, false)
             }
             kind::TERRAIN => Terrain::decode(frame.payload, &self.scene).map(|_| ()),
+            kind::GNSS => self.check_gnss(frame).map(|_| ()),
+            kind::ATTITUDE => self.check_attitude(frame).map(|_| ()),
+            kind::TIME_SCALES => decode_time_scales(frame.payload).map(|_| ()),
             kind::TIME if frame.payload.is_empty() => Ok(()),
             kind::TIME => Err(Fault::BadLength),
             _ => Err(Fault::UnknownKind),
@@ -102,6 +109,8 @@ impl Controller {
         self.now_us = t_us;
         self.next_update_us = 0;
         self.nav = None;
+        self.gnss = None;
+        self.attitude = None;
         self.hold_all();
     }
 
@@ -115,6 +124,23 @@ impl Controller {
                 self.inputs_generation = self.inputs_generation.wrapping_add(1);
                 Ok(())
             }
+            kind::GNSS => {
+                self.gnss = Some(self.check_gnss(frame)?);
+                self.nav = None;
+                Ok(())
+            }
+            kind::ATTITUDE => {
+                let (attitude, pole) = self.check_attitude(frame)?;
+                self.attitude = Some(attitude);
+                self.pole = Some(pole);
+                self.nav = None;
+                Ok(())
+            }
+            kind::TIME_SCALES => {
+                self.time_scales = decode_time_scales(frame.payload)?;
+                self.rederive_attitude();
+                Ok(())
+            }
             kind::TIME if frame.payload.is_empty() => Ok(()),
             kind::TIME => Err(Fault::BadLength),
             _ => Err(Fault::UnknownKind),
@@ -123,7 +149,83 @@ impl Controller {
 
     fn accept_nav(&mut self, frame: &Frame<'_>) -> Result<(), Fault> {
         self.nav = Some(self.check_nav(frame)?);
+        self.gnss = None;
+        self.attitude = None;
         Ok(())
+    }
+
+    /// An orbit the controller flies: an orbital frame; |r| in the altitude band and a
+    /// speed of an imaging orbit ([`MIN_SPEED2_RATIO`]..[`MAX_SPEED2_RATIO`] of the
+    /// circular speed squared) (`out_of_range`). Every value finite (the caller's).
+    fn check_orbit(&self, state: &StateVector) -> Result<(), Fault> {
+        let (r, v) = (state.position_m, state.velocity_mps);
+        let (r2, _) = core_math::earth::check_state(r, v).map_err(|_| Fault::OutOfRange)?;
+        let r_m = libm::sqrt(r2);
+        let (h_lo, h_hi) = self.config.altitude_range_m;
+        if !(r_m >= EARTH.b_m() + h_lo && r_m <= EARTH.a_m + h_hi) {
+            return Err(Fault::OutOfRange);
+        }
+        let speed2_ratio = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) * r_m / core_math::GM_M3_S2;
+        if !(MIN_SPEED2_RATIO..=MAX_SPEED2_RATIO).contains(&speed2_ratio) {
+            return Err(Fault::OutOfRange);
+        }
+        Ok(())
+    }
+
+    /// A time of fix or of validity `t0_us` in a frame tagged `tag_us`: after the last
+    /// one taken (`last_us`), not after the tag, and at most `max_age_us` before it
+    /// (`fix_time`).
+    fn check_data_time(
+        t0_us: u64,
+        tag_us: u64,
+        last_us: Option<u64>,
+        max_age_us: u64,
+    ) -> Result<(), Fault> {
+        let fresh = t0_us <= tag_us && tag_us - t0_us <= max_age_us;
+        if !fresh || last_us.is_some_and(|last| t0_us <= last) {
+            return Err(Fault::FixTime);
+        }
+        Ok(())
+    }
+
+    /// A GNSS frame's checks: finite (`non_finite`), the time of fix
+    /// ([`Controller::check_data_time`], against `gnss_stale_after`), the orbit in I
+    /// ([`Controller::check_orbit`]).
+    fn check_gnss(&self, frame: &Frame<'_>) -> Result<GnssState, Fault> {
+        let gnss = Gnss::decode(frame.payload)?;
+        let last = self.gnss.map(|g| g.fix_us);
+        Self::check_data_time(
+            gnss.fix_us,
+            frame.time_us,
+            last,
+            self.config.gnss_stale_after_us,
+        )?;
+        self.check_orbit(&GnssState::inertial(&gnss))?;
+        Ok(GnssState::new(&gnss))
+    }
+
+    /// An ATTITUDE frame's checks: finite (`non_finite`), the time of validity
+    /// ([`Controller::check_data_time`], against `stale_after`), the quaternion's norm
+    /// (`bad_quaternion`), the camera's rates (Omega, each axis) within the scene's
+    /// largest rate (`attitude_outside_model`). Returns the attitude in I and the pole
+    /// it was computed with (a new one when the one in force is too old for it).
+    fn check_attitude(&self, frame: &Frame<'_>) -> Result<(AttitudeState, CelestialPole), Fault> {
+        let received = StarAttitude::decode(frame.payload)?;
+        let last = self.attitude.map(|a| a.received.valid_us);
+        Self::check_data_time(
+            received.valid_us,
+            frame.time_us,
+            last,
+            self.config.stale_after_us,
+        )?;
+        let pole = pole_for(self.pole.as_ref(), received.valid_us, &self.time_scales)?;
+        let state =
+            AttitudeState::derive(&received, &self.scene.mounting_q, &pole, &self.time_scales)?;
+        let max_rate = self.plan.envelope.max_rate_rad_s;
+        if !state.omega_rad_s.iter().all(|w| w.abs() <= max_rate) {
+            return Err(Fault::AttitudeOutsideModel);
+        }
+        Ok((state, pole))
     }
 
     /// A NAV frame's checks: finite; an orbital frame; |r| in the altitude band and a
@@ -134,16 +236,8 @@ impl Controller {
     /// up to that) to `stale_after` ahead (`attitude_outside_model`).
     fn check_nav(&self, frame: &Frame<'_>) -> Result<NavState, Fault> {
         let nav = Nav::decode(frame.payload)?;
-        let r_m = nav.check_state()?;
-        let (h_lo, h_hi) = self.config.altitude_range_m;
-        if !(r_m >= EARTH.b_m() + h_lo && r_m <= EARTH.a_m + h_hi) {
-            return Err(Fault::OutOfRange);
-        }
-        let v = nav.state.velocity_mps;
-        let speed2_ratio = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) * r_m / core_math::GM_M3_S2;
-        if !(MIN_SPEED2_RATIO..=MAX_SPEED2_RATIO).contains(&speed2_ratio) {
-            return Err(Fault::OutOfRange);
-        }
+        nav.check_state()?;
+        self.check_orbit(&nav.state)?;
         let back_s = self.config.update_period_us as f32 * 1e-6;
         let ahead_s = self.config.stale_after_us as f32 * 1e-6;
         if !inside_envelope(&nav.attitude, &self.plan.envelope, back_s, ahead_s) {

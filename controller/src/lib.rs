@@ -2,15 +2,16 @@
 //! scene and its plan, per-segment TDI line periods out. `no_std`, no allocation, no
 //! hardware: the firmware feeds it bytes and a clock, and gives it a [`LinePeriodSink`].
 //!
-//! telemetry in ([`frame`], [`nav`]) -> frames to state ([`intake`]; the scene and its
+//! telemetry in ([`frame`], [`nav`], the bus's own frames: [`bus`]) -> frames to state ([`intake`]; the scene and its
 //! plan: [`scene`], [`plan`]) -> the controller's state ([`control`], its settings in
-//! [`config`]) -> state to periods ([`update`]: core-math's general real-Earth form) ->
+//! [`config`]) -> state to periods (the bus's data carried to the instant: [`track`]; [`update`]: core-math's general real-Earth form) ->
 //! line periods out ([`sink`], [`report`]; whole frames into the transmit queue:
 //! [`downlink`]).
 #![no_std]
 #![forbid(unsafe_code)]
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+pub mod bus;
 pub mod bytes;
 pub mod config;
 pub mod control;
@@ -28,6 +29,7 @@ pub mod restart;
 pub mod scene;
 pub mod session;
 pub mod sink;
+pub mod track;
 pub mod update;
 
 pub use config::{Config, EARTH};

@@ -20,6 +20,10 @@ pub const MAX_TDI_STAGES: u16 = 256;
 /// Fixed part of the SCENE payload, then [`SEGMENT_LEN`] bytes per segment.
 pub const SCENE_HEADER_LEN: usize = 44;
 pub const SEGMENT_LEN: usize = 20;
+/// The optional end of a SCENE payload (version 4): the camera's mounting quaternion.
+pub const MOUNTING_LEN: usize = 16;
+/// The identity quaternion: the camera's axes are the body's.
+pub const IDENTITY_MOUNTING: [f32; 4] = [1.0, 0.0, 0.0, 0.0];
 /// Ground heights a segment may image (m above the WGS 84 ellipsoid): the Dead Sea
 /// shore to above Everest.
 pub const MIN_GROUND_H_M: f32 = -500.0;
@@ -78,6 +82,11 @@ pub struct Scene {
     pub max_stages: u16,
     pub segments: [SegmentSpec; MAX_SEGMENTS],
     pub count: u8,
+    /// The camera's mounting on the body (Part II's `cam_q`): `w, x, y, z`, scalar
+    /// first, x_body = R(q) x_camera. Used with the bus's ATTITUDE frames; a NAV
+    /// frame's attitude is the camera's own. Identity unless the SCENE payload ends
+    /// with one.
+    pub mounting_q: [f32; 4],
 }
 
 impl Scene {
@@ -115,6 +124,7 @@ impl Scene {
             max_stages: 96,
             segments,
             count: 10,
+            mounting_q: IDENTITY_MOUNTING,
         }
     }
 
@@ -136,7 +146,8 @@ impl Scene {
             && self.line_clock_hz == old.line_clock_hz
             && self.mtf_floor == old.mtf_floor
             && self.envelope == old.envelope
-            && self.max_stages == old.max_stages;
+            && self.max_stages == old.max_stages
+            && self.mounting_q == old.mounting_q;
         let chip = |s: &Scene| {
             s.table().get(k).filter(|c| c.active).map(|c| SegmentSpec {
                 ground_h_m: 0.0,
@@ -175,6 +186,11 @@ impl Scene {
             && angle_ok(e.max_pitch_rad)
             && e.max_rate_rad_s.is_finite()
             && (0.0..=MAX_ENVELOPE_RATE_RAD_S).contains(&e.max_rate_rad_s);
+        let q = self.mounting_q.map(f64::from);
+        let norm = libm::sqrt(q.iter().map(|x| x * x).sum::<f64>());
+        if !(libm::fabs(norm - 1.0) <= core_math::earth::bus::MAX_QUATERNION_NORM_ERROR) {
+            return Err(Fault::BadQuaternion);
+        }
         if !clock_ok || !envelope_ok || StageRule::<f32>::new(f64::from(self.mtf_floor)).is_err() {
             return Err(Fault::InvalidScene);
         }
@@ -234,8 +250,11 @@ impl Scene {
         let count = r.u8().ok_or(bad)?;
         let _reserved = r.u8().ok_or(bad)?;
         // A length that matches its own count is well formed, even when the count is
-        // more than the table holds: that is a scene the camera cannot use.
-        if payload.len() != SCENE_HEADER_LEN + usize::from(count) * SEGMENT_LEN {
+        // more than the table holds: that is a scene the camera cannot use. The
+        // mounting may follow the table.
+        let table_len = SCENE_HEADER_LEN + usize::from(count) * SEGMENT_LEN;
+        let with_mounting = payload.len() == table_len + MOUNTING_LEN;
+        if payload.len() != table_len && !with_mounting {
             return Err(Fault::BadLength);
         }
         if usize::from(count) > MAX_SEGMENTS {
@@ -265,6 +284,13 @@ impl Scene {
                 ground_h_m,
             };
         }
+        let mut mounting_q = IDENTITY_MOUNTING;
+        if with_mounting {
+            for x in mounting_q.iter_mut() {
+                *x = r.f32().ok_or(bad)?;
+            }
+            finite &= mounting_q.iter().all(|x| x.is_finite());
+        }
         if !r.is_done() {
             return Err(Fault::BadLength);
         }
@@ -292,6 +318,7 @@ impl Scene {
             max_stages,
             segments,
             count,
+            mounting_q,
         })
     }
 
@@ -313,6 +340,12 @@ impl Scene {
             w.put(&[u8::from(s.active), 0])?;
             w.put(&s.p1_m.to_le_bytes())?;
             w.put(&s.ground_h_m.to_le_bytes())?;
+        }
+        // Version 3's layout whenever it says the same.
+        if self.mounting_q != IDENTITY_MOUNTING {
+            for x in self.mounting_q {
+                w.put(&x.to_le_bytes())?;
+            }
         }
         Some(w.len())
     }

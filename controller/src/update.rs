@@ -1,5 +1,5 @@
-//! The update: state to periods. At every update instant, the NAV state propagated to
-//! it, each active segment's line period, its MTF (mismatch times drift smear) and TDI
+//! The update: state to periods. At every update instant, the NAV state (or the bus's
+//! fix and attitude, [`crate::track`]) carried to it, each active segment's line period, its MTF (mismatch times drift smear) and TDI
 //! stage limit, its drift angles, and the yaw steering request; the periods written
 //! through a [`LinePeriodSink`]. A refused computation leaves that segment's last good
 //! period in force, and nothing outside the physically possible period range is ever
@@ -15,6 +15,7 @@ use crate::fault::Fault;
 use crate::nav::attitude_at;
 use crate::plan::SegmentPlan;
 use crate::sink::LinePeriodSink;
+use crate::track;
 
 impl Controller {
     /// Moves the clock to `now_us` (from the time source) and runs the update that is due,
@@ -56,28 +57,34 @@ impl Controller {
 
     fn update_at<S: LinePeriodSink>(&mut self, t_us: u64, sink: &mut S) {
         self.yaw_request_rad = None;
-        let Some(nav) = self.nav else { return };
-        if self.update_mode == Mode::Stale {
-            self.hold_planned();
-            return;
-        }
-        // Not stale: t - t_nav lies in [-update period, stale_after], both < 2^53 us:
-        // the difference is exact in i64 and small in f32. Converted from i32 when it
-        // fits (one instruction; from i64 it is a software call), to the same f32.
-        let dt_us = (t_us as i64).wrapping_sub(nav.time_us as i64);
-        let dt_s = match i32::try_from(dt_us) {
-            Ok(dt) => dt as f32,
-            Err(_) => i64_to_f32(dt_us),
-        } * 1e-6;
-        let state = nav.propagator.parts_at(dt_s);
-        let attitude = attitude_at(&nav.attitude, dt_s);
-        let instant = match GENERAL_F32.instant_parts(
-            state.position_m,
-            state.velocity_mps,
-            state.r2_minus_a2_m2,
-            &attitude,
-            EARTH_RATE_RAD_S as f32,
-        ) {
+        let instant = match (&self.nav, &self.gnss, &self.attitude) {
+            (Some(nav), _, _) if self.update_mode != Mode::Stale => {
+                let dt_s = seconds_since(t_us, nav.time_us);
+                let state = nav.propagator.parts_at(dt_s);
+                let attitude = attitude_at(&nav.attitude, dt_s);
+                GENERAL_F32.instant_parts(
+                    state.position_m,
+                    state.velocity_mps,
+                    state.r2_minus_a2_m2,
+                    &attitude,
+                    EARTH_RATE_RAD_S as f32,
+                )
+            }
+            (None, Some(gnss), Some(attitude)) if self.update_mode != Mode::Stale => {
+                track::instant(
+                    gnss,
+                    attitude,
+                    seconds_since(t_us, gnss.fix_us),
+                    seconds_since(t_us, attitude.received.valid_us),
+                )
+            }
+            (None, None, _) | (None, _, None) => return,
+            _ => {
+                self.hold_planned();
+                return;
+            }
+        };
+        let instant = match instant {
             Ok(i) => i,
             Err(e) => {
                 self.reject(Fault::from(e));
@@ -254,6 +261,19 @@ impl Controller {
             held: false,
         })
     }
+}
+
+/// The time from `t0_us` to `t_us` (s). Both are < 2^53 us and, where it is used,
+/// t - t0 lies within an update period before and a staleness limit after: the
+/// difference is exact in i64 and small in f32. Converted from i32 when it fits (one
+/// instruction; from i64 it is a software call), to the same f32.
+#[inline(always)]
+fn seconds_since(t_us: u64, t0_us: u64) -> f32 {
+    let dt_us = (t_us as i64).wrapping_sub(t0_us as i64);
+    (match i32::try_from(dt_us) {
+        Ok(dt) => dt as f32,
+        Err(_) => i64_to_f32(dt_us),
+    }) * 1e-6
 }
 
 /// `x as f32` out of line: inline, LLVM evaluated it (a software call) beside the

@@ -10,6 +10,7 @@
 
 use std::convert::Infallible;
 
+use controller::bus::{encode_time_scales, Gnss, StarAttitude};
 use controller::config::MAX_TIME_TAG_US;
 use controller::frame::{
     encode, kind, Decoder, Event, FrameError, HEADER_LEN, MAX_FRAME, MAX_PAYLOAD, SYNC, VERSION,
@@ -72,13 +73,23 @@ pub enum Action {
     /// A TERRAIN frame, in the window: heights for the scene in force, valid or with
     /// one defect (a NaN, a height out of range, the wrong count).
     Terrain { dt_us: u64, what: u8, x: u64 },
+    /// A bus frame (GNSS, ATTITUDE, TIME_SCALES), in the window, whose content is
+    /// refused with one of the bus's faults.
+    BadBus { dt_us: u64, what: u8 },
 }
 
 /// Kinds the camera takes (and END, which ends a run): anything else is unknown.
 fn is_known_kind(k: u8) -> bool {
     matches!(
         k,
-        kind::NAV | kind::SCENE | kind::TERRAIN | kind::TIME | kind::END
+        kind::NAV
+            | kind::SCENE
+            | kind::TERRAIN
+            | kind::TIME
+            | kind::END
+            | kind::GNSS
+            | kind::ATTITUDE
+            | kind::TIME_SCALES
     )
 }
 
@@ -95,7 +106,7 @@ impl Action {
                 1 + (x >> 3) % 60_000
             }
         };
-        match sel % 32 {
+        match sel % 34 {
             0..=7 => Action::Nav {
                 dt_us: dt(a),
                 u_rad: frac(b) * core::f64::consts::TAU,
@@ -152,10 +163,14 @@ impl Action {
                 len: (a % 1000) as u16,
                 seed: b,
             },
-            _ => Action::Terrain {
+            31 => Action::Terrain {
                 dt_us: dt(a),
                 what: b as u8,
                 x: c,
+            },
+            _ => Action::BadBus {
+                dt_us: dt(a),
+                what: b as u8,
             },
         }
     }
@@ -283,6 +298,116 @@ fn state(i: f64, u: f64, h: f64) -> StateVector {
     StateVector {
         position_m: core::array::from_fn(|k| a * (cu * p[k] + su * q[k])),
         velocity_mps: core::array::from_fn(|k| speed * (-su * p[k] + cu * q[k])),
+    }
+}
+
+/// A bus frame's kind and payload, tagged `t_us`, that the controller must refuse,
+/// and its fault (docs/telemetry.md, "The bus's frames").
+fn bad_bus_payload(t_us: u64, what: u8) -> (u8, Vec<u8>, Fault) {
+    let sv = state(1.7, 0.3, 645e3);
+    let gnss = Gnss {
+        fix_us: t_us,
+        position_m: sv.position_m,
+        velocity_mps: sv.velocity_mps,
+    };
+    let attitude = StarAttitude {
+        valid_us: t_us,
+        q: [0.6, 0.0, 0.8, 0.0],
+        body_rate_rad_s: [0.0; 3],
+    };
+    let mut p = [0u8; 64];
+    let gnss_bytes = |g: Gnss, p: &mut [u8; 64]| {
+        let n = g.encode(p).unwrap();
+        p[..n].to_vec()
+    };
+    let att_bytes = |a: StarAttitude, p: &mut [u8; 64]| {
+        let n = a.encode(p).unwrap();
+        p[..n].to_vec()
+    };
+    let scales = |leap: i16, dut1: f32, p: &mut [u8; 64]| {
+        let n = encode_time_scales(leap, dut1, p).unwrap();
+        p[..n].to_vec()
+    };
+    match what % 10 {
+        0 => {
+            let a = StarAttitude {
+                q: [0.6, 0.0, 0.8, 0.05],
+                ..attitude
+            };
+            (kind::ATTITUDE, att_bytes(a, &mut p), Fault::BadQuaternion)
+        }
+        1 => {
+            let a = StarAttitude {
+                valid_us: t_us + 1,
+                ..attitude
+            };
+            (kind::ATTITUDE, att_bytes(a, &mut p), Fault::FixTime)
+        }
+        2 => {
+            let g = Gnss {
+                fix_us: t_us + 1,
+                ..gnss
+            };
+            (kind::GNSS, gnss_bytes(g, &mut p), Fault::FixTime)
+        }
+        3 => {
+            let g = Gnss {
+                fix_us: t_us.saturating_sub(2_000_001),
+                ..gnss
+            };
+            let f = if t_us >= 2_000_001 {
+                Fault::FixTime
+            } else {
+                Fault::OutOfRange
+            };
+            // Near the clock's start the fix cannot be too old: an orbit below the band
+            // instead.
+            let g = if t_us >= 2_000_001 {
+                g
+            } else {
+                Gnss {
+                    position_m: gnss.position_m.map(|x| x * 0.9),
+                    ..gnss
+                }
+            };
+            (kind::GNSS, gnss_bytes(g, &mut p), f)
+        }
+        4 => (
+            kind::TIME_SCALES,
+            scales(61, 0.0, &mut p),
+            Fault::TimeScales,
+        ),
+        5 => (
+            kind::TIME_SCALES,
+            scales(18, -0.95, &mut p),
+            Fault::TimeScales,
+        ),
+        6 => (
+            kind::TIME_SCALES,
+            scales(18, f32::NAN, &mut p),
+            Fault::NonFinite,
+        ),
+        7 => {
+            let mut g = gnss;
+            g.velocity_mps[2] = f64::INFINITY;
+            (kind::GNSS, gnss_bytes(g, &mut p), Fault::NonFinite)
+        }
+        8 => {
+            let a = StarAttitude {
+                body_rate_rad_s: [0.0, 1.0, 0.0],
+                ..attitude
+            };
+            (
+                kind::ATTITUDE,
+                att_bytes(a, &mut p),
+                Fault::AttitudeOutsideModel,
+            )
+        }
+        _ => {
+            let mut b = att_bytes(attitude, &mut p);
+            b.pop();
+            (kind::ATTITUDE, b, Fault::BadLength)
+        }
     }
 }
 
@@ -647,6 +772,9 @@ impl Harness {
             Fault::AttitudeOutsideModel,
             Fault::InvalidScene,
             Fault::TimeJump,
+            Fault::BadQuaternion,
+            Fault::FixTime,
+            Fault::TimeScales,
         ]
         .iter()
         .map(|&f| c.counters.get(f))
@@ -730,6 +858,11 @@ impl Harness {
                 self.one_frame(kind::NAV, now + dt_us, &nav_payload(sv, att), Err(f), None);
             }
             Action::Time { dt_us } => self.one_frame(kind::TIME, now + dt_us, &[], Ok(()), None),
+            Action::BadBus { dt_us, what } => {
+                let t = now + dt_us;
+                let (k, payload, f) = bad_bus_payload(t, what);
+                self.one_frame(k, t, &payload, Err(f), None);
+            }
             Action::Terrain { dt_us, what, x } => {
                 let count = self.session.controller.scene().count;
                 let mut t = Terrain {

@@ -20,7 +20,7 @@ use core_math::sphere::{
 use core_math::{Backend, Camera, EarthReference, Model, GENERAL_F32, GENERAL_F64};
 use cortex_m_rt::entry;
 use firmware::platform;
-use firmware::synthetic::{controller_with_nav, NoRegisters};
+use firmware::synthetic::{controller_with_bus, controller_with_nav, NoRegisters, BUS_EPOCH_US};
 use firmware::FirmwareError;
 
 use controller::{Config, Controller};
@@ -237,6 +237,16 @@ fn scene_kinds() -> Result<(), FirmwareError> {
         let mut c = controller_with_nav(scene, true, attitude)?;
         steady_update_region(everything, &mut c)?;
     }
+    // The same agile instant from the bus's frames (GNSS in the ITRF, a GCRF
+    // quaternion with body rates): the update carries both and turns them into the
+    // ITRF of its instant.
+    let mut c = controller_with_bus(all, agile)?;
+    update_region_at(
+        "bus frames (GNSS, ATTITUDE), scene roll and pitch up to 25 deg, all segments: planned",
+        &mut c,
+        BUS_EPOCH_US + 80_000,
+        BUS_EPOCH_US + 100_000,
+    )?;
     let mut c = controller_with_nav(all, false, agile)?;
     first_update_region(
         "scene roll and pitch up to 25 deg, the first update after NAV, all segments: planned",

@@ -10,8 +10,8 @@ use super::{ARCSEC_TO_RAD, TWO_PI};
 /// integer turns never enter.
 pub fn era00(ut1: &JulianDays) -> f64 {
     let tu = ut1.days();
-    let f = libm::fmod(ut1.whole_d, 1.0) + libm::fmod(ut1.frac_d, 1.0);
-    let theta = libm::fmod(
+    let f = super::fmod(ut1.whole_d, 1.0) + super::fmod(ut1.frac_d, 1.0);
+    let theta = super::fmod(
         TWO_PI * (f + 0.779_057_273_264_0 + 0.002_737_811_911_354_48 * tu),
         TWO_PI,
     );

@@ -111,7 +111,7 @@ pub const TERMS: [Term; 77] = [
 /// The five Delaunay arguments l, l', F, D, Om (rad) at `t` Julian centuries TT since
 /// J2000.0, linear in t (Simon et al. 1994), as `iauNut00b` computes them.
 pub fn delaunay(t: f64) -> [f64; 5] {
-    let arg = |c0: f64, c1: f64| libm::fmod(c0 + c1 * t, TURN_ARCSEC) * ARCSEC_TO_RAD;
+    let arg = |c0: f64, c1: f64| super::fmod(c0 + c1 * t, TURN_ARCSEC) * ARCSEC_TO_RAD;
     [
         // Mean anomaly of the Moon.
         arg(485_868.249_036, 1_717_915_923.217_8),
@@ -132,7 +132,7 @@ pub(crate) fn argument(n: &[i8; 5], fa: &[f64; 5]) -> f64 {
     for (k, x) in n.iter().zip(fa.iter()) {
         a += f64::from(*k) * x;
     }
-    libm::fmod(a, TWO_PI)
+    super::fmod(a, TWO_PI)
 }
 
 /// Nutation in longitude and obliquity (dpsi, deps) (rad), IAU 2000B, at `t` Julian

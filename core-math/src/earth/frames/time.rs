@@ -119,7 +119,7 @@ pub fn check_gps_s(gps_s: f64) -> Result<(), ModelError> {
 /// exactly into whole days and seconds of the day (fmod is exact, and so is the
 /// subtraction), so the offset and the half day move the small part only.
 fn split_days(gps_s: f64, offset_s: f64) -> JulianDays {
-    let sec_of_day = libm::fmod(gps_s, DAY_S);
+    let sec_of_day = super::fmod(gps_s, DAY_S);
     let whole = (gps_s - sec_of_day) / DAY_S;
     JulianDays {
         whole_d: whole - J2000_WHOLE_DAYS_FROM_GPS_EPOCH,
