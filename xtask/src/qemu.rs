@@ -32,7 +32,7 @@ pub use bench::{bench, measure as bench_counts, BenchArgs, BenchCounts};
 use board::Board;
 pub use board::{size, SizeArgs};
 pub use flash::{flash, FlashArgs};
-pub use pass::{e2e_test, reset_test, run, RunArgs};
+pub use pass::{e2e_test, run, RunArgs};
 pub use runner::qemu;
 pub use tools::{ensure_rust_target, ensure_target_tools};
 
@@ -110,10 +110,9 @@ pub fn test_target() -> Result<()> {
         e2e_test(board)?;
     }
     faults::faults_test(Board::Mps2An386)?;
-    // On the mps2-an386 only: QEMU's STM32F405 USART drops the bytes that arrive while
-    // the firmware boots, so what the firmware lost there cannot be told from the
-    // outside (docs/target.md, "Faults and resets").
-    reset_test(Board::Mps2An386)?;
+    // No reset test yet (`cargo xtask run --reset-at`): which frames a reset loses (those in the receive queue
+    // and on the wire) depends on timing, and the check does not yet know which, so its
+    // verdict is not repeatable (docs/target.md, "Faults and resets").
     eprintln!(
         "xtask: target checks passed on {} in {:.1} s",
         board::names(),

@@ -175,25 +175,6 @@ pub fn e2e_test(board: Board) -> Result<()> {
     Ok(())
 }
 
-/// The reset test (`cargo xtask test`): the short pass with the firmware reset after
-/// its update at 30 s; the recovery checked against the run without the reset.
-pub fn reset_test(board: Board) -> Result<()> {
-    let started = Instant::now();
-    let pass = scenario::short_pass(Config::default().update_period_us)?;
-    let elf = build_firmware(board, "firmware", true, &[], &[])?;
-    let result = play(&elf, &pass, Some(RESET_TEST_AT_S))?;
-    result.finish()?;
-    eprintln!(
-        "xtask: reset test passed on {} in {:.1} s",
-        board.name(),
-        started.elapsed().as_secs_f64()
-    );
-    Ok(())
-}
-
-/// Where the reset test resets the firmware: in the roll slew of the short pass.
-const RESET_TEST_AT_S: f64 = 30.0;
-
 /// Everything a played pass gave, and the verdicts.
 struct Played {
     firmware: Downlink,
