@@ -43,6 +43,8 @@ pub mod accuracy;
 pub mod dual;
 pub mod earth;
 pub mod error;
+#[cfg(feature = "earth-fixed")]
+mod fixed_int;
 pub mod line_period;
 pub mod model;
 pub mod mtf;

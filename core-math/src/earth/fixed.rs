@@ -29,6 +29,7 @@ use ::fixed::types::I24F40;
 
 use crate::earth::{Attitude, Earth, EarthCamera, EarthGeometry, General, InertialGeometry};
 use crate::error::{ModelError, Param};
+use crate::fixed_int::{shr, RSQRT_SEED};
 use crate::model::{Backend, ImageMotion};
 use crate::real::Scalar;
 
@@ -367,20 +368,6 @@ fn times_focal(x: i64, px: &EarthFixedPixel) -> i64 {
     shr(top, px.shift)
 }
 
-/// Seeds r0 = 1/sqrt(f) in Q14 at the centres of the intervals [i/1024, (i+1)/1024)
-/// that split [1/4, 1): isqrt(2^39 / (2i + 1)) < 2^15 (relative error at most 2^-10).
-/// Built at compile time, integer only; entries below 256 are never read (f >= 1/4) and
-/// make the index a 10-bit field with no bounds check. 2 KiB of flash.
-const SEED: [u16; 1024] = {
-    let mut t = [0u16; 1024];
-    let mut i = 256;
-    while i < 1024 {
-        t[i] = ((1u64 << 39) / (2 * i as u64 + 1)).isqrt() as u16;
-        i += 1;
-    }
-    t
-};
-
 /// sqrt(x) to within 2 units, integer only, no division (core's `isqrt` divides, which
 /// is a `__aeabi_uldivmod` call on a 32-bit core). The scheme of the round Earth's
 /// per-pixel root (`docs/fixed-point.md`): normalise x by an even shift z to
@@ -395,7 +382,7 @@ fn sqrt_u64(x: u64) -> u64 {
     let z = x.leading_zeros() & !1;
     let xn = x << z;
     let f = (xn >> 32) as u32; // [2^30, 2^32)
-    let r0 = SEED[(f >> 22) as usize & 1023] as u32; // Q14
+    let r0 = RSQRT_SEED[(f >> 22) as usize & 1023] as u32; // Q14
     let u = (3 << 28) - ((f as u64 * (r0 * r0) as u64) >> 32) as u32; // 3 - f r0^2, Q28
     let r1 = ((r0 as u64 * u as u64) >> 14) as u32; // Q29, < 2^30.1
     let s = ((f as u64 * r1 as u64) >> 30) as u32; // Q31
@@ -403,17 +390,6 @@ fn sqrt_u64(x: u64) -> u64 {
     let corr = (r1 as i64 * (d >> 16)) >> 45; // r1 d / 2, Q31
     let y = (s as i64 + corr) as u64; // Q31, <= 2^31 + 1
     (y << 1) >> (z >> 1)
-}
-
-/// x >> sh (arithmetic) for sh in 1..=31, in 32-bit halves: the compiler cannot know
-/// that the shift is below 32 and would otherwise emit the general 64-bit sequence.
-#[inline(always)]
-fn shr(x: i64, sh: u32) -> i64 {
-    debug_assert!((1..32).contains(&sh));
-    let lo = x as u32;
-    let hi = (x >> 32) as i32;
-    let lo = (lo >> (sh & 31)) | ((hi as u32) << ((32 - sh) & 31));
-    (((hi >> (sh & 31)) as i64) << 32) | lo as i64
 }
 
 #[cfg(test)]

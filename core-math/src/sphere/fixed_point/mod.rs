@@ -31,6 +31,7 @@ mod turns;
 use fixed::types::{I0F32, I1F31, I24F40, I2F30, I3F61, I7F25};
 
 use crate::error::{ModelError, Param};
+use crate::fixed_int::shr;
 use crate::model::{Backend, Camera, ImageMotion};
 use crate::real::Scalar;
 use crate::sphere::{Geometry, Sphere};
@@ -386,17 +387,6 @@ fn near_limb_q(u: &UpdateConst, p: &PixelConst, toward_left: bool) -> Result<u32
     }
     // 2 - m in Q31 as 2^32 - 1 - m/2^8: off by 2^-31 of 2, a relative 2^-32.
     Ok(sqrt::q_from_m(m39, !(m39 >> 8), 4))
-}
-
-/// x >> sh (arithmetic) for sh in 1..=31, in 32-bit halves: the compiler cannot know
-/// that the shift is below 32 and would otherwise emit the general 64-bit sequence.
-#[inline(always)]
-fn shr(x: i64, sh: u32) -> i64 {
-    debug_assert!((1..32).contains(&sh));
-    let lo = x as u32;
-    let hi = (x >> 32) as i32;
-    let lo = (lo >> (sh & 31)) | ((hi as u32) << ((32 - sh) & 31));
-    (((hi >> (sh & 31)) as i64) << 32) | lo as i64
 }
 
 #[cfg(test)]

@@ -2,21 +2,7 @@
 //! table, one Newton step for the reciprocal square root and one coupled (Heron)
 //! correction, 32x32 -> 64 multiplies only. No division, no 64-bit variable shift.
 
-/// Seeds r0 = 1/sqrt(f) in Q14 at the centres of the intervals [i/1024, (i+1)/1024),
-/// i in 128..1024, that split [1/8, 1): isqrt(2^39 / (2i + 1)) =
-/// floor(2^14 sqrt(1024 / (i + 1/2))) < 46 251. Relative error of a seed: at most
-/// 2^-11 / (2 f) <= 2^-9. Built at compile time, integer only. Entries 0..128 are never
-/// read (f >= 1/8 by construction); they make the index a 10-bit field with no bounds
-/// check. 2 KiB of flash.
-const SEED: [u16; 1024] = {
-    let mut t = [0u16; 1024];
-    let mut i = 128;
-    while i < 1024 {
-        t[i] = ((1u64 << 39) / (2 * i as u64 + 1)).isqrt() as u16;
-        i += 1;
-    }
-    t
-};
+use crate::fixed_int::RSQRT_SEED;
 
 /// High word of a 32x32 -> 64 product.
 #[inline(always)]
@@ -40,7 +26,7 @@ pub(crate) fn q_from_m(mq: u32, t: u32, extra: u32) -> u32 {
     let mz = mq << z;
     let x = mz as u64 * t as u64; // q^2 2^(z - 2), Q64
     let f = (x >> 32) as u32; // Q32, in [2^29, 2^32)
-    let r0 = SEED[(f >> 22) as usize & 1023] as u32; // Q14
+    let r0 = RSQRT_SEED[(f >> 22) as usize & 1023] as u32; // Q14
     let u = (3 << 28) - mulhi(f, r0 * r0); // 3 - f r0^2, Q28 (about 2^29)
     let r1 = ((r0 as u64 * u as u64) >> 14) as u32; // Q29, < 2^30.5
     let s = ((f as u64 * r1 as u64) >> 30) as u32; // Q31, about sqrt(f)
