@@ -76,6 +76,9 @@ struct FirstWrite<'a, S, C> {
 
 impl<S: LinePeriodSink, C: Monotonic> LinePeriodSink for FirstWrite<'_, S, C> {
     type Error = S::Error;
+    // Not inlined: its first instruction marks where the first period after a reset is
+    // written, for the instruction count of `cargo xtask run --reset-at`.
+    #[inline(never)]
     fn write_period(&mut self, index: u8, ticks: u32) -> Result<(), S::Error> {
         let written = self.sink.write_period(index, ticks);
         if written.is_ok() && self.at_us.is_none() {
@@ -87,6 +90,7 @@ impl<S: LinePeriodSink, C: Monotonic> LinePeriodSink for FirstWrite<'_, S, C> {
 
 #[entry]
 fn main() -> ! {
+    let painted = stack::paint_boot_window();
     let Parts {
         mut link,
         line_clock,
@@ -115,6 +119,7 @@ fn main() -> ! {
         Some(snapshot) => restore(session, snapshot, &mut clocks, &mut clock),
         None => Err(()),
     };
+    stack::paint_rest(painted);
     // The host's pass player starts sending when it reads this line (a link that is not
     // enabled yet may drop bytes): keep `telemetry::READY` in it.
     defmt::info!(
@@ -125,9 +130,10 @@ fn main() -> ! {
         board::LINK
     );
     defmt::info!(
-        "boot: reset cause {=str}, {=u32} resets since power-on",
+        "boot: reset cause {=str}, {=u32} resets since power-on, core clock {=u32} Hz",
         boot.cause.name(),
-        boot.resets
+        boot.resets,
+        core_clock_hz
     );
     // SysTick and the MPU are the core's: nothing else takes the core peripherals.
     let Some(mut core) = cortex_m::Peripherals::take() else {

@@ -1,11 +1,17 @@
 //! The stack: its high-water mark, and the guard that makes an overflow a fault.
 //!
-//! cortex-m-rt puts the stack at the top of RAM, growing down towards `.bss`. cortex-m-rt
-//! (feature `paint-stack`) paints the whole stack region, from `_stack_end` (the end of
-//! `.bss` and `.uninit`) up to `_stack_start` (the top of RAM), with
-//! [`STACK_PAINT_VALUE`] before `main` runs; the deepest word the stack has overwritten
+//! cortex-m-rt puts the stack at the top of RAM, growing down towards `.bss`. `main`
+//! paints the stack region below its frame, from `_stack_end` (the end of `.bss` and
+//! `.uninit`) up, with [`STACK_PAINT_VALUE`]; the deepest word the stack has overwritten
 //! since is the lowest one that no longer holds the paint. The firmware has no heap and a
 //! few bytes of static data, so this peak is its RAM use.
+//!
+//! The paint comes in two strokes: [`paint_boot_window`] first, the [`BOOT_WINDOW_BYTES`]
+//! below `main`'s frame, which the board's bring-up and a reset's restore run in; then,
+//! once the periods are back in the registers, [`paint_rest`], the region below. Painting
+//! the whole region before `main` (cortex-m-rt's `paint-stack`) would hold the periods
+//! back after a reset by its length: 4 MiB of stack on the mps2 (docs/target.md, "Faults
+//! and resets").
 //!
 //! The guard ([`guard`]) is an MPU region of [`GUARD_BYTES`] with no access at the
 //! bottom of the stack region, between the stack and `.bss`: a push that reaches it is a
@@ -19,7 +25,10 @@
 use core::sync::atomic::{AtomicUsize, Ordering};
 
 use cortex_m::peripheral::MPU;
-use cortex_m_rt::STACK_PAINT_VALUE;
+
+/// The paint: cortex-m-rt's value (its `paint-stack` feature, not used here, would write
+/// the same), unlikely as data and odd as an address.
+pub const STACK_PAINT_VALUE: u32 = 0xcccc_cccc;
 
 extern "C" {
     // Symbols of cortex-m-rt's link.x: only their addresses are used.
@@ -72,6 +81,43 @@ pub fn guard(mpu: &mut MPU) -> Option<core::ops::Range<usize>> {
     cortex_m::asm::isb();
     GUARD_TOP.store(top, Ordering::Relaxed);
     Some(base..top)
+}
+
+/// The stack the boot may use before [`paint_rest`]: the stack budget of the firmware
+/// (docs/target.md). A mark of this size or more says the boot went past it.
+pub const BOOT_WINDOW_BYTES: usize = 12 * 1024;
+
+/// Paints the [`BOOT_WINDOW_BYTES`] below the caller's frame (down to the region's
+/// bottom at most); returns the lowest address painted, for [`paint_rest`].
+#[inline(never)]
+pub fn paint_boot_window() -> usize {
+    let low = (&raw const _stack_end) as usize;
+    // The stack pointer as read here may be above this function's own frame (its
+    // prologue may come after the read): stop short of it by a margin.
+    let below_frame = (cortex_m::register::msp::read() as usize & !3).saturating_sub(256);
+    let from = below_frame.saturating_sub(BOOT_WINDOW_BYTES).max(low);
+    paint(from, below_frame);
+    from
+}
+
+/// Paints the stack region below `painted` (what [`paint_boot_window`] returned).
+#[inline(never)]
+pub fn paint_rest(painted: usize) {
+    let low = (&raw const _stack_end) as usize;
+    paint(low, painted);
+}
+
+/// Writes the paint over [from, to), word by word.
+fn paint(from: usize, to: usize) {
+    let mut p = from;
+    while p < to {
+        // SAFETY: [from, to) lies in the stack region (word-aligned: link.x asserts it)
+        // below the running frames: nothing lives there (ARMv7-M code keeps nothing
+        // below the stack pointer; an interrupt's frames there are gone by the time this
+        // loop runs again), and no guard is set up yet (`main` paints before `guard`).
+        unsafe { core::ptr::write_volatile(p as *mut u32, STACK_PAINT_VALUE) };
+        p += 4;
+    }
 }
 
 /// Bytes of stack used since reset: from the top of RAM down to the lowest word whose
