@@ -110,10 +110,6 @@ pub fn test_target() -> Result<()> {
         e2e_test(board)?;
     }
     faults::faults_test(Board::Mps2An386)?;
-    // No reset test yet (`cargo xtask run --reset-at`): which frames a reset loses
-    // (those in the receive queue and on the wire) depends on timing, and the check
-    // does not yet know which, so its verdict is not repeatable (docs/target.md,
-    // "Faults and resets").
     eprintln!(
         "xtask: target checks passed on {} in {:.1} s",
         board::names(),

@@ -170,7 +170,7 @@ fn measure_on(board: Board, log_to_stderr: bool, profile: Option<usize>) -> Resu
 }
 
 /// Compiles the plugin next to the bench ELF (a few hundred ms with gcc).
-fn build_plugin(dir: &Path) -> Result<PathBuf> {
+pub(super) fn build_plugin(dir: &Path) -> Result<PathBuf> {
     let source = workspace_root().join(PLUGIN_SOURCE);
     let out = dir.join("libstopwatch.so");
     let status = Command::new("gcc")
@@ -193,16 +193,32 @@ fn build_plugin(dir: &Path) -> Result<PathBuf> {
 
 /// Addresses of the first instructions of the two markers (Thumb bit cleared).
 fn marker_addresses(elf: &Path) -> Result<(u64, u64)> {
+    Ok((
+        symbol_address(elf, |n| n == "bench_start")?,
+        symbol_address(elf, |n| n == "bench_stop")?,
+    ))
+}
+
+/// The address of the first instruction of the function whose (mangled) name `is`
+/// picks, Thumb bit cleared.
+pub(super) fn symbol_address(elf: &Path, is: impl Fn(&str) -> bool) -> Result<u64> {
     let bytes = std::fs::read(elf).with_context(|| format!("cannot read {}", elf.display()))?;
     let file =
         object::File::parse(&*bytes).with_context(|| format!("cannot parse {}", elf.display()))?;
-    let find = |name: &str| {
-        file.symbols()
-            .find(|s| s.name() == Ok(name))
-            .map(|s| s.address() & !1)
-            .with_context(|| format!("no symbol `{name}` in {}", elf.display()))
-    };
-    Ok((find("bench_start")?, find("bench_stop")?))
+    let found: Vec<u64> = file
+        .symbols()
+        .filter(|s| s.name().is_ok_and(&is))
+        .map(|s| s.address() & !1)
+        .collect();
+    match found.as_slice() {
+        [a] => Ok(*a),
+        [] => bail!("no such function in {}", elf.display()),
+        _ => bail!(
+            "{} functions of that name in {}",
+            found.len(),
+            elf.display()
+        ),
+    }
 }
 
 fn qemu_version() -> String {

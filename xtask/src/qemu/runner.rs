@@ -42,7 +42,7 @@ pub struct Options {
     /// Echo the decoded log to stderr instead of stdout (for commands whose stdout is
     /// data, e.g. `report --csv`).
     pub log_to_stderr: bool,
-    /// Told once, when the firmware logs [`LINK_READY`]: from then on its link takes
+    /// Told each time the firmware logs [`LINK_READY`]: from then on its link takes
     /// bytes (the STM32F405's USART drops what arrives before it is enabled).
     pub link_ready: Option<std::sync::mpsc::Sender<()>>,
 }
@@ -202,8 +202,9 @@ impl Printer<'_> {
             let _ = out.flush();
         }
         if message.contains(LINK_READY) {
-            if let Some(ready) = self.link_ready.take() {
-                // The receiver may have given up already; nothing else to tell.
+            // Told at every boot (a reset brings the link up again); the receiver may
+            // have given up already, then nothing else is to be told.
+            if let Some(ready) = &self.link_ready {
                 let _ = ready.send(());
             }
         }

@@ -122,3 +122,68 @@ pub fn twin(bytes: &[u8]) -> Result<(Downlink, BTreeMap<u64, InForce>)> {
 /// EARTH_F32_REL_TOLERANCE is 2e-6 of |v1| at the envelope's worst conditioning; the
 /// issue's 1e-6 holds for the pass's conditions, and is what is checked.
 pub const F32_REL_TOLERANCE: f64 = 1e-6;
+
+/// The host's model of a reset between two frames: `prefix` through a session, then a
+/// core that comes up with `cause` (its `resets`-th since power-on), restores the
+/// snapshot the first session kept, and runs `suffix`. Returns the frames each part
+/// sent, as the firmware's downlink would carry them.
+pub fn reset_twin(
+    prefix: &[u8],
+    suffix: &[u8],
+    cause: controller::restart::ResetCause,
+    resets: u32,
+) -> Result<(Vec<u8>, Vec<u8>)> {
+    let (before, out_before) = host_run(prefix)?;
+    let mut snapshot = controller::restart::Snapshot::EMPTY;
+    let kept = before.controller.snapshot_inputs(&mut snapshot)
+        && before.controller.snapshot_periods(&mut snapshot.periods);
+    if !kept {
+        return Err(anyhow!("the host run kept no snapshot before the reset"));
+    }
+    let mut c = Controller::blank(Config::default());
+    c.note_boot(cause, resets);
+    c.restore(&snapshot, &mut Accept)
+        .map_err(|f| anyhow!("the host run refused its own snapshot: {}", f.name()))?;
+    let mut after = Session::new(c);
+    let mut out_after = Vec::new();
+    after.feed(suffix, &mut Accept, |f| out_after.extend_from_slice(f));
+    Ok((out_before, out_after))
+}
+
+/// Where `uplink` may be cut between two frames at `at_us`: after the last whole frame
+/// tagged before it that comes before the first frame tagged within a second after it
+/// (a frame far ahead, such as an injected time jump, does not mark the instant). What
+/// follows the cut, noise included, belongs to the rest.
+pub fn cut_before(uplink: &[u8], at_us: u64) -> usize {
+    let mut decoder = Decoder::new();
+    let mut cut = 0;
+    for (i, &b) in uplink.iter().enumerate() {
+        let mut tag = None;
+        decoder.feed(&[b], |e| {
+            if let Event::Frame(f) = e {
+                tag = Some(f.time_us);
+            }
+        });
+        match tag {
+            Some(t) if (at_us..at_us.saturating_add(1_000_000)).contains(&t) => break,
+            Some(t) if t < at_us => cut = i + 1,
+            _ => {}
+        }
+    }
+    cut
+}
+
+/// A session after power-on fed `bytes`, and the frames it sent.
+pub fn host_run(bytes: &[u8]) -> Result<(Session, Vec<u8>)> {
+    let mut session = Session::new(new_controller()?);
+    let mut out = Vec::new();
+    session.feed(bytes, &mut Accept, |f| out.extend_from_slice(f));
+    Ok((session, out))
+}
+
+/// How many whole frames `bytes` holds.
+pub fn frame_count(bytes: &[u8]) -> usize {
+    let mut n = 0;
+    Decoder::new().feed(bytes, |e| n += usize::from(matches!(e, Event::Frame(_))));
+    n
+}

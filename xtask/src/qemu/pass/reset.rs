@@ -9,59 +9,135 @@ use std::collections::BTreeMap;
 use std::io::{BufRead, BufReader, Write};
 use std::os::unix::net::UnixStream;
 use std::path::{Path, PathBuf};
+use std::sync::mpsc::{channel, Receiver, Sender};
 
 use controller::frame::{kind, Decoder, Event};
 use controller::report::Periods;
 
-use super::check::Downlink;
+use super::check::{self, Downlink};
+use crate::qemu::{bench, tools};
 
-/// The reset to make: at which pass time, through which QMP socket.
+/// The reset to make: between two frames of the uplink, once the firmware has answered
+/// every frame before the cut, through QEMU's QMP socket.
 pub struct Trigger {
-    pub at_us: u64,
     pub qmp: PathBuf,
+    /// Uplink bytes sent before the reset; the rest follows once the firmware is up.
+    pub cut: usize,
+    /// Frames the firmware sends for those bytes (a host run of them says how many).
+    after_frames: usize,
     decoder: Decoder,
-    /// The time tag of the PERIODS frame after which the reset was asked for.
+    seen: usize,
+    last_periods_us: Option<u64>,
+    /// Told once the reset is made: the sender then waits for the link to come up.
+    made: Option<Sender<()>>,
+    /// The time tag of the last PERIODS frame before the reset.
     pub done_after_us: Option<u64>,
+    pub boot_count: BootCount,
 }
 
 impl Trigger {
-    pub fn new(at_s: f64, qmp: PathBuf) -> Trigger {
-        Trigger {
-            at_us: (at_s * 1e6).round() as u64,
-            qmp,
-            decoder: Decoder::new(),
-            done_after_us: None,
+    /// A reset after the frames of `uplink` tagged before `at_s`; the receiver hears
+    /// when it is made.
+    pub fn new(
+        at_s: f64,
+        qmp: PathBuf,
+        uplink: &[u8],
+        elf: &Path,
+    ) -> Result<(Trigger, Receiver<()>)> {
+        let cut = check::cut_before(uplink, (at_s * 1e6).round() as u64);
+        let (_, sent) = check::host_run(uplink.get(..cut).unwrap_or_default())?;
+        let after_frames = check::frame_count(&sent);
+        if after_frames == 0 {
+            bail!("--reset-at {at_s}: the firmware sends nothing before that instant");
         }
+        let (made, heard) = channel();
+        let trigger = Trigger {
+            qmp,
+            cut,
+            after_frames,
+            decoder: Decoder::new(),
+            seen: 0,
+            last_periods_us: None,
+            made: Some(made),
+            done_after_us: None,
+            boot_count: BootCount::new(elf)?,
+        };
+        Ok((trigger, heard))
     }
 
-    /// QEMU's arguments for the QMP socket.
+    /// QEMU's arguments: the QMP socket, the boot count's plugin.
     pub fn qemu_args(&self) -> Vec<String> {
         vec![
             "-qmp".into(),
             format!("unix:{},server=on,wait=off", self.qmp.display()),
+            "-plugin".into(),
+            self.boot_count.plugin_args.clone(),
         ]
     }
 
-    /// Watches the downlink: at the first PERIODS frame at or after the reset instant,
-    /// resets the machine.
+    /// Watches the downlink: once the firmware has sent every frame it owes the bytes
+    /// before the cut, resets the machine.
     pub fn watch(&mut self, bytes: &[u8]) -> Result<()> {
         if self.done_after_us.is_some() {
             return Ok(());
         }
-        let at_us = self.at_us;
-        let mut due = None;
+        let (seen, last) = (&mut self.seen, &mut self.last_periods_us);
         self.decoder.feed(bytes, |e| {
             if let Event::Frame(f) = e {
-                if f.kind == kind::PERIODS && f.time_us >= at_us && due.is_none() {
-                    due = Some(f.time_us);
+                *seen += 1;
+                if f.kind == kind::PERIODS {
+                    *last = Some(f.time_us);
                 }
             }
         });
-        if let Some(t_us) = due {
+        if self.seen >= self.after_frames {
             system_reset(&self.qmp)?;
-            self.done_after_us = Some(t_us);
+            self.done_after_us = Some(self.last_periods_us.unwrap_or(0));
+            if let Some(made) = self.made.take() {
+                // The sender may have stopped already; then nothing waits for this.
+                let _ = made.send(());
+            }
         }
         Ok(())
+    }
+}
+
+/// Counts, with the stopwatch plugin of `cargo xtask bench`, the guest instructions
+/// from the reset vector (`Reset`) to the first period the restore writes (the entry
+/// of the flight binary's `FirstWrite::write_period`).
+pub struct BootCount {
+    pub plugin_args: String,
+    out: PathBuf,
+}
+
+impl BootCount {
+    pub fn new(elf: &Path) -> Result<BootCount> {
+        if !tools::have("gcc") {
+            tools::apt_install(&["gcc", "libc6-dev"], "gcc (to build the QEMU plugin)")?;
+        }
+        let dir = elf.parent().context("the ELF has no folder")?;
+        let plugin = bench::build_plugin(dir)?;
+        let start = bench::symbol_address(elf, |n| n == "Reset").context("`Reset`")?;
+        let stop = bench::symbol_address(elf, |n| {
+            n.contains("FirstWrite") && n.contains("write_period")
+        })
+        .context("`FirstWrite::write_period`")?;
+        let out = dir.join("reset-boot-counts.txt");
+        let _ = std::fs::remove_file(&out);
+        Ok(BootCount {
+            plugin_args: format!(
+                "{},start={start:#x},stop={stop:#x},out={}",
+                plugin.display(),
+                out.display()
+            ),
+            out,
+        })
+    }
+
+    /// The count of the last reset that wrote a period (None: no restore wrote one).
+    pub fn read(&self) -> Option<u64> {
+        let text = std::fs::read_to_string(&self.out).ok()?;
+        text.lines().rev().find_map(|l| l.trim().parse().ok())
     }
 }
 
@@ -94,7 +170,8 @@ fn system_reset(path: &Path) -> Result<()> {
 }
 
 /// What the reset cost, from the firmware's downlink and log against the twin's
-/// downlink (the run without the reset).
+/// downlink (the run without the reset), and whether the firmware recovered as the
+/// host's model of the same reset does ([`check::reset_twin`]).
 pub struct Report {
     pub reset_after_us: u64,
     pub cause: String,
@@ -104,29 +181,50 @@ pub struct Report {
     /// Updates after `fresh_at_us` whose PERIODS differ from the twin's.
     pub changed: usize,
     pub examples: Vec<String>,
+    /// PERIODS and STATUS frames compared with the host's model of the reset.
+    pub modelled: (usize, usize),
+    /// Where the firmware and the host's model of the reset part.
+    pub unlike_model: Vec<String>,
+    /// Guest instructions from the reset vector to the first period written.
+    pub boot_instructions: Option<u64>,
+    /// The core's clock, from the firmware's boot line.
+    pub core_clock_hz: Option<f64>,
 }
 
 impl Report {
+    /// `uplink` was cut at `cut` for the reset.
     pub fn new(
         reset_after_us: u64,
         firmware: &Downlink,
         twin: &Downlink,
         log: &[String],
-    ) -> Report {
+        uplink: &[u8],
+        cut: usize,
+        boot_instructions: Option<u64>,
+    ) -> Result<Report> {
         // The first STATUS of the firmware after its reset (resets since power-on > 0).
-        let cause = firmware
+        let boot = firmware
             .status
             .iter()
             .find(|(t, s)| *t > reset_after_us && s.resets > 0)
-            .and_then(|(_, s)| Some((s.reset_cause?, s.resets)))
-            .map_or("no STATUS reports it".into(), |(c, n)| {
-                format!("{}, {n} since power-on", c.name())
-            });
+            .and_then(|(_, s)| Some((s.reset_cause?, s.resets)));
+        let cause = boot.map_or("no STATUS reports it".into(), |(c, n)| {
+            format!("{}, {n} since power-on", c.name())
+        });
         // "restored after the reset: N periods programmed D us after the board came up"
         let restored_us = log.iter().find_map(|m| {
             let rest = m.strip_prefix("restored after the reset: ")?;
             let (_, after) = rest.split_once("programmed ")?;
             after.split_once(" us")?.0.trim().parse().ok()
+        });
+        // "boot: reset cause C, N resets since power-on, core clock F Hz"
+        let core_clock_hz: Option<f64> = log.iter().rev().find_map(|m| {
+            let rest = m.strip_prefix("boot: ")?;
+            rest.split_once("core clock ")?
+                .1
+                .strip_suffix(" Hz")?
+                .parse()
+                .ok()
         });
         let decoded = firmware.decoded();
         let fresh_at_us = decoded
@@ -152,20 +250,65 @@ impl Report {
                 }
             }
         }
-        Report {
+        let mut unlike_model = Vec::new();
+        let mut modelled = (0, 0);
+        match boot {
+            None => unlike_model.push("no STATUS after the reset: nothing to model".into()),
+            Some((cause, resets)) => {
+                let (before, rest) = uplink.split_at(cut.min(uplink.len()));
+                let (mut sent, after) = check::reset_twin(before, rest, cause, u32::from(resets))?;
+                sent.extend_from_slice(&after);
+                let model = Downlink::decode(&sent);
+                modelled = (model.periods.len(), model.status.len());
+                if let Some(k) = (0..firmware.periods.len().max(model.periods.len()))
+                    .find(|&k| firmware.periods.get(k) != model.periods.get(k))
+                {
+                    let at = |d: &Downlink| {
+                        d.periods
+                            .get(k)
+                            .map_or("none".into(), |(t, _)| format!("{:.3} s", *t as f64 * 1e-6))
+                    };
+                    unlike_model.push(format!(
+                        "PERIODS frame {k} ({} in the firmware, {} in the host's model of the reset) differs",
+                        at(firmware),
+                        at(&model)
+                    ));
+                }
+                if firmware.status != model.status {
+                    unlike_model.push(format!(
+                        "the STATUS frames differ from the host's model of the reset ({} vs {})",
+                        firmware.status.len(),
+                        model.status.len()
+                    ));
+                }
+            }
+        }
+        Ok(Report {
             reset_after_us,
             cause,
             restored_us,
             fresh_at_us,
             changed,
             examples,
-        }
+            modelled,
+            unlike_model,
+            boot_instructions,
+            core_clock_hz,
+        })
     }
 
     pub fn print(&self) {
-        let restored = self.restored_us.map_or("not restored".into(), |d| {
-            format!("periods restored after {d} us")
-        });
+        // The time is that of the instructions at one a cycle, the core's clock
+        // rate: QEMU counts instructions exactly, not cycles (docs/target.md).
+        let restored = match (self.restored_us, self.boot_instructions, self.core_clock_hz) {
+            (None, ..) => "not restored".into(),
+            (Some(_), Some(n), Some(hz)) => format!(
+                "periods restored after {:.0} us ({n} instructions from the reset vector at {:.0} MHz)",
+                n as f64 / hz * 1e6,
+                hz * 1e-6
+            ),
+            (Some(d), ..) => format!("periods restored after {d} us of QEMU's host time"),
+        };
         let fresh = self.fresh_at_us.map_or("never fresh again".into(), |t| {
             format!("held until fresh telemetry at {:.2} s", t as f64 * 1e-6)
         });
@@ -174,6 +317,15 @@ impl Report {
             self.reset_after_us as f64 * 1e-6,
             self.cause,
             self.changed
+        );
+        let (periods, status) = self.modelled;
+        let verdict = if self.unlike_model.is_empty() {
+            "equal"
+        } else {
+            "differ from"
+        };
+        println!(
+            "reset model: the firmware's frames {verdict} the host's run of the same reset between the same frames ({periods} PERIODS, {status} STATUS)"
         );
     }
 
@@ -186,6 +338,7 @@ impl Report {
             p.push("no fresh update after the reset".into());
         }
         p.extend(self.examples.iter().cloned());
+        p.extend(self.unlike_model.iter().cloned());
         p
     }
 }
