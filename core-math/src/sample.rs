@@ -119,6 +119,59 @@ impl SplitMix64 {
 }
 
 impl SplitMix64 {
+    /// One draw of the general model's envelope (issue 11) as `cargo xtask ellipsoid` and
+    /// the two-route test sample it: WGS 84, altitude 200-2000 km above the ellipsoid's
+    /// geocentric radius under the satellite, eccentricity 0-0.05 at any true anomaly (so
+    /// any argument of perigee), inclination 0-180 deg with one draw in eight each exactly
+    /// equatorial, polar and retrograde equatorial (and one polar draw in four exactly
+    /// over a pole), the attitude of [`SplitMix64::earth_attitude`], ground height -500 to
+    /// 9000 m, focal length 0.3-1.5 m, pixel 5-20 um, p1 within +/-0.05 m, field angle
+    /// within +/-40 deg. Unlike [`SplitMix64::earth_case`] it never moves a case toward
+    /// the limb.
+    pub fn envelope_case(&mut self) -> EarthCase {
+        let camera = EarthCamera {
+            focal_m: self.uniform(0.3, 1.5),
+            pixel_m: self.uniform(5e-6, 20e-6),
+            p1_m: self.uniform(-0.05, 0.05),
+        };
+        let deg = f64::to_radians;
+        let incl = match self.next_u64() % 8 {
+            0 => 0.0,
+            1 => 90.0,
+            2 => 180.0,
+            _ => self.uniform(0.0, 180.0),
+        };
+        let mut arg_lat = self.uniform(0.0, 360.0);
+        if incl == 90.0 && self.next_u64().is_multiple_of(4) {
+            arg_lat = if self.next_u64().is_multiple_of(2) {
+                90.0
+            } else {
+                270.0
+            };
+        }
+        let (incl, arg_lat) = (deg(incl), deg(arg_lat));
+        let raan = deg(self.uniform(0.0, 360.0));
+        let e = self.uniform(0.0, 0.05);
+        let nu = deg(self.uniform(0.0, 360.0));
+        let lat = libm::asin(libm::sin(incl) * libm::sin(arg_lat));
+        let r = Ellipsoid::WGS84.geocentric_radius_m(lat) + self.uniform(200e3, 2000e3);
+        let state = eccentric_state(r, e, nu, incl, raan, arg_lat);
+        let attitude = self.earth_attitude();
+        let geometry = EarthGeometry {
+            state,
+            attitude,
+            ground_h_m: self.uniform(-500.0, 9000.0),
+            ellipsoid: Ellipsoid::WGS84,
+            earth_rate_rad_s: crate::EARTH_RATE_RAD_S,
+        };
+        let n_px = libm::tan(deg(self.uniform(-40.0, 40.0))) * camera.focal_m / camera.pixel_m;
+        EarthCase {
+            camera,
+            geometry,
+            n_px,
+        }
+    }
+
     /// An attitude of the real-Earth envelope: roll and pitch within +/-45 deg, any yaw,
     /// each rate within +/-2 deg/s (drawn in that order).
     pub fn earth_attitude(&mut self) -> Attitude<f64> {

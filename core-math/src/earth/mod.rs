@@ -72,6 +72,14 @@ impl Ellipsoid {
     pub fn b_m(&self) -> f64 {
         self.a_m * (1.0 - self.flattening)
     }
+
+    /// Distance from the centre to the surface along a direction of geocentric latitude
+    /// `lat_rad`: a b / sqrt(b^2 cos^2 + a^2 sin^2).
+    pub fn geocentric_radius_m(&self, lat_rad: f64) -> f64 {
+        let (s, c) = libm::sincos(lat_rad);
+        let (a, b) = (self.a_m, self.b_m());
+        a * b / libm::sqrt((b * c) * (b * c) + (a * s) * (a * s))
+    }
 }
 
 /// The optics of the real-Earth model: focal length, pixel pitch, and the P1 position of
