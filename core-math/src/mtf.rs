@@ -163,7 +163,7 @@ fn sinc_root(level: f64) -> f64 {
     let (mut lo, mut hi) = (0.0_f64, PI);
     for _ in 0..80 {
         let mid = 0.5 * (lo + hi);
-        if libm::sin(mid) / mid >= level {
+        if crate::trig_f64::sin(mid) / mid >= level {
             lo = mid;
         } else {
             hi = mid;

@@ -142,7 +142,7 @@ pub fn nut00b(t: f64) -> (f64, f64) {
     let fa = delaunay(t);
     let (mut dp, mut de) = (0.0, 0.0);
     for (n, c) in TERMS.iter().rev() {
-        let (sarg, carg) = libm::sincos(argument(n, &fa));
+        let (sarg, carg) = crate::trig_f64::sin_cos(argument(n, &fa));
         dp += (c[0] + c[1] * t) * sarg + c[2] * carg;
         de += (c[3] + c[4] * t) * carg + c[5] * sarg;
     }
