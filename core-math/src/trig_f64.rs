@@ -133,6 +133,15 @@ fn rem_pio2(x: f64, ix: u32) -> (i32, f64, f64) {
     medium(x, ix)
 }
 
+/// x = n pi/2 + y0 + y1 with |y0| <= pi/4 for pi/4 < |x|, `ix` the high word of |x|;
+/// None from 2^20 pi/2 on, for infinities and NaN.
+fn reduce(x: f64, ix: u32) -> Option<(i32, f64, f64)> {
+    if ix >= 0x4139_21fb {
+        return None;
+    }
+    Some(rem_pio2(x, ix))
+}
+
 /// (sin x, cos x), bit for bit libm's `sincos` for |x| < [`SIN_COS_LIMIT_RAD`]; NaN
 /// beyond, for infinities and for NaN.
 pub fn sin_cos(x: f64) -> (f64, f64) {
@@ -144,11 +153,9 @@ pub fn sin_cos(x: f64) -> (f64, f64) {
         }
         return (k_sin(x, 0.0, 0), k_cos(x, 0.0));
     }
-    // 2^20 pi/2 and beyond, infinities, NaN.
-    if ix >= 0x4139_21fb {
+    let Some((n, y0, y1)) = reduce(x, ix) else {
         return (f64::NAN, f64::NAN);
-    }
-    let (n, y0, y1) = rem_pio2(x, ix);
+    };
     let (s, c) = (k_sin(y0, y1, 1), k_cos(y0, y1));
     match n & 3 {
         0 => (s, c),
@@ -158,12 +165,42 @@ pub fn sin_cos(x: f64) -> (f64, f64) {
     }
 }
 
-/// sin x: [`sin_cos`]'s sine.
+/// sin x alone (one kernel, as libm's `sin`): [`sin_cos`]'s sine bit for bit.
 pub fn sin(x: f64) -> f64 {
-    sin_cos(x).0
+    let ix = high_word(x) & 0x7fff_ffff;
+    if ix <= 0x3fe9_21fb {
+        if ix < 0x3e46_a09e {
+            return x;
+        }
+        return k_sin(x, 0.0, 0);
+    }
+    let Some((n, y0, y1)) = reduce(x, ix) else {
+        return f64::NAN;
+    };
+    match n & 3 {
+        0 => k_sin(y0, y1, 1),
+        1 => k_cos(y0, y1),
+        2 => -k_sin(y0, y1, 1),
+        _ => -k_cos(y0, y1),
+    }
 }
 
-/// cos x: [`sin_cos`]'s cosine.
+/// cos x alone (one kernel, as libm's `cos`): [`sin_cos`]'s cosine bit for bit.
 pub fn cos(x: f64) -> f64 {
-    sin_cos(x).1
+    let ix = high_word(x) & 0x7fff_ffff;
+    if ix <= 0x3fe9_21fb {
+        if ix < 0x3e46_a09e {
+            return 1.0;
+        }
+        return k_cos(x, 0.0);
+    }
+    let Some((n, y0, y1)) = reduce(x, ix) else {
+        return f64::NAN;
+    };
+    match n & 3 {
+        0 => k_cos(y0, y1),
+        1 => -k_sin(y0, y1, 1),
+        2 => -k_cos(y0, y1),
+        _ => k_sin(y0, y1, 1),
+    }
 }

@@ -113,6 +113,10 @@ fn f64_sin_cos_is_libm_bit_for_bit_below_the_limit() {
                 assert_eq!(trig_f64::cos(v).to_bits(), libm::cos(v).to_bits(), "{v:e}");
             } else if v.abs() >= 1_647_100.0 {
                 assert!(s.is_nan() && c.is_nan(), "{v:e}");
+                assert!(
+                    trig_f64::sin(v).is_nan() && trig_f64::cos(v).is_nan(),
+                    "{v:e}"
+                );
             }
         }
     }
@@ -120,6 +124,7 @@ fn f64_sin_cos_is_libm_bit_for_bit_below_the_limit() {
     for v in [f64::NAN, f64::INFINITY, -f64::INFINITY] {
         let (s, c) = trig_f64::sin_cos(v);
         assert!(s.is_nan() && c.is_nan());
+        assert!(trig_f64::sin(v).is_nan() && trig_f64::cos(v).is_nan());
     }
     assert_eq!(trig_f64::sin_cos(-0.0).0.to_bits(), (-0.0f64).to_bits());
 }

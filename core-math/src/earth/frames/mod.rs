@@ -52,6 +52,7 @@ pub const DAYS_PER_JULIAN_CENTURY: f64 = 36_525.0;
 /// step r - s with s <= r < 2 s is exact (Sterbenz), and so is every halving of s
 /// down to y. At most log2(x / y) + 1 steps (16 for the largest argument here,
 /// 43 825 days against 1 day).
+#[inline(never)]
 pub(crate) fn fmod(x: f64, y: f64) -> f64 {
     let mut r = libm::fabs(x);
     if !(r.is_finite() && y.is_finite() && y > 0.0) {
