@@ -8,8 +8,10 @@ pub type Mat3 = [[f64; 3]; 3];
 
 pub(crate) const IDENTITY: Mat3 = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
 
-/// a b.
-pub(crate) fn mul(a: &Mat3, b: &Mat3) -> Mat3 {
+/// a b: the one 3x3 product of the flight binary (the frames' rotations and the
+/// controller's attitude chain), kept out of line so that it stays one copy.
+#[inline(never)]
+pub fn mul(a: &Mat3, b: &Mat3) -> Mat3 {
     let col = |j: usize| [b[0][j], b[1][j], b[2][j]];
     let (c0, c1, c2) = (col(0), col(1), col(2));
     let row = |r: [f64; 3]| [dot(r, c0), dot(r, c1), dot(r, c2)];
