@@ -20,15 +20,17 @@
 pub const SIN_COS_LIMIT_RAD: f64 = 1_647_099.0;
 
 const TO_INT: f64 = 1.5 / f64::EPSILON;
-const INV_PIO2: f64 = 6.366_197_723_675_813_824_33e-1;
+// The constants by their bits, as fdlibm states them (its decimal forms carry more
+// digits than an f64 holds).
+const INV_PIO2: f64 = f64::from_bits(0x3FE4_5F30_6DC9_C883);
 // pi/2 in three parts with their tails (fdlibm's PIO2_1 .. PIO2_3T): k * PIO2_n exact
 // for the quadrant counts below 2^20.
-const PIO2_1: f64 = 1.570_796_326_734_125_614_17;
-const PIO2_1T: f64 = 6.077_100_506_506_192_249_32e-11;
-const PIO2_2: f64 = 6.077_100_506_303_965_976_60e-11;
-const PIO2_2T: f64 = 2.022_266_248_795_950_631_54e-21;
-const PIO2_3: f64 = 2.022_266_248_711_166_455_80e-21;
-const PIO2_3T: f64 = 8.478_427_660_368_899_569_97e-32;
+const PIO2_1: f64 = f64::from_bits(0x3FF9_21FB_5440_0000);
+const PIO2_1T: f64 = f64::from_bits(0x3DD0_B461_1A62_6331);
+const PIO2_2: f64 = f64::from_bits(0x3DD0_B461_1A60_0000);
+const PIO2_2T: f64 = f64::from_bits(0x3BA3_198A_2E03_7073);
+const PIO2_3: f64 = f64::from_bits(0x3BA3_198A_2E00_0000);
+const PIO2_3T: f64 = f64::from_bits(0x397B_839A_2520_49C1);
 
 fn high_word(x: f64) -> u32 {
     (x.to_bits() >> 32) as u32
@@ -36,12 +38,12 @@ fn high_word(x: f64) -> u32 {
 
 /// sin x on [-pi/4, pi/4], x + y the argument with y its tail (`iy` 0: y is zero).
 fn k_sin(x: f64, y: f64, iy: i32) -> f64 {
-    const S1: f64 = -1.666_666_666_666_663_243_48e-1;
-    const S2: f64 = 8.333_333_333_322_489_461_24e-3;
-    const S3: f64 = -1.984_126_982_985_794_931_34e-4;
-    const S4: f64 = 2.755_731_370_707_006_767_89e-6;
-    const S5: f64 = -2.505_076_025_340_686_341_95e-8;
-    const S6: f64 = 1.589_690_995_211_550_102_21e-10;
+    const S1: f64 = f64::from_bits(0xBFC5_5555_5555_5549);
+    const S2: f64 = f64::from_bits(0x3F81_1111_1110_F8A6);
+    const S3: f64 = f64::from_bits(0xBF2A_01A0_19C1_61D5);
+    const S4: f64 = f64::from_bits(0x3EC7_1DE3_57B1_FE7D);
+    const S5: f64 = f64::from_bits(0xBE5A_E5E6_8A2B_9CEB);
+    const S6: f64 = f64::from_bits(0x3DE5_D93A_5ACF_D57C);
     let z = x * x;
     let w = z * z;
     let r = S2 + z * (S3 + z * S4) + z * w * (S5 + z * S6);
@@ -55,12 +57,12 @@ fn k_sin(x: f64, y: f64, iy: i32) -> f64 {
 
 /// cos x on [-pi/4, pi/4], x + y the argument.
 fn k_cos(x: f64, y: f64) -> f64 {
-    const C1: f64 = 4.166_666_666_666_660_190_37e-2;
-    const C2: f64 = -1.388_888_888_887_410_957_49e-3;
-    const C3: f64 = 2.480_158_728_947_672_941_78e-5;
-    const C4: f64 = -2.755_731_435_139_066_330_35e-7;
-    const C5: f64 = 2.087_572_321_298_174_827_90e-9;
-    const C6: f64 = -1.135_964_755_778_819_482_65e-11;
+    const C1: f64 = f64::from_bits(0x3FA5_5555_5555_554C);
+    const C2: f64 = f64::from_bits(0xBF56_C16C_16C1_5177);
+    const C3: f64 = f64::from_bits(0x3EFA_01A0_19CB_1590);
+    const C4: f64 = f64::from_bits(0xBE92_7E4F_809C_52AD);
+    const C5: f64 = f64::from_bits(0x3E21_EE9E_BDB4_B1C4);
+    const C6: f64 = f64::from_bits(0xBDA8_FAE9_BE88_38D4);
     let z = x * x;
     let w = z * z;
     let r = z * (C1 + z * (C2 + z * C3)) + w * w * (C4 + z * (C5 + z * C6));
