@@ -245,7 +245,10 @@ impl Controller {
         }
         // Any yaw is allowed: wrapped once here (in f64: an f32 yaw of any size), the
         // per-update trigonometry then works near zero.
-        let yaw = libm::remainder(f64::from(nav.attitude.yaw_rad), 2.0 * core::f64::consts::PI);
+        let yaw = core_math::earth::frames::remainder(
+            f64::from(nav.attitude.yaw_rad),
+            2.0 * core::f64::consts::PI,
+        );
         Ok(NavState {
             time_us: frame.time_us,
             propagator: Propagator::new(&nav.state),

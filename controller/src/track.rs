@@ -17,7 +17,7 @@
 //! ERA's own rate differs from `w` by 1e-8 of it, 1.5e-12 rad). No trigonometry.
 
 use core_math::earth::bus::quaternion_matrix;
-use core_math::earth::frames::{CelestialPole, Mat3, TimeScales, POLE_MAX_AGE_S};
+use core_math::earth::frames::{mat_mul, CelestialPole, TimeScales, POLE_MAX_AGE_S};
 use core_math::earth::{GeneralInstant, InertialAttitude};
 use core_math::{ModelError, Param, StateVector, GENERAL_F32};
 
@@ -76,12 +76,6 @@ pub fn pole_for(
         Some(p) if libm::fabs(t_s - p.gps_s) <= POLE_MAX_AGE_S => Ok(*p),
         _ => CelestialPole::at(t_s, scales).map_err(|_| Fault::FixTime),
     }
-}
-
-fn mat_mul(a: &Mat3, b: &Mat3) -> Mat3 {
-    core::array::from_fn(|i| {
-        core::array::from_fn(|j| a[i][0] * b[0][j] + a[i][1] * b[1][j] + a[i][2] * b[2][j])
-    })
 }
 
 impl AttitudeState {

@@ -56,6 +56,7 @@ pub mod sample;
 pub mod sphere;
 mod sqrt;
 pub mod trig;
+pub mod trig_f64;
 pub mod vector;
 
 #[cfg(feature = "reference")]

@@ -163,7 +163,9 @@ fn sinc_root(level: f64) -> f64 {
     let (mut lo, mut hi) = (0.0_f64, PI);
     for _ in 0..80 {
         let mid = 0.5 * (lo + hi);
-        if libm::sin(mid) / mid >= level {
+        // `sin_cos`'s sine (the same value as `sin`): the flight binary links
+        // `sin_cos` anyway, and a second reduction and kernel would cost flash.
+        if crate::trig_f64::sin_cos(mid).0 / mid >= level {
             lo = mid;
         } else {
             hi = mid;

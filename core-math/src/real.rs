@@ -105,7 +105,7 @@ impl Real for f64 {
     }
     #[inline(always)]
     fn sin_cos(self) -> (Self, Self) {
-        libm::sincos(self)
+        crate::trig_f64::sin_cos(self)
     }
     #[inline(always)]
     fn is_finite(self) -> bool {

@@ -6,14 +6,15 @@
 //! k * part exact for |k| < 2^13, i.e. |x| < 12 800 rad), then the minimax polynomials
 //! of Cephes' `sinf`/`cosf` on [-pi/4, pi/4]. Measured error against f64 over
 //! |x| <= 100 rad: at most 1.54 ulp (`core-math/tests/trig.rs`). Larger arguments, which
-//! the model never produces, fall back to libm's f64 `sincos`, rounded.
+//! the model never produces, fall back to the f64 `sincos` of [`crate::trig_f64`],
+//! rounded (NaN from 2^20 pi/2 rad on).
 
 /// pi/2 = P1 + P2 + P3, P1 and P2 with trailing zero bits (Cephes' DP1..DP3, doubled).
 const P1: f32 = 1.570_312_5;
 const P2: f32 = 4.837_513e-4;
 const P3: f32 = 7.549_79e-8;
 const TWO_OVER_PI: f32 = core::f32::consts::FRAC_2_PI;
-/// Beyond this |x| the reduction is not exact: libm in f64 ([`sin_cos_huge`]).
+/// Beyond this |x| the reduction is not exact: f64 ([`sin_cos_huge`]).
 const FAST_LIMIT: f32 = 12_800.0;
 
 /// sin r and cos r for |r| <= pi/4 (Cephes coefficients).
@@ -67,7 +68,7 @@ pub fn sin_f32(x: f32) -> f32 {
 
 /// (sin x, cos x) in f32.
 ///
-/// Inlined, with libm's route for huge arguments kept out of line: as one function the
+/// Inlined, with the f64 route for huge arguments kept out of line: as one function the
 /// fallback's register saves made every call pay a prologue (`cargo xtask bench
 /// --profile` shows it).
 #[inline(always)]
@@ -86,13 +87,14 @@ pub fn sin_cos_f32(x: f32) -> (f32, f32) {
 }
 
 /// (sin x, cos x) for the arguments the reduction cannot take (|x| >= 12 800 rad, and
-/// NaN, infinities): libm's f64 `sincos` of the exact argument, rounded to f32. Not
+/// NaN, infinities): the f64 `sincos` of the exact argument, rounded to f32 (libm's
+/// bit for bit; NaN from 2^20 pi/2 rad on, [`crate::trig_f64`]). Not
 /// `sincosf`: its own reduction would add 3.2 KB of flash, and the f64 one is linked
 /// anyway (the planner's boot-time work). Within 0.5 ulp + 1 f64 ulp.
 #[cold]
 #[inline(never)]
 fn sin_cos_huge(x: f32) -> (f32, f32) {
-    let (s, c) = libm::sincos(f64::from(x));
+    let (s, c) = crate::trig_f64::sin_cos(f64::from(x));
     (s as f32, c as f32)
 }
 

@@ -1,6 +1,7 @@
-//! The f32 sine/cosine against f64 libm.
+//! The f32 sine/cosine against f64 libm, and the f64 sine/cosine against libm's.
 
 use core_math::trig::{atan_f32, sin_cos_f32};
+use core_math::trig_f64;
 
 fn ulp_err(got: f32, exact: f64) -> f64 {
     // Error in units of the f32 spacing at the exact value.
@@ -51,9 +52,9 @@ fn within_one_ulp_over_the_angles_the_model_uses() {
 #[test]
 fn large_and_special_arguments() {
     assert_eq!(sin_cos_f32(0.0), (0.0, 1.0));
-    // Beyond the fast range: libm's f64 sincos of the exact argument, rounded; that is
+    // Beyond the fast range: the f64 sincos of the exact argument, rounded; that is
     // sincosf's correctly rounded value here (and at every argument within 1 ulp).
-    for x in [1e5f32, -3.0e7, 1.7e38, 12_800.0] {
+    for x in [1e5f32, -1.6e6, 12_800.0] {
         let (s, c) = sin_cos_f32(x);
         let (s64, c64) = libm::sincos(f64::from(x));
         assert_eq!((s, c), (s64 as f32, c64 as f32), "{x}");
@@ -64,8 +65,68 @@ fn large_and_special_arguments() {
         );
     }
     assert_eq!(sin_cos_f32(1e5), libm::sincosf(1e5));
-    let (s, c) = sin_cos_f32(f32::NAN);
-    assert!(s.is_nan() && c.is_nan());
+    // Beyond 2^20 pi/2 rad the f64 reduction stops: NaN, as for NaN and infinities.
+    for x in [f32::NAN, f32::INFINITY, -3.0e7, 1.7e38, 1.648e6] {
+        let (s, c) = sin_cos_f32(x);
+        assert!(s.is_nan() && c.is_nan(), "{x}");
+    }
+}
+
+/// Every f64 argument from 1e-30 to past the limit, both signs, dense on a log scale and
+/// at the multiples of pi/4 where fdlibm's reduction changes case: `trig_f64` is libm's
+/// `sincos`, `sin` and `cos` bit for bit below [`trig_f64::SIN_COS_LIMIT_RAD`], NaN
+/// above.
+#[test]
+fn f64_sin_cos_is_libm_bit_for_bit_below_the_limit() {
+    let mut xs = Vec::new();
+    let mut x = 1e-30f64;
+    while x < 1e7 {
+        xs.push(x);
+        x = f64::from_bits(x.to_bits() + 0x0000_0a7f_0000_0001);
+    }
+    for k in 1..=40_000 {
+        let m = f64::from(k) * core::f64::consts::FRAC_PI_4;
+        for d in -3i64..=3 {
+            xs.push(f64::from_bits((m.to_bits() as i64 + d) as u64));
+        }
+    }
+    let mut seed = 0x9e37_79b9_7f4a_7c15u64;
+    for _ in 0..200_000 {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        xs.push((seed >> 11) as f64 / (1u64 << 53) as f64 * 30.0);
+    }
+    let mut below = 0;
+    for &x in &xs {
+        for v in [x, -x] {
+            let (s, c) = trig_f64::sin_cos(v);
+            if v.abs() < trig_f64::SIN_COS_LIMIT_RAD {
+                below += 1;
+                let (ls, lc) = libm::sincos(v);
+                assert_eq!(
+                    (s.to_bits(), c.to_bits()),
+                    (ls.to_bits(), lc.to_bits()),
+                    "{v:e}"
+                );
+                assert_eq!(trig_f64::sin(v).to_bits(), libm::sin(v).to_bits(), "{v:e}");
+                assert_eq!(trig_f64::cos(v).to_bits(), libm::cos(v).to_bits(), "{v:e}");
+            } else if v.abs() >= 1_647_100.0 {
+                assert!(s.is_nan() && c.is_nan(), "{v:e}");
+                assert!(
+                    trig_f64::sin(v).is_nan() && trig_f64::cos(v).is_nan(),
+                    "{v:e}"
+                );
+            }
+        }
+    }
+    assert!(below > 500_000, "{below}");
+    for v in [f64::NAN, f64::INFINITY, -f64::INFINITY] {
+        let (s, c) = trig_f64::sin_cos(v);
+        assert!(s.is_nan() && c.is_nan());
+        assert!(trig_f64::sin(v).is_nan() && trig_f64::cos(v).is_nan());
+    }
+    assert_eq!(trig_f64::sin_cos(-0.0).0.to_bits(), (-0.0f64).to_bits());
 }
 
 /// atan over every magnitude the drift tangent can take (10^-30 ... 10^30, dense near

@@ -46,6 +46,9 @@ const MAGIC: u32 = 0x5444_4952; // "TDIR"
 const VERSION: u32 = 2;
 
 impl Record {
+    // Out of line: the boot, the HardFault handler and the cause's note all seal or
+    // check the record.
+    #[inline(never)]
     fn crc(&self) -> u32 {
         let mut bytes = [0u8; 16];
         for (chunk, word) in
@@ -58,6 +61,8 @@ impl Record {
         u32::from(crc::crc16(&bytes))
     }
 
+    // Out of line, as `crc`: three callers.
+    #[inline(never)]
     fn checks_out(&self) -> bool {
         self.magic == MAGIC && self.version == VERSION && self.crc == self.crc()
     }
@@ -114,6 +119,9 @@ unsafe fn region() -> &'static mut Region {
     unsafe { &mut *core::ptr::addr_of_mut!(__sretained) }
 }
 
+// Out of line: `keep` and the boot's restore both check it, and flash is scarcer than
+// the cycles of a call.
+#[inline(never)]
 fn payload_crc(parts: &[&Payload]) -> u32 {
     let crc = parts.iter().fold(crc::INIT, |c, p| {
         let c = crc::update(c, &p.len.to_le_bytes());

@@ -46,14 +46,14 @@ pub struct Kepler {
 
 /// 1 - cos x without cancellation.
 fn one_minus_cos(x: f64) -> f64 {
-    let s = libm::sin(0.5 * x);
+    let s = crate::trig_f64::sin(0.5 * x);
     2.0 * s * s
 }
 
 /// x - sin x without cancellation (series below 0.5, where it converges fast).
 fn x_minus_sin(x: f64) -> f64 {
     if libm::fabs(x) >= 0.5 {
-        return x - libm::sin(x);
+        return x - crate::trig_f64::sin(x);
     }
     // x^3/3! - x^5/5! + ...
     let x2 = x * x;
@@ -105,8 +105,9 @@ impl Kepler {
         let m = self.n * dt_s;
         let mut x = m;
         for _ in 0..30 {
-            let f = x + self.e_sin * one_minus_cos(x) - self.e_cos * libm::sin(x) - m;
-            let df = 1.0 + self.e_sin * libm::sin(x) - self.e_cos * libm::cos(x);
+            let f = x + self.e_sin * one_minus_cos(x) - self.e_cos * crate::trig_f64::sin(x) - m;
+            let df =
+                1.0 + self.e_sin * crate::trig_f64::sin(x) - self.e_cos * crate::trig_f64::cos(x);
             let step = f / df;
             x -= step;
             // Quadratic convergence: the error left is ~ e step^2 / |x|, below 1e-20 of
@@ -122,11 +123,11 @@ impl Kepler {
     pub fn at(&self, dt_s: f64) -> (V3, V3) {
         let de = self.delta_e(dt_s);
         let omc = one_minus_cos(de);
-        let sin_de = libm::sin(de);
+        let sin_de = crate::trig_f64::sin(de);
         let f_m1 = -self.a / self.r0n * omc;
         let g = dt_s - x_minus_sin(de) / self.n;
         // r(t) = a (1 - e cos E): a - (a - r0) cos dE + sigma0 sqrt(a) sin dE.
-        let r = self.a * (1.0 - self.e_cos * libm::cos(de) + self.e_sin * sin_de);
+        let r = self.a * (1.0 - self.e_cos * crate::trig_f64::cos(de) + self.e_sin * sin_de);
         let fdot = -libm::sqrt(self.gm * self.a) * sin_de / (r * self.r0n);
         let gdot = 1.0 - self.a / r * omc;
         let dr = core::array::from_fn(|k| f_m1 * self.r0[k] + g * self.v0[k]);

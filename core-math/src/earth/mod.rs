@@ -296,9 +296,9 @@ impl EarthGeometry<f64> {
         let y_l = unit(cross(r, v));
         let x_l = cross(y_l, z_l);
         let at = &self.attitude;
-        let (sp, cp) = libm::sincos(at.roll_rad);
-        let (st, ct) = libm::sincos(at.pitch_rad);
-        let (sy, cy) = libm::sincos(at.yaw_rad);
+        let (sp, cp) = crate::trig_f64::sin_cos(at.roll_rad);
+        let (st, ct) = crate::trig_f64::sin_cos(at.pitch_rad);
+        let (sy, cy) = crate::trig_f64::sin_cos(at.yaw_rad);
         // A = Rx(roll) Ry(pitch) Rz(yaw), row-major.
         let a = [
             [ct * cy, -ct * sy, st],
@@ -627,8 +627,8 @@ pub fn check_altitude<S: Real>(c_m2: S, r2: S, eq_m: S) -> Result<(), ModelError
 /// from the ascending node, the node on +x. With it the real-Earth model reduces to the
 /// round-Earth geometry of the same i0 and gamma0.
 pub fn circular_state(radius_m: f64, inclination_rad: f64, arg_latitude_rad: f64) -> StateVector {
-    let (si, ci) = libm::sincos(inclination_rad);
-    let (su, cu) = libm::sincos(arg_latitude_rad);
+    let (si, ci) = crate::trig_f64::sin_cos(inclination_rad);
+    let (su, cu) = crate::trig_f64::sin_cos(arg_latitude_rad);
     let speed = libm::sqrt(crate::model::GM_M3_S2 / radius_m);
     StateVector {
         position_m: [radius_m * cu, radius_m * su * ci, radius_m * su * si],

@@ -104,8 +104,8 @@ impl<'a, H: DemHeight> DemTile<'a, H> {
             hi_m: T::from_f64(self.max_m + m),
             slope: T::from_f64(self.slope_metric(e) * 1.01),
             tan_lat_c: T::from_f64(libm::tan(lat_c)),
-            cos_lon_c: T::from_f64(libm::cos(lon_c)),
-            sin_lon_c: T::from_f64(libm::sin(lon_c)),
+            cos_lon_c: T::from_f64(crate::trig_f64::cos(lon_c)),
+            sin_lon_c: T::from_f64(crate::trig_f64::sin(lon_c)),
             row_c: T::from_f64(0.5 * rows),
             col_c: T::from_f64(0.5 * cols),
             rows_per_rad: T::from_f64(1.0 / g.dlat_deg.to_radians()),
@@ -139,7 +139,7 @@ impl<'a, H: DemHeight> DemTile<'a, H> {
             .to_radians();
         let low = self.min_m.min(0.0);
         self.slope_lat_m_per_rad / (e.a_m * (1.0 - e2) + low)
-            + self.slope_lon_m_per_rad / ((e.a_m + low) * libm::cos(lat_max))
+            + self.slope_lon_m_per_rad / ((e.a_m + low) * crate::trig_f64::cos(lat_max))
     }
 }
 

@@ -391,7 +391,7 @@ impl<T: Real> Search<T> {
             .max(libm::fabs(g.lat_deg(g.nrows - 1)))
             .to_radians()
             + LAT_MARGIN_RAD;
-        let cos_box = libm::cos(lat_max);
+        let cos_box = crate::trig_f64::cos(lat_max);
         // Metres per radian of latitude and of longitude (at the equator) at or above
         // the lowest node: the meridian radius a (1 - e^2) / W^3 >= a (1 - e^2), the
         // prime vertical a / W >= a.

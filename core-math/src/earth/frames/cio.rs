@@ -58,7 +58,7 @@ const S3: [Term; 1] = [([0, 0, 0, 0, 1], 0.30, -23.42)];
 fn sum(terms: &[Term], fa: &[f64; 5]) -> f64 {
     let mut w = 0.0;
     for (n, s, c) in terms.iter().rev() {
-        let (sa, ca) = libm::sincos(argument(n, fa));
+        let (sa, ca) = crate::trig_f64::sin_cos(argument(n, fa));
         w += s * sa + c * ca;
     }
     w

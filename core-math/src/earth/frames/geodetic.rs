@@ -92,8 +92,8 @@ pub fn itrf_from_geodetic(
     if !(h_m >= GEODETIC_MIN_H_OVER_A * a && h_m <= MAX_POSITION_M) {
         return Err(ModelError::OutOfDomain(Param::Height));
     }
-    let (sp, cp) = libm::sincos(lat_rad);
-    let (sl, cl) = libm::sincos(lon_rad);
+    let (sp, cp) = crate::trig_f64::sin_cos(lat_rad);
+    let (sl, cl) = crate::trig_f64::sin_cos(lon_rad);
     let w = (1.0 - ellipsoid.flattening) * (1.0 - ellipsoid.flattening);
     let ac = a / libm::sqrt(cp * cp + w * sp * sp);
     let r = (ac + h_m) * cp;

@@ -29,7 +29,7 @@ pub use c2t::{
     c2t, c2t_from_cio, c2t_from_dates, CelestialPole, C2T_TOLERANCE_RAD, POLE_MAX_AGE_S,
 };
 pub use geodetic::{geodetic_from_itrf, itrf_from_geodetic};
-pub use rot::Mat3;
+pub use rot::{mul as mat_mul, Mat3};
 pub use time::{JulianDays, TimeScales};
 
 /// Arcseconds to radians (SOFA's `DAS2R`, 4.848136811095359935899141e-6, to the nearest
@@ -52,11 +52,20 @@ pub const DAYS_PER_JULIAN_CENTURY: f64 = 36_525.0;
 /// step r - s with s <= r < 2 s is exact (Sterbenz), and so is every halving of s
 /// down to y. At most log2(x / y) + 1 steps (16 for the largest argument here,
 /// 43 825 days against 1 day).
+#[inline(always)]
 pub(crate) fn fmod(x: f64, y: f64) -> f64 {
+    rem_trunc(x, y).0
+}
+
+/// [`fmod`]'s remainder and whether the truncated quotient |x| / y is odd. Out of line:
+/// soft-float f64 makes it long, and inlined it came to eight copies.
+#[inline(never)]
+fn rem_trunc(x: f64, y: f64) -> (f64, bool) {
     let mut r = libm::fabs(x);
     if !(r.is_finite() && y.is_finite() && y > 0.0) {
-        return f64::NAN;
+        return (f64::NAN, false);
     }
+    let mut odd = false;
     if r >= y {
         let mut s = y;
         // s * 2 overflows to infinity before it could pass a finite r: the loop ends.
@@ -64,21 +73,44 @@ pub(crate) fn fmod(x: f64, y: f64) -> f64 {
             s *= 2.0;
         }
         while s >= y {
-            if r >= s {
+            // The last step, s = y, is the quotient's lowest bit.
+            odd = r >= s;
+            if odd {
                 r -= s;
             }
             s *= 0.5;
         }
     }
-    libm::copysign(r, x)
+    (libm::copysign(r, x), odd)
+}
+
+/// x - n y with n the integer nearest x / y, ties to even, as IEEE 754's (and C's)
+/// `remainder`, for finite x and finite y > 0 (NaN otherwise): exact, so equal to
+/// `libm::remainder` wherever that is defined, without its 712 bytes of code. From
+/// [`fmod`]'s r: |r| - y when |r| > y / 2, or |r| = y / 2 and the truncated quotient is
+/// odd (exact: y / 2 < |r| < y), with the sign of x.
+pub fn remainder(x: f64, y: f64) -> f64 {
+    let (r, odd) = rem_trunc(x, y);
+    let a = libm::fabs(r);
+    let half = 0.5 * y;
+    if a > half || (a == half && odd) {
+        let m = a - y;
+        if x < 0.0 {
+            -m
+        } else {
+            m
+        }
+    } else {
+        r
+    }
 }
 
 #[cfg(test)]
 mod tests {
-    /// The exact remainder against libm's over the arguments the frames reduce and
-    /// random ones: bit for bit.
+    /// The exact remainders (truncated and nearest) against libm's over the arguments
+    /// the frames reduce and random ones: bit for bit.
     #[test]
-    fn fmod_matches_libm_bit_for_bit() {
+    fn fmod_and_remainder_match_libm_bit_for_bit() {
         let mut seed = 0x2545_F491_4F6C_DD1Du64;
         let mut next = || {
             seed ^= seed << 13;
@@ -106,9 +138,37 @@ mod tests {
                     b.to_bits(),
                     "fmod({x:e}, {y:e}): {a:e} vs {b:e}"
                 );
+                let (a, b) = (super::remainder(x, y), libm::remainder(x, y));
+                assert_eq!(
+                    a.to_bits(),
+                    b.to_bits(),
+                    "remainder({x:e}, {y:e}): {a:e} vs {b:e}"
+                );
             }
         }
+        // Halfway cases (ties to the even quotient) and the f32 yaws of every size the
+        // controller wraps.
+        for y in [1.0, 2.0, 0.75] {
+            for k in -50..50 {
+                let x = (f64::from(k) + 0.5) * y;
+                let (a, b) = (super::remainder(x, y), libm::remainder(x, y));
+                assert_eq!(a.to_bits(), b.to_bits(), "remainder({x:e}, {y:e})");
+            }
+        }
+        let mut x = f32::MIN_POSITIVE;
+        while x < f32::MAX {
+            for v in [f64::from(x), -f64::from(x)] {
+                let (a, b) = (
+                    super::remainder(v, super::TWO_PI),
+                    libm::remainder(v, super::TWO_PI),
+                );
+                assert_eq!(a.to_bits(), b.to_bits(), "remainder({v:e}, 2 pi)");
+            }
+            x = f32::from_bits(x.to_bits() + 1_009);
+        }
         assert!(super::fmod(1.0, 0.0).is_nan());
+        assert!(super::remainder(1.0, 0.0).is_nan());
+        assert!(super::remainder(f64::NAN, 1.0).is_nan());
         assert!(super::fmod(f64::INFINITY, 1.0).is_nan());
         assert_eq!(super::fmod(-0.0, 1.0).to_bits(), (-0.0f64).to_bits());
     }
