@@ -36,9 +36,10 @@ pub use pass::{e2e_test, run, RunArgs};
 pub use runner::qemu;
 pub use tools::{ensure_rust_target, ensure_target_tools};
 
-/// The firmware's target: Cortex-M4F, hard-float ABI.
+/// The firmware's target on the Cortex-M4F boards: hard-float ABI.
 pub const TARGET: &str = "thumbv7em-none-eabihf";
-/// A core without an FPU (Cortex-M3), for the fixed-point backend's build check.
+/// A core without an FPU (Cortex-M3): the mps2-an385's target, and the fixed-point
+/// backends' build check.
 pub const NO_FPU_TARGET: &str = "thumbv7m-none-eabi";
 
 /// Every check of the target crates, for `cargo xtask test`: toolchain and QEMU present,
@@ -65,18 +66,20 @@ pub fn test_target() -> Result<()> {
     }
     // The firmware's binaries with every feature but the other boards', for each board;
     // the hil-tests; and both with the RTT logger of a real STM32F405.
-    let board_lints: [(&str, Board, &[&str]); 5] = [
+    let board_lints: [(&str, Board, &[&str]); 7] = [
         ("firmware", Board::Mps2An386, &["bench", "no-panic-check"]),
+        ("firmware", Board::Mps2An385, &["bench", "no-panic-check"]),
         ("firmware", Board::Stm32f405, &["bench", "no-panic-check"]),
         ("firmware", Board::Stm32f405, &["defmt-rtt"]),
         ("hil-tests", Board::DEFAULT, &[]),
+        ("hil-tests", Board::Mps2An385, &[]),
         ("hil-tests", Board::Stm32f405, &["defmt-rtt"]),
     ];
     for (package, board, extra) in board_lints {
         let features = board.cargo_features(extra);
         let mut args = vec!["clippy", "--package", package, "--all-targets"];
         args.extend(features.iter().map(String::as_str));
-        args.extend_from_slice(&["--target", TARGET, "--", "-D", "warnings"]);
+        args.extend_from_slice(&["--target", board.target(), "--", "-D", "warnings"]);
         cargo(&args)?;
     }
     // Each fixed-point backend alone, for a core without an FPU (the real Earth's
@@ -101,7 +104,7 @@ pub fn test_target() -> Result<()> {
     for board in Board::ALL {
         let features = board.cargo_features(&[]);
         for profile in [None, Some("--release")] {
-            let mut args = vec!["test", "--package", "hil-tests", "--target", TARGET];
+            let mut args = vec!["test", "--package", "hil-tests", "--target", board.target()];
             args.extend(features.iter().map(String::as_str));
             args.extend(runner.iter().map(String::as_str));
             args.extend(profile);
@@ -164,10 +167,15 @@ fn runner_config() -> Result<Vec<String>> {
         return Ok(Vec::new());
     }
     let exe = exe.replace('\\', "\\\\").replace('"', "\\\"");
-    Ok(vec![
-        "--config".into(),
-        format!("target.{TARGET}.runner=\"{exe} qemu\""),
-    ])
+    Ok([TARGET, NO_FPU_TARGET]
+        .into_iter()
+        .flat_map(|target| {
+            [
+                "--config".into(),
+                format!("target.{target}.runner=\"{exe} qemu\""),
+            ]
+        })
+        .collect())
 }
 
 /// Builds one binary of the firmware crate for the target and `board`, with `features`
@@ -193,7 +201,7 @@ pub(crate) fn build_firmware(
         "--bin",
         bin,
         "--target",
-        TARGET,
+        board.target(),
     ]
     .map(String::from)
     .to_vec();
