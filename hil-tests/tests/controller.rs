@@ -12,7 +12,7 @@ use core::convert::Infallible;
 
 use controller::frame::{encode, kind, Decoder, Event, MAX_FRAME};
 use controller::nav::Nav;
-use controller::{Config, Controller, Fault, LinePeriodSink, Mode, Terrain};
+use controller::{Controller, Fault, LinePeriodSink, Mode, Terrain};
 use hil_tests::controller_cases::{case, ControllerCase, CASE_COUNT};
 use hil_tests::golden::{UpdateGolden, CONTROLLER_GOLDEN};
 
@@ -43,7 +43,7 @@ fn feed(c: &mut Controller, bytes: &[u8]) {
 
 /// The controller of case `k` after its frames, advanced to its update instant.
 fn run(k: usize, cc: &ControllerCase) -> Controller {
-    let mut c = match Controller::new(Config::default(), cc.scene) {
+    let mut c = match Controller::new(hil_tests::controller_config(), cc.scene) {
         Ok(c) => c,
         Err(f) => defmt::panic!("case {=usize}: scene refused: {=str}", k, f.name()),
     };

@@ -47,6 +47,17 @@ pub mod stm32f405;
 #[cfg(feature = "stm32f405")]
 pub use stm32f405::{take, Clock, LineClock, Link, Watchdog as BoardWatchdog, LINK, NAME};
 
+/// The controller's configuration on this board: the default, with the sample pixels in
+/// fixed point where the core has no FPU (the mps2-an385: docs/controller.md,
+/// "Backends").
+pub fn controller_config() -> controller::Config {
+    controller::Config {
+        #[cfg(feature = "mps2-an385")]
+        fixed_point_pixels: true,
+        ..controller::Config::default()
+    }
+}
+
 /// The telemetry link's speed (baud), 8N1: the ground link's, the same on every board
 /// (QEMU ignores it).
 pub const LINK_BAUD: u32 = 115_200;

@@ -52,6 +52,16 @@ impl Board {
         }
     }
 
+    /// The controller's configuration in this board's firmware
+    /// (`firmware::board::controller_config`), for the host twin: the sample pixels in
+    /// fixed point on the core without an FPU.
+    pub fn controller_config(self) -> controller::Config {
+        controller::Config {
+            fixed_point_pixels: self == Board::Mps2An385,
+            ..controller::Config::default()
+        }
+    }
+
     /// QEMU's `-cpu`.
     pub fn qemu_cpu(self) -> &'static str {
         match self {

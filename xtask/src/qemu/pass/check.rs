@@ -67,8 +67,8 @@ impl LinePeriodSink for Accept {
 
 /// The controller the firmware runs after power-on (same config, same boot scene, the
 /// boot it notes for STATUS).
-pub fn new_controller() -> Result<Controller> {
-    let mut c = Controller::new(Config::default(), Scene::paper_default())
+pub fn new_controller(config: Config) -> Result<Controller> {
+    let mut c = Controller::new(config, Scene::paper_default())
         .map_err(|f| anyhow!("the default scene was refused: {}", f.name()))?;
     c.note_boot(controller::restart::ResetCause::PowerOn, 0);
     Ok(c)
@@ -84,8 +84,8 @@ pub struct InForce {
 /// A host run of `bytes` through a `Session`, as the firmware does, byte by byte.
 /// Also returns the NAV frame and terrain in force at each update (the inputs of the
 /// reference check).
-pub fn twin(bytes: &[u8]) -> Result<(Downlink, BTreeMap<u64, InForce>)> {
-    let mut session = Session::new(new_controller()?);
+pub fn twin(bytes: &[u8], config: Config) -> Result<(Downlink, BTreeMap<u64, InForce>)> {
+    let mut session = Session::new(new_controller(config)?);
     let mut out = Vec::new();
     let mut inputs = BTreeMap::new();
     for &b in bytes {
@@ -122,3 +122,8 @@ pub fn twin(bytes: &[u8]) -> Result<(Downlink, BTreeMap<u64, InForce>)> {
 /// EARTH_F32_REL_TOLERANCE is 2e-6 of |v1| at the envelope's worst conditioning; the
 /// issue's 1e-6 holds for the pass's conditions, and is what is checked.
 pub const F32_REL_TOLERANCE: f64 = 1e-6;
+
+/// What the fixed-point pixels (the mps2-an385's) add to it: the real-Earth fixed-point
+/// backend's target from 1 deg of the limb outward, which its error bound and survey
+/// meet (docs/fixed-point.md, "The error bound").
+pub const EARTH_FIXED_REL_TOLERANCE: f64 = 2e-6;
