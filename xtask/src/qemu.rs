@@ -43,9 +43,10 @@ pub const TARGET: &str = "thumbv7em-none-eabihf";
 pub const NO_FPU_TARGET: &str = "thumbv7m-none-eabi";
 
 /// Every check of the target crates, for `cargo xtask test`: toolchain and QEMU present,
-/// clippy with `-D warnings` on thumbv7em for core-math, controller, firmware and
-/// hil-tests (the firmware for each board, and the STM32F405 with its real-board logger
-/// too), and on thumbv7m (no FPU) for core-math's fixed-point backend; then, on each
+/// clippy with `-D warnings` on each board's target for core-math, controller, firmware
+/// and hil-tests (the firmware for each board, and the STM32F405 with its real-board
+/// logger too), and on thumbv7m (no FPU) for the controller with fixed-point pixels and
+/// core-math's fixed-point backends; then, on each
 /// board's QEMU machine, the hil-tests in the test (dev) and release profiles and the
 /// end-to-end pass test ([`e2e_test`]).
 pub fn test_target() -> Result<()> {
@@ -82,6 +83,20 @@ pub fn test_target() -> Result<()> {
         args.extend_from_slice(&["--target", board.target(), "--", "-D", "warnings"]);
         cargo(&args)?;
     }
+    // The controller as the Cortex-M3 board builds it (fixed-point pixels).
+    cargo(&[
+        "clippy",
+        "--package",
+        "controller",
+        "--lib",
+        "--features",
+        "earth-fixed",
+        "--target",
+        NO_FPU_TARGET,
+        "--",
+        "-D",
+        "warnings",
+    ])?;
     // Each fixed-point backend alone, for a core without an FPU (the real Earth's
     // without `sphere`, as an FPU-less flight build would link it).
     for features in ["fixed-point", "earth-fixed"] {
@@ -113,6 +128,8 @@ pub fn test_target() -> Result<()> {
         e2e_test(board)?;
     }
     faults::faults_test(Board::Mps2An386)?;
+    // Not yet on the mps2-an385: 2 of 4 runs there found the watchdog's reset cause
+    // "unknown" (docs/target.md, "Faults and resets").
     // No reset test yet (`cargo xtask run --reset-at`): which frames a reset loses
     // (those in the receive queue and on the wire) depends on timing, and the check
     // does not yet know which, so its verdict is not repeatable (docs/target.md,
