@@ -17,7 +17,12 @@ use hil_tests::controller_cases::{case, ControllerCase, CASE_COUNT};
 use hil_tests::golden::{UpdateGolden, CONTROLLER_GOLDEN};
 
 /// Ticks: the reference check of `cargo xtask run` (half a tick of rounding plus 1e-6).
+#[cfg(not(feature = "mps2-an385"))]
 const TICKS_REL_TOL: f64 = 1e-6;
+/// Ticks on the Cortex-M3: the fixed-point pixels add their backend's 2e-6
+/// (docs/fixed-point.md, "The error bound"), as the pass's reference check does there.
+#[cfg(feature = "mps2-an385")]
+const TICKS_REL_TOL: f64 = 3e-6;
 /// Drift at each centre and the yaw request (rad): f32's rounding of angles of order
 /// 0.1 rad through the general form (the host tests measure below 1e-7).
 const ANGLE_TOL_RAD: f64 = 2e-6;
