@@ -31,6 +31,11 @@ pub struct Config {
     /// outside b + low ..= a + high are refused, and scenes are planned and the period
     /// guard set for it.
     pub altitude_range_m: (f64, f64),
+    /// Evaluates the sample pixels in fixed point (`core_math::EARTH_FIXED`, integers
+    /// only) instead of the f32 row form: for a core without an FPU. Off by default;
+    /// the mps2-an385 firmware turns it on (docs/controller.md, "Backends").
+    #[cfg(feature = "earth-fixed")]
+    pub fixed_point_pixels: bool,
 }
 
 impl Default for Config {
@@ -41,6 +46,8 @@ impl Default for Config {
             gnss_stale_after_us: 2_000_000,
             max_time_jump_us: 5_000_000,
             altitude_range_m: (500e3, 800e3),
+            #[cfg(feature = "earth-fixed")]
+            fixed_point_pixels: false,
         }
     }
 }

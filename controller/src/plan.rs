@@ -66,6 +66,9 @@ pub struct SegmentPlan {
     pub samples: Vec<Sample, MAX_SAMPLES>,
     /// The centre's pixel constants, for the steered residual (`General::motion_yawed`).
     pub centre: GeneralPixel<f32>,
+    /// `samples`' pixel constants of the fixed-point backend, in the same order.
+    #[cfg(feature = "earth-fixed")]
+    pub fixed: Vec<core_math::earth::fixed::EarthFixedPixel, MAX_SAMPLES>,
     /// Relative error allowed on the segment's velocity extremes.
     pub sampling_budget: f32,
     /// Largest amount v1 may leave the samples' range between two samples (m/s):
@@ -320,6 +323,8 @@ impl Plan {
                     }
                 }));
             let mut samples = Vec::new();
+            #[cfg(feature = "earth-fixed")]
+            let mut fixed = Vec::new();
             for n in pixels {
                 // Checked like any pixel: the row form then needs no check of its own.
                 // (`focal_plane_m` alone checks the same but, inlined, costs 280 bytes of
@@ -331,6 +336,14 @@ impl Plan {
                 samples
                     .push(Sample { px: n as f32, p2_m })
                     .map_err(|_| Fault::InvalidScene)?;
+                #[cfg(feature = "earth-fixed")]
+                fixed
+                    .push(
+                        core_math::EARTH_FIXED
+                            .pixel(&camera, n)
+                            .map_err(|_| Fault::InvalidScene)?,
+                    )
+                    .map_err(|_| Fault::InvalidScene)?;
             }
             let centre = GENERAL_F32
                 .pixel(&camera, centre_px)
@@ -341,6 +354,8 @@ impl Plan {
                 row: GENERAL_F32.row(&camera).map_err(|_| Fault::InvalidScene)?,
                 samples,
                 centre,
+                #[cfg(feature = "earth-fixed")]
+                fixed,
                 sampling_budget: budget as f32,
                 interpolation_mps: error(k) as f32,
                 sampling_bound: (error(k) / v_min) as f32,

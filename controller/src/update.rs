@@ -5,7 +5,7 @@
 //! period in force, and nothing outside the physically possible period range is ever
 //! written. Which parts are out of line, and why: docs/controller.md.
 
-use core_math::earth::{GeneralRowMotion, GeneralUpdate};
+use core_math::earth::{GeneralInstant, GeneralRowMotion, GeneralUpdate};
 use core_math::ImageMotion;
 use core_math::{nearest_ticks, smear_mtf, Backend, Real, GENERAL_F32};
 
@@ -113,7 +113,7 @@ impl Controller {
         // in a row (a flat scene makes one, terrain one per segment). It stays in one
         // place in memory, which the out-of-line `segment` and `extremes` read.
         let mut ground_h_m = f32::NAN;
-        let mut ground: Result<GeneralUpdate<f32>, Fault> = Err(Fault::OutOfRange);
+        let mut ground: Result<Ground, Fault> = Err(Fault::OutOfRange);
         for k in 0..self.plan.segments.len() {
             let Some(seg) = self.plan.segments.get(k) else {
                 break;
@@ -122,9 +122,7 @@ impl Controller {
             let height_m = self.height(index);
             // NaN never equals: the first segment makes the first ground.
             if height_m != ground_h_m {
-                ground = GENERAL_F32
-                    .ground(&instant, &EARTH, height_m)
-                    .map_err(Fault::from);
+                ground = self.make_ground(&instant, height_m);
                 ground_h_m = height_m;
             }
             let result = match &ground {
@@ -156,6 +154,24 @@ impl Controller {
         }
     }
 
+    /// The segment's [`Extremes`] by the configured backend.
+    #[cfg(not(feature = "earth-fixed"))]
+    #[inline(always)]
+    fn extremes(&self, update: &Ground, seg: &SegmentPlan) -> Result<Extremes, Fault> {
+        extremes(update, seg)
+    }
+
+    /// The segment's [`Extremes`] by the configured backend.
+    #[cfg(feature = "earth-fixed")]
+    #[inline(always)]
+    fn extremes(&self, update: &Ground, seg: &SegmentPlan) -> Result<Extremes, Fault> {
+        if self.config.fixed_point_pixels {
+            extremes_fixed(update, seg)
+        } else {
+            extremes(&update.float, seg)
+        }
+    }
+
     fn height(&self, index: u8) -> f32 {
         self.heights_m
             .get(usize::from(index))
@@ -170,7 +186,7 @@ impl Controller {
     #[inline(never)]
     fn segment(
         &self,
-        update: &GeneralUpdate<f32>,
+        update: &Ground,
         seg: &SegmentPlan,
         steer: Option<(f32, f32, f32)>,
     ) -> Result<SegmentOutput, Fault> {
@@ -186,7 +202,7 @@ impl Controller {
             hi,
             drift_v2,
             drift_v1,
-        } = extremes(update, seg)?;
+        } = self.extremes(update, seg)?;
         let reversed = centre.v1_mps > 0.0;
         let tan_centre = centre.v2_mps / centre.v1_mps;
         // v1's extremes are tracked signed, and its sign checked once after the loop;
@@ -241,7 +257,7 @@ impl Controller {
         };
         let tan_residual = match steer {
             Some((sin, cos, _)) => {
-                let m = steered_centre(update, seg, sin, cos)?;
+                let m = steered_centre(float(update), seg, sin, cos)?;
                 m.v2_mps / m.v1_mps
             }
             None => tan_centre,
@@ -282,6 +298,75 @@ fn seconds_since(t_us: u64, t0_us: u64) -> f32 {
 #[inline(never)]
 fn i64_to_f32(x: i64) -> f32 {
     x as f32
+}
+
+/// What the segments over one ground height are evaluated from: the f32 general form's
+/// update (docs/controller.md, "Backends").
+#[cfg(not(feature = "earth-fixed"))]
+type Ground = GeneralUpdate<f32>;
+
+/// What the segments over one ground height are evaluated from: the f32 update, which
+/// the steered centre uses, and the same rounded to the fixed-point backend's formats,
+/// which every sample pixel uses (docs/controller.md, "Backends").
+#[cfg(feature = "earth-fixed")]
+struct Ground {
+    float: GeneralUpdate<f32>,
+    /// None unless `Config::fixed_point_pixels`.
+    fixed: Option<core_math::earth::fixed::EarthFixedUpdate>,
+}
+
+impl Controller {
+    #[cfg(not(feature = "earth-fixed"))]
+    #[inline(always)]
+    fn make_ground(&self, instant: &GeneralInstant<f32>, height_m: f32) -> Result<Ground, Fault> {
+        GENERAL_F32
+            .ground(instant, &EARTH, height_m)
+            .map_err(Fault::from)
+    }
+
+    /// The f32 update of the ground and, for fixed-point pixels, the same widened to
+    /// f64 and rounded once to the fixed-point formats: per ground height, not per pixel.
+    #[cfg(feature = "earth-fixed")]
+    fn make_ground(&self, instant: &GeneralInstant<f32>, height_m: f32) -> Result<Ground, Fault> {
+        let float = GENERAL_F32.ground(instant, &EARTH, height_m)?;
+        let fixed = if self.config.fixed_point_pixels {
+            Some(fixed_update(&float, instant.r2_m2)?)
+        } else {
+            None
+        };
+        Ok(Ground { float, fixed })
+    }
+}
+
+/// `float` widened to f64 and rounded to the fixed-point backend's formats.
+#[cfg(feature = "earth-fixed")]
+fn fixed_update(
+    float: &GeneralUpdate<f32>,
+    r2_m2: f32,
+) -> Result<core_math::earth::fixed::EarthFixedUpdate, Fault> {
+    let w = |x: [f32; 3]| x.map(f64::from);
+    let wide = GeneralUpdate {
+        n_b: w(float.n_b),
+        rho_b_m: w(float.rho_b_m),
+        stretch2_minus_1: f64::from(float.stretch2_minus_1),
+        c_m2: f64::from(float.c_m2),
+        inv_c_per_m2: f64::from(float.inv_c_per_m2),
+        w_b_rad_s: w(float.w_b_rad_s),
+        v_b_mps: w(float.v_b_mps),
+    };
+    Ok(core_math::EARTH_FIXED.from_general(&wide, f64::from(r2_m2))?)
+}
+
+#[cfg(not(feature = "earth-fixed"))]
+#[inline(always)]
+fn float(g: &Ground) -> &GeneralUpdate<f32> {
+    g
+}
+
+#[cfg(feature = "earth-fixed")]
+#[inline(always)]
+fn float(g: &Ground) -> &GeneralUpdate<f32> {
+    &g.float
 }
 
 /// What a segment's samples show: v1's signed extremes, and the (|v2|, |v1|) of the
@@ -361,6 +446,50 @@ fn sweep(
         }
     }
     Ok(e)
+}
+
+/// The [`Extremes`] of the centre and the samples by the fixed-point backend
+/// (`SegmentPlan::fixed`: the centre first), integer only per pixel: v1's extremes
+/// compared as I24F40 bits, the largest |v2/v1| by cross-multiplying the bits' magnitudes
+/// (exact in u128). Widened to f32 once, at the end: the per-segment work after it is
+/// the f32 path's.
+#[cfg(feature = "earth-fixed")]
+#[inline(never)]
+fn extremes_fixed(g: &Ground, seg: &SegmentPlan) -> Result<Extremes, Fault> {
+    use core_math::EARTH_FIXED;
+    let Some(up) = &g.fixed else {
+        return Err(Fault::InvalidScene);
+    };
+    let Some((first, pixels)) = seg.fixed.split_first() else {
+        return Err(Fault::InvalidScene);
+    };
+    let centre = EARTH_FIXED.motion(up, first)?;
+    let (c1, c2) = (centre.v1_mps.to_bits(), centre.v2_mps.to_bits());
+    let (mut lo, mut hi) = (c1, c1);
+    let (mut d2, mut d1) = (c2.unsigned_abs(), c1.unsigned_abs());
+    for px in pixels {
+        let m = EARTH_FIXED.motion(up, px)?;
+        let (v1, v2) = (m.v1_mps.to_bits(), m.v2_mps.to_bits());
+        lo = lo.min(v1);
+        hi = hi.max(v1);
+        let (a1, a2) = (v1.unsigned_abs(), v2.unsigned_abs());
+        if u128::from(a2) * u128::from(d1) > u128::from(d2) * u128::from(a1) {
+            (d2, d1) = (a2, a1);
+        }
+    }
+    // I24F40 bits to m/s: exact to f32's rounding (|v| < 2^23 m/s).
+    const LSB_MPS: f32 = 1.0 / (1u64 << 40) as f32;
+    let mps = |bits: i64| bits as f32 * LSB_MPS;
+    Ok(Extremes {
+        centre: ImageMotion {
+            v1_mps: mps(c1),
+            v2_mps: mps(c2),
+        },
+        lo: mps(lo),
+        hi: mps(hi),
+        drift_v2: d2 as f32 * LSB_MPS,
+        drift_v1: d1 as f32 * LSB_MPS,
+    })
 }
 
 /// The segment's centre pixel seen by the camera turned by the yaw request

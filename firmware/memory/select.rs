@@ -7,8 +7,9 @@
 // build script's OUT_DIR and that folder on the search path.
 
 /// The boards: cargo feature and layout file in `firmware/memory/`.
-const BOARDS: [(&str, &str); 2] = [
+const BOARDS: [(&str, &str); 3] = [
     ("mps2-an386", "mps2-an386.x"),
+    ("mps2-an385", "mps2-an385.x"),
     ("stm32f405", "stm32f405.x"),
 ];
 

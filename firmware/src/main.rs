@@ -10,7 +10,7 @@
 #![no_main]
 
 use controller::session::Session;
-use controller::{Config, Controller, LinePeriodSink, Scene};
+use controller::{Controller, LinePeriodSink, Scene};
 use cortex_m_rt::entry;
 use firmware::board::{self, Monotonic, Parts};
 use firmware::line_clock::LineClocks;
@@ -29,7 +29,7 @@ static SESSION: StaticCell<Session> = StaticCell::new();
 /// `init_with` would panic there (docs/no-panic.md).
 #[inline(never)]
 fn blank_session() -> Option<&'static mut Session> {
-    SESSION.try_init_with(|| Session::new(Controller::blank(Config::default())))
+    SESSION.try_init_with(|| Session::new(Controller::blank(board::controller_config())))
 }
 
 /// Puts the snapshot kept before a reset back: the periods into the registers first,

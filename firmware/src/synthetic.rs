@@ -11,11 +11,12 @@ use core::hint::black_box;
 use controller::bus::{Gnss, StarAttitude};
 use controller::frame::{encode, kind, Decoder, Event, MAX_FRAME};
 use controller::nav::{Attitude, Nav};
-use controller::{Config, Controller, LinePeriodSink};
+use controller::{Controller, LinePeriodSink};
 use core_math::earth::frames::{self, Mat3, TimeScales};
 use core_math::earth::EarthGeometry;
 use core_math::StateVector;
 
+use crate::board;
 use crate::FirmwareError;
 
 /// Orbit of the synthetic frame: 645 km over the equatorial radius of WGS 84, circular,
@@ -44,7 +45,7 @@ pub fn controller_with_nav(
     exhaustive: bool,
     attitude: Attitude<f32>,
 ) -> Result<Controller, FirmwareError> {
-    let config = Config::default();
+    let config = board::controller_config();
     let c = if exhaustive {
         Controller::evaluate_everything(config, scene)
     } else {
@@ -105,7 +106,8 @@ pub fn controller_with_bus(
     scene: controller::Scene,
     attitude: Attitude<f32>,
 ) -> Result<Controller, FirmwareError> {
-    let mut c = Controller::new(Config::default(), scene).map_err(|_| FirmwareError::Layout)?;
+    let mut c =
+        Controller::new(board::controller_config(), scene).map_err(|_| FirmwareError::Layout)?;
     let state = orbit();
     let w = core_math::EARTH_RATE_RAD_S;
     let (r, v) = (state.position_m, state.velocity_mps);

@@ -17,6 +17,17 @@ use defmt_rtt as _;
 #[cfg(not(feature = "defmt-rtt"))]
 use defmt_semihosting as _;
 
+/// The controller's configuration on the board under test: as the firmware's
+/// (`firmware::board::controller_config`), the sample pixels in fixed point on the
+/// Cortex-M3 (mps2-an385).
+pub fn controller_config() -> controller::Config {
+    controller::Config {
+        #[cfg(feature = "mps2-an385")]
+        fixed_point_pixels: true,
+        ..controller::Config::default()
+    }
+}
+
 /// The generated cases (see `build.rs`).
 pub mod golden {
     // `Param` appears in the generated file only when a refusal names a parameter.

@@ -12,7 +12,7 @@ use core::convert::Infallible;
 use controller::frame::{encode, kind, MAX_FRAME};
 use controller::nav::{Attitude, Nav};
 use controller::session::Session;
-use controller::{Config, Controller, Counters, Fault, LinePeriodSink, Scene};
+use controller::{Controller, Counters, Fault, LinePeriodSink, Scene};
 use core_math::{StateVector, GM_M3_S2};
 
 struct Accept;
@@ -72,7 +72,7 @@ fn inject_at(k: u64) -> Inject {
 }
 
 fn play(faults: bool) -> Run {
-    let controller = match Controller::new(Config::default(), Scene::paper_default()) {
+    let controller = match Controller::new(hil_tests::controller_config(), Scene::paper_default()) {
         Ok(c) => c,
         Err(f) => defmt::panic!("default scene refused: {=str}", f.name()),
     };

@@ -36,15 +36,17 @@ pub use pass::{e2e_test, run, RunArgs};
 pub use runner::qemu;
 pub use tools::{ensure_rust_target, ensure_target_tools};
 
-/// The firmware's target: Cortex-M4F, hard-float ABI.
+/// The firmware's target on the Cortex-M4F boards: hard-float ABI.
 pub const TARGET: &str = "thumbv7em-none-eabihf";
-/// A core without an FPU (Cortex-M3), for the fixed-point backend's build check.
+/// A core without an FPU (Cortex-M3): the mps2-an385's target, and the fixed-point
+/// backends' build check.
 pub const NO_FPU_TARGET: &str = "thumbv7m-none-eabi";
 
 /// Every check of the target crates, for `cargo xtask test`: toolchain and QEMU present,
-/// clippy with `-D warnings` on thumbv7em for core-math, controller, firmware and
-/// hil-tests (the firmware for each board, and the STM32F405 with its real-board logger
-/// too), and on thumbv7m (no FPU) for core-math's fixed-point backend; then, on each
+/// clippy with `-D warnings` on each board's target for core-math, controller, firmware
+/// and hil-tests (the firmware for each board, and the STM32F405 with its real-board
+/// logger too), and on thumbv7m (no FPU) for the controller with fixed-point pixels and
+/// core-math's fixed-point backends; then, on each
 /// board's QEMU machine, the hil-tests in the test (dev) and release profiles and the
 /// end-to-end pass test ([`e2e_test`]).
 pub fn test_target() -> Result<()> {
@@ -65,20 +67,36 @@ pub fn test_target() -> Result<()> {
     }
     // The firmware's binaries with every feature but the other boards', for each board;
     // the hil-tests; and both with the RTT logger of a real STM32F405.
-    let board_lints: [(&str, Board, &[&str]); 5] = [
+    let board_lints: [(&str, Board, &[&str]); 7] = [
         ("firmware", Board::Mps2An386, &["bench", "no-panic-check"]),
+        ("firmware", Board::Mps2An385, &["bench", "no-panic-check"]),
         ("firmware", Board::Stm32f405, &["bench", "no-panic-check"]),
         ("firmware", Board::Stm32f405, &["defmt-rtt"]),
         ("hil-tests", Board::DEFAULT, &[]),
+        ("hil-tests", Board::Mps2An385, &[]),
         ("hil-tests", Board::Stm32f405, &["defmt-rtt"]),
     ];
     for (package, board, extra) in board_lints {
         let features = board.cargo_features(extra);
         let mut args = vec!["clippy", "--package", package, "--all-targets"];
         args.extend(features.iter().map(String::as_str));
-        args.extend_from_slice(&["--target", TARGET, "--", "-D", "warnings"]);
+        args.extend_from_slice(&["--target", board.target(), "--", "-D", "warnings"]);
         cargo(&args)?;
     }
+    // The controller as the Cortex-M3 board builds it (fixed-point pixels).
+    cargo(&[
+        "clippy",
+        "--package",
+        "controller",
+        "--lib",
+        "--features",
+        "earth-fixed",
+        "--target",
+        NO_FPU_TARGET,
+        "--",
+        "-D",
+        "warnings",
+    ])?;
     // Each fixed-point backend alone, for a core without an FPU (the real Earth's
     // without `sphere`, as an FPU-less flight build would link it).
     for features in ["fixed-point", "earth-fixed"] {
@@ -101,7 +119,7 @@ pub fn test_target() -> Result<()> {
     for board in Board::ALL {
         let features = board.cargo_features(&[]);
         for profile in [None, Some("--release")] {
-            let mut args = vec!["test", "--package", "hil-tests", "--target", TARGET];
+            let mut args = vec!["test", "--package", "hil-tests", "--target", board.target()];
             args.extend(features.iter().map(String::as_str));
             args.extend(runner.iter().map(String::as_str));
             args.extend(profile);
@@ -110,6 +128,8 @@ pub fn test_target() -> Result<()> {
         e2e_test(board)?;
     }
     faults::faults_test(Board::Mps2An386)?;
+    // Not yet on the mps2-an385: 2 of 4 runs there found the watchdog's reset cause
+    // "unknown" (docs/target.md, "Faults and resets").
     eprintln!(
         "xtask: target checks passed on {} in {:.1} s",
         board::names(),
@@ -160,10 +180,15 @@ fn runner_config() -> Result<Vec<String>> {
         return Ok(Vec::new());
     }
     let exe = exe.replace('\\', "\\\\").replace('"', "\\\"");
-    Ok(vec![
-        "--config".into(),
-        format!("target.{TARGET}.runner=\"{exe} qemu\""),
-    ])
+    Ok([TARGET, NO_FPU_TARGET]
+        .into_iter()
+        .flat_map(|target| {
+            [
+                "--config".into(),
+                format!("target.{target}.runner=\"{exe} qemu\""),
+            ]
+        })
+        .collect())
 }
 
 /// Builds one binary of the firmware crate for the target and `board`, with `features`
@@ -189,7 +214,7 @@ pub(crate) fn build_firmware(
         "--bin",
         bin,
         "--target",
-        TARGET,
+        board.target(),
     ]
     .map(String::from)
     .to_vec();

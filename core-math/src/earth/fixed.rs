@@ -163,6 +163,22 @@ impl EarthFixed {
         Self::round_update(&up, p[0] * p[0] + p[1] * p[1] + p[2] * p[2])
     }
 
+    /// The per-pixel constants from a general-form update made elsewhere (`up`, with
+    /// `r2_m2` = |r|^2 of the same instant): for a caller that already forms the update
+    /// in its own precision, e.g. the controller's f32 update widened to f64. Only the
+    /// envelope's checks run here (W through [`envelope::MAX_W_RAD_S`]); the error bound
+    /// of `docs/fixed-point.md` then adds to `up`'s own error.
+    pub fn from_general(
+        &self,
+        up: &crate::earth::GeneralUpdate<f64>,
+        r2_m2: f64,
+    ) -> Result<EarthFixedUpdate, ModelError> {
+        if !(r2_m2 > 0.0 && r2_m2.is_finite()) {
+            return Err(ModelError::OutOfDomain(Param::Position));
+        }
+        Self::round_update(up, r2_m2)
+    }
+
     /// The f64 update, every length over |r|, rounded to the per-pixel formats.
     fn round_update(
         up: &crate::earth::GeneralUpdate<f64>,

@@ -17,7 +17,7 @@ use core_math::sphere::fixed_point::geometry_from_f64;
 use core_math::sphere::{
     Geometry, MicroF32, NaiveF32, Reference, CLOSED_F32, CLOSED_F64, CLOSED_MICROMATH, FIXED,
 };
-use core_math::{Backend, Camera, EarthReference, Model, GENERAL_F32, GENERAL_F64};
+use core_math::{Backend, Camera, EarthReference, Model, EARTH_FIXED, GENERAL_F32, GENERAL_F64};
 use cortex_m_rt::entry;
 use firmware::platform;
 use firmware::synthetic::{controller_with_bus, controller_with_nav, NoRegisters, BUS_EPOCH_US};
@@ -409,7 +409,13 @@ fn earth_regions() -> Result<(), FirmwareError> {
     let plan32 = plan_pixels(&GENERAL_F32, &camera)?;
     let plan64 = plan_pixels(&GENERAL_F64, &camera)?;
     let plan_ref = plan_pixels(&EarthReference, &camera)?;
+    let efx = core_math::earth::fixed::geometry_from_f64(&e64)?;
+    let upfx = EARTH_FIXED.update(&efx)?;
+    let axisfx = EARTH_FIXED.pixel(&camera, 0.0)?;
+    let loopfx = loop_pixels(&EARTH_FIXED, &camera)?;
+    let planfx = plan_pixels(&EARTH_FIXED, &camera)?;
     full_update_region("GENERAL_F32 full update", &GENERAL_F32, &e32, &plan32);
+    full_update_region("EARTH_FIXED full update", &EARTH_FIXED, &efx, &planfx);
     full_update_region("GENERAL_F64 full update", &GENERAL_F64, &e64, &plan64);
     full_update_region(
         "EarthReference full update",
@@ -422,6 +428,12 @@ fn earth_regions() -> Result<(), FirmwareError> {
         &GENERAL_F32,
         &up32,
         &loop32,
+    );
+    loop_region(
+        "EARTH_FIXED motion, 32 pixels in a loop",
+        &EARTH_FIXED,
+        &upfx,
+        &loopfx,
     );
     loop_region(
         "GENERAL_F64 motion, 32 pixels in a loop",
@@ -449,6 +461,16 @@ fn earth_regions() -> Result<(), FirmwareError> {
         "EarthGeometry::validate (every check in f64: the reference's; not on the f32 path)",
         &e32,
         |g| g.validate(),
+    );
+    region(
+        "EARTH_FIXED update (earth model in soft f64, rounded to integers)",
+        &efx,
+        |g| EARTH_FIXED.update(g),
+    );
+    region(
+        "EARTH_FIXED motion, 1 pixel (n = 0; integer only)",
+        (&upfx, &axisfx),
+        |(u, p)| EARTH_FIXED.motion(u, p),
     );
     region("GENERAL_F64 update (earth model)", &e64, |g| {
         GENERAL_F64.update(g)

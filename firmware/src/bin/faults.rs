@@ -19,7 +19,7 @@
 #![no_std]
 #![no_main]
 
-use controller::{Config, Controller, LinePeriodSink};
+use controller::{Controller, LinePeriodSink};
 use cortex_m_rt::entry;
 use firmware::board::{self, Monotonic, Parts, WATCHDOG_TIMEOUT_MS};
 use firmware::retained::{self, ResetCause};
@@ -58,7 +58,7 @@ fn restored_as_kept(boot: &retained::Boot) -> bool {
     let (Some(snapshot), Some(expected)) = (retained::snapshot(boot), flown()) else {
         return false;
     };
-    let mut c = Controller::blank(Config::default());
+    let mut c = Controller::blank(board::controller_config());
     let mut regs = Recorded {
         ticks: [0; controller::scene::MAX_SEGMENTS],
     };

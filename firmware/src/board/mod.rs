@@ -18,28 +18,45 @@
 //!
 //! | feature | module | link | line clock | clock | watchdog |
 //! |---|---|---|---|---|---|
-//! | `mps2-an386` (default) | [`mps2_an386`] on [`cmsdk`] | CMSDK UART0 | CMSDK TIMER0 RELOAD | CMSDK TIMER1 | CMSDK APB watchdog |
+//! | `mps2-an386` (default) | [`mps2`] on [`cmsdk`] | CMSDK UART0 | CMSDK TIMER0 RELOAD | CMSDK TIMER1 | CMSDK APB watchdog |
+//! | `mps2-an385` (Cortex-M3, no FPU) | [`mps2`] on [`cmsdk`] | CMSDK UART0 | CMSDK TIMER0 RELOAD | CMSDK TIMER1 | CMSDK APB watchdog |
 //! | `stm32f405` | `stm32f405` (stm32f4xx-hal) | USART1 | TIM2 ARR | TIM5 (1 MHz) | IWDG |
 
-#[cfg(all(feature = "mps2-an386", feature = "stm32f405"))]
+#[cfg(any(
+    all(feature = "mps2-an386", feature = "stm32f405"),
+    all(feature = "mps2-an386", feature = "mps2-an385"),
+    all(feature = "mps2-an385", feature = "stm32f405"),
+))]
 compile_error!(
-    "two boards selected: build with `--no-default-features --features stm32f405` for the STM32F405"
+    "two boards selected: build with `--no-default-features --features <board>` for a board other than the default"
 );
-#[cfg(not(any(feature = "mps2-an386", feature = "stm32f405")))]
-compile_error!("no board selected: enable the feature `mps2-an386` or `stm32f405`");
+#[cfg(not(any(feature = "mps2-an386", feature = "mps2-an385", feature = "stm32f405")))]
+compile_error!("no board selected: enable the feature `mps2-an386`, `mps2-an385` or `stm32f405`");
 
-// The CMSDK APB UART and timer: every board built on the CMSDK shares them.
-#[cfg(feature = "mps2-an386")]
+// The CMSDK APB UART, timer and watchdog: every board built on the CMSDK shares them.
+#[cfg(any(feature = "mps2-an386", feature = "mps2-an385"))]
 pub mod cmsdk;
-#[cfg(feature = "mps2-an386")]
-pub mod mps2_an386;
-#[cfg(feature = "mps2-an386")]
-pub use mps2_an386::{take, Clock, LineClock, Link, Watchdog as BoardWatchdog, LINK, NAME};
+// The two MPS2 FPGA images differ in their core only (M4F, M3): one module serves both.
+#[cfg(any(feature = "mps2-an386", feature = "mps2-an385"))]
+pub mod mps2;
+#[cfg(any(feature = "mps2-an386", feature = "mps2-an385"))]
+pub use mps2::{take, Clock, LineClock, Link, Watchdog as BoardWatchdog, LINK, NAME};
 
 #[cfg(feature = "stm32f405")]
 pub mod stm32f405;
 #[cfg(feature = "stm32f405")]
 pub use stm32f405::{take, Clock, LineClock, Link, Watchdog as BoardWatchdog, LINK, NAME};
+
+/// The controller's configuration on this board: the default, with the sample pixels in
+/// fixed point where the core has no FPU (the mps2-an385: docs/controller.md,
+/// "Backends").
+pub fn controller_config() -> controller::Config {
+    controller::Config {
+        #[cfg(feature = "mps2-an385")]
+        fixed_point_pixels: true,
+        ..controller::Config::default()
+    }
+}
 
 /// The telemetry link's speed (baud), 8N1: the ground link's, the same on every board
 /// (QEMU ignores it).

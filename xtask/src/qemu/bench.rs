@@ -60,7 +60,7 @@ pub fn bench(args: &BenchArgs) -> Result<()> {
     let counts = measure_on(board, false, None)?;
     let overhead = counts.overhead;
     println!();
-    println!("guest instructions per region (Cortex-M4 under QEMU {}, board {} ({}), release: opt-level 3, fat LTO, codegen-units 1)", counts.qemu_version, board.name(), board.qemu_machine());
+    println!("guest instructions per region ({} under QEMU {}, board {} ({}), release: opt-level 3, fat LTO, codegen-units 1)", board.qemu_cpu(), counts.qemu_version, board.name(), board.qemu_machine());
     println!("net = raw - {overhead} (the empty region: markers and black_box). Instructions, not cycles.");
     println!();
     println!("{:>8} {:>8}  region", "net", "raw");

@@ -14,6 +14,9 @@ pub enum Board {
     /// QEMU's mps2-an386 (CMSDK UART and timers): the default
     #[value(name = "mps2-an386")]
     Mps2An386,
+    /// QEMU's mps2-an385: the same peripherals on a Cortex-M3 without FPU
+    #[value(name = "mps2-an385")]
+    Mps2An385,
     /// An STM32F405RG through stm32f4xx-hal: QEMU's netduinoplus2, or a real board
     #[value(name = "stm32f405")]
     Stm32f405,
@@ -28,7 +31,7 @@ pub struct BoardArg {
 }
 
 impl Board {
-    pub const ALL: [Board; 2] = [Board::Mps2An386, Board::Stm32f405];
+    pub const ALL: [Board; 3] = [Board::Mps2An386, Board::Mps2An385, Board::Stm32f405];
     /// The firmware crate's default feature.
     pub const DEFAULT: Board = Board::Mps2An386;
 
@@ -36,7 +39,34 @@ impl Board {
     pub fn name(self) -> &'static str {
         match self {
             Board::Mps2An386 => "mps2-an386",
+            Board::Mps2An385 => "mps2-an385",
             Board::Stm32f405 => "stm32f405",
+        }
+    }
+
+    /// The Rust target: hard-float Cortex-M4F, or the Cortex-M3's soft float.
+    pub fn target(self) -> &'static str {
+        match self {
+            Board::Mps2An386 | Board::Stm32f405 => super::TARGET,
+            Board::Mps2An385 => super::NO_FPU_TARGET,
+        }
+    }
+
+    /// The controller's configuration in this board's firmware
+    /// (`firmware::board::controller_config`), for the host twin: the sample pixels in
+    /// fixed point on the core without an FPU.
+    pub fn controller_config(self) -> controller::Config {
+        controller::Config {
+            fixed_point_pixels: self == Board::Mps2An385,
+            ..controller::Config::default()
+        }
+    }
+
+    /// QEMU's `-cpu`.
+    pub fn qemu_cpu(self) -> &'static str {
+        match self {
+            Board::Mps2An386 | Board::Stm32f405 => "cortex-m4",
+            Board::Mps2An385 => "cortex-m3",
         }
     }
 
@@ -44,6 +74,7 @@ impl Board {
     pub fn qemu_machine(self) -> &'static str {
         match self {
             Board::Mps2An386 => "mps2-an386",
+            Board::Mps2An385 => "mps2-an385",
             Board::Stm32f405 => "netduinoplus2",
         }
     }
@@ -51,7 +82,7 @@ impl Board {
     /// probe-rs's `--chip` for the real part; None for a board that exists only in QEMU.
     pub fn probe_rs_chip(self) -> Option<&'static str> {
         match self {
-            Board::Mps2An386 => None,
+            Board::Mps2An386 | Board::Mps2An385 => None,
             Board::Stm32f405 => Some("STM32F405RGTx"),
         }
     }

@@ -10,12 +10,12 @@ use super::build_firmware;
 use super::runner::{run_elf, Options};
 
 /// Runs the `faults` binary on `board` and checks both resets and the recovery. Only the
-/// mps2-an386's watchdog is modelled by QEMU 7.2 (the STM32F405's IWDG is not: there the
-/// binary would hang until the runner's time limit).
+/// MPS2's watchdog (mps2-an386 and mps2-an385) is modelled by QEMU 7.2 (the STM32F405's
+/// IWDG is not: there the binary would hang until the runner's time limit).
 pub fn faults_test(board: Board) -> Result<()> {
-    if board != Board::Mps2An386 {
+    if !matches!(board, Board::Mps2An386 | Board::Mps2An385) {
         bail!(
-            "QEMU does not model the {}'s watchdog: the faults test runs on the mps2-an386",
+            "QEMU does not model the {}'s watchdog: the faults test runs on the MPS2 boards",
             board.name()
         );
     }

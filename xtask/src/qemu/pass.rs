@@ -35,7 +35,7 @@ use controller::report::{mode_from_u8, Periods, Status};
 use controller::{Config, Fault, Mode};
 
 use crate::plot::Plot;
-use check::{Downlink, F32_REL_TOLERANCE};
+use check::{Downlink, EARTH_FIXED_REL_TOLERANCE, F32_REL_TOLERANCE};
 use scenario::Pass;
 
 use super::board::{Board, BoardArg};
@@ -197,6 +197,10 @@ struct Played {
     max_ticks: f64,
     compared: usize,
     reference_failures: Vec<String>,
+    /// The relative tolerance the reference check allowed on top of half a tick.
+    rel_tolerance: f64,
+    /// What it is made of, for the report.
+    tolerance_note: &'static str,
     /// Updates whose PERIODS differ from the twin's (or exist in one run only).
     changed: usize,
     changed_examples: Vec<String>,
@@ -254,8 +258,8 @@ impl Played {
             );
         }
         println!(
-            "reference: largest |ticks - reference| {:.4} ticks (allowed: 0.5 for the rounding to whole ticks + 1e-6 x ticks for the f32 closed form)",
-            self.max_ticks
+            "reference: largest |ticks - reference| {:.4} ticks (allowed: 0.5 for the rounding to whole ticks + {:.0e} x ticks for {})",
+            self.max_ticks, self.rel_tolerance, self.tolerance_note
         );
         for p in &problems {
             println!("FAILED: {p}");
@@ -299,6 +303,9 @@ fn play(elf: &Path, pass: &Pass, reset_at_s: Option<f64>) -> Result<Played> {
         stream.injected.len(),
         elf.display()
     );
+    // The twin runs the controller as the board's firmware configures it.
+    let board = Board::of_elf(&std::fs::read(elf).with_context(|| format!("{}", elf.display()))?)?;
+    let config = board.controller_config();
     let t_qemu = Instant::now();
     let trigger = match reset_at_s {
         Some(at_s) => Some(reset::Trigger::new(
@@ -306,6 +313,7 @@ fn play(elf: &Path, pass: &Pass, reset_at_s: Option<f64>) -> Result<Played> {
             std::env::temp_dir().join(format!("tdi-qmp-{}.sock", std::process::id())),
             &uplink,
             elf,
+            config,
         )?),
         None => None,
     };
@@ -322,8 +330,8 @@ fn play(elf: &Path, pass: &Pass, reset_at_s: Option<f64>) -> Result<Played> {
 
     // The twin: the stream without the injected faults, and a host run of the faulty
     // stream (whose STATUS must equal the firmware's: same code, same bytes).
-    let (twin, navs) = check::twin(&stream.clean())?;
-    let (faulty_twin, _) = check::twin(&uplink)?;
+    let (twin, navs) = check::twin(&stream.clean(), config)?;
+    let (faulty_twin, _) = check::twin(&uplink, config)?;
     let twin_s = t_twin.elapsed().as_secs_f64();
 
     let reset = match (reset_at_s, reset_after_us) {
@@ -336,6 +344,7 @@ fn play(elf: &Path, pass: &Pass, reset_at_s: Option<f64>) -> Result<Played> {
             &uplink,
             cut.unwrap_or(uplink.len()),
             boot_instructions,
+            config,
         )?),
         (Some(at_s), None) => bail!("the pass never reached {at_s} s: no reset was made"),
     };
@@ -343,10 +352,18 @@ fn play(elf: &Path, pass: &Pass, reset_at_s: Option<f64>) -> Result<Played> {
         None => compare_with_twin(&firmware, &twin),
         Some(r) => (r.changed, Vec::new()),
     };
-    let controller = check::new_controller()?;
+    let controller = check::new_controller(config)?;
     let t_check = Instant::now();
+    let (rel_tolerance, tolerance_note) = if config.fixed_point_pixels {
+        (
+            F32_REL_TOLERANCE + EARTH_FIXED_REL_TOLERANCE,
+            "the f32 update and the fixed-point pixels",
+        )
+    } else {
+        (F32_REL_TOLERANCE, "the f32 closed form")
+    };
     let (max_rel, max_ticks, compared, reference_failures) =
-        reference_check(&firmware, &navs, &controller)?;
+        reference_check(&firmware, &navs, &controller, rel_tolerance)?;
     let truth = match pass.truth.agile() {
         Some(a) => Some(truth::check(a, &firmware, &controller)?),
         None => None,
@@ -397,6 +414,8 @@ fn play(elf: &Path, pass: &Pass, reset_at_s: Option<f64>) -> Result<Played> {
         max_ticks,
         compared,
         reference_failures,
+        rel_tolerance,
+        tolerance_note,
         changed,
         changed_examples,
         final_status,
@@ -457,6 +476,7 @@ fn reference_check(
     firmware: &Downlink,
     inputs: &BTreeMap<u64, check::InForce>,
     controller: &controller::Controller,
+    rel_tolerance: f64,
 ) -> Result<(f64, f64, usize, Vec<String>)> {
     let mut max_rel = 0.0f64;
     let mut max_ticks = 0.0f64;
@@ -497,7 +517,7 @@ fn reference_check(
             max_rel = max_rel.max(rel);
             max_ticks = max_ticks.max(diff);
             compared += 1;
-            if diff > F32_REL_TOLERANCE * exact + 0.5 {
+            if diff > rel_tolerance * exact + 0.5 {
                 failures.push(format!(
                     "update at {:.3} s, segment {}: {} ticks, reference {exact:.3} (relative {rel:.2e})",
                     t_us as f64 * 1e-6,

@@ -85,7 +85,7 @@ pub fn run_elf(elf: &Path, options: &Options) -> Result<Outcome> {
     let board = Board::of_elf(&bytes).with_context(|| format!("{}", elf.display()))?;
 
     let mut cmd = Command::new(QEMU);
-    cmd.args(["-cpu", "cortex-m4", "-machine", board.qemu_machine()])
+    cmd.args(["-cpu", board.qemu_cpu(), "-machine", board.qemu_machine()])
         .args(["-nographic", "-monitor", "none"])
         .arg("-serial")
         .arg(options.serial.as_deref().unwrap_or("none"))

@@ -13,6 +13,7 @@ use std::sync::mpsc::{channel, Receiver, Sender};
 
 use controller::frame::{kind, Decoder, Event};
 use controller::report::Periods;
+use controller::Config;
 
 use super::check::{self, Downlink};
 use crate::qemu::{bench, tools};
@@ -43,9 +44,10 @@ impl Trigger {
         qmp: PathBuf,
         uplink: &[u8],
         elf: &Path,
+        config: Config,
     ) -> Result<(Trigger, Receiver<()>)> {
         let cut = check::cut_before(uplink, (at_s * 1e6).round() as u64);
-        let (_, sent) = check::host_run(uplink.get(..cut).unwrap_or_default())?;
+        let (_, sent) = check::host_run(uplink.get(..cut).unwrap_or_default(), config)?;
         let after_frames = check::frame_count(&sent);
         if after_frames == 0 {
             bail!("--reset-at {at_s}: the firmware sends nothing before that instant");
@@ -201,6 +203,7 @@ impl Report {
         uplink: &[u8],
         cut: usize,
         boot_instructions: Option<u64>,
+        config: Config,
     ) -> Result<Report> {
         // The first STATUS of the firmware after its reset (resets since power-on > 0).
         let boot = firmware
@@ -256,7 +259,7 @@ impl Report {
             None => unlike_model.push("no STATUS after the reset: nothing to model".into()),
             Some((cause, resets)) => {
                 let (before, rest) = uplink.split_at(cut.min(uplink.len()));
-                let (mut sent, after) = check::reset_twin(before, rest, cause, u32::from(resets))?;
+                let (mut sent, after) = check::reset_twin(before, rest, cause, u32::from(resets), config)?;
                 sent.extend_from_slice(&after);
                 let model = Downlink::decode(&sent);
                 modelled = (model.periods.len(), model.status.len());

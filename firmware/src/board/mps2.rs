@@ -1,5 +1,9 @@
-//! Board `mps2-an386` (the default): QEMU's `-machine mps2-an386`, a Cortex-M4 with FPU
-//! and the Cortex-M System Design Kit's APB peripherals at fixed addresses. No HAL or
+//! Boards `mps2-an386` (the default) and `mps2-an385`: QEMU's `-machine mps2-an386`, a
+//! Cortex-M4 with FPU, and `-machine mps2-an385`, a Cortex-M3 without one. Both FPGA
+//! images put the Cortex-M System Design Kit's APB peripherals at the same fixed
+//! addresses, on the same interrupt lines and APB clock (QEMU hw/arm/mps2.c, which
+//! builds both from one code path; ARM AN385 and AN386), so only the core and the
+//! board's name differ. No HAL or
 //! peripheral access crate exists for it: the peripherals are driven through the
 //! register blocks and drivers of [`cmsdk`](super::cmsdk). UART0 is the telemetry link;
 //! TIMER0 stands in for segment 0's line clock; TIMER1, free-running, is the
@@ -17,7 +21,11 @@ use crate::retained::{self, ResetCause};
 use crate::{rx, tx};
 
 /// The board's name (the cargo feature).
+#[cfg(feature = "mps2-an386")]
 pub const NAME: &str = "mps2-an386";
+/// The board's name (the cargo feature).
+#[cfg(feature = "mps2-an385")]
+pub const NAME: &str = "mps2-an385";
 /// The telemetry link's peripheral.
 pub const LINK: &str = "UART0";
 /// The board's telemetry link, segment 0's line clock and clock.
@@ -75,27 +83,27 @@ pub fn take() -> Result<Parts<Link, LineClock, Clock, Watchdog>, BoardError> {
     })
 }
 
-/// UART0's receive interrupt on the mps2-an386 (NVIC line 0; QEMU hw/arm/mps2.c).
+/// UART0's receive interrupt on the MPS2 (NVIC line 0; QEMU hw/arm/mps2.c).
 #[derive(Clone, Copy)]
 pub struct Uart0Rx;
 
 const UART0_RX_IRQ: u16 = 0;
 
-// SAFETY: 0 is the NVIC line QEMU's mps2-an386 wires UART0's RX interrupt to.
+// SAFETY: 0 is the NVIC line QEMU's mps2-an385 and mps2-an386 wire UART0's RX interrupt to.
 unsafe impl cortex_m::interrupt::InterruptNumber for Uart0Rx {
     fn number(self) -> u16 {
         UART0_RX_IRQ
     }
 }
 
-/// UART0's transmit interrupt on the mps2-an386 (NVIC line 1: each UART's TX line is
+/// UART0's transmit interrupt on the MPS2 (NVIC line 1: each UART's TX line is
 /// its RX line + 1; QEMU hw/arm/mps2.c).
 #[derive(Clone, Copy)]
 pub struct Uart0Tx;
 
 const UART0_TX_IRQ: u16 = 1;
 
-// SAFETY: 1 is the NVIC line QEMU's mps2-an386 wires UART0's TX interrupt to.
+// SAFETY: 1 is the NVIC line QEMU's mps2-an385 and mps2-an386 wire UART0's TX interrupt to.
 unsafe impl cortex_m::interrupt::InterruptNumber for Uart0Tx {
     fn number(self) -> u16 {
         UART0_TX_IRQ
@@ -117,7 +125,7 @@ unsafe fn NonMaskableInt() {
     cortex_m::peripheral::SCB::sys_reset()
 }
 
-/// Every device interrupt. The mps2-an386 has no peripheral access crate to name its
+/// Every device interrupt. The MPS2 has no peripheral access crate to name its
 /// vectors, so cortex-m-rt's default vector table sends them all here with their
 /// number; only UART0's receive and transmit interrupts are ever unmasked. (`unsafe` because
 /// cortex-m-rt asks it of a `DefaultHandler`; nothing in it is.)
