@@ -201,6 +201,12 @@ fn main() -> ! {
         }
         Err(()) => 1,
     };
+    if stack::boot_window_overrun() {
+        defmt::warn!(
+            "stack: the boot used all {=usize} bytes painted for it; the mark below is a lower bound",
+            stack::BOOT_WINDOW_BYTES
+        );
+    }
     defmt::info!(
         "stack high-water mark: {=usize} bytes (the session, in static memory: {=usize} bytes)",
         stack::high_water_mark_bytes(),

@@ -22,7 +22,7 @@
 //! how `flip-link` would do it too, from the other side (the stack below `.bss`, the
 //! fault from the end of RAM); the MPU needs no extra linker and works on every board.
 
-use core::sync::atomic::{AtomicUsize, Ordering};
+use core::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
 use cortex_m::peripheral::MPU;
 
@@ -87,6 +87,15 @@ pub fn guard(mpu: &mut MPU) -> Option<core::ops::Range<usize>> {
 /// (docs/target.md). A mark of this size or more says the boot went past it.
 pub const BOOT_WINDOW_BYTES: usize = 12 * 1024;
 
+/// Set by [`paint_rest`] when the boot's frames had reached the bottom of the boot
+/// window: then the high-water mark is a lower bound, not the peak.
+static BOOT_WINDOW_OVERRUN: AtomicBool = AtomicBool::new(false);
+
+/// Whether the boot used the whole window painted for it ([`BOOT_WINDOW_OVERRUN`]).
+pub fn boot_window_overrun() -> bool {
+    BOOT_WINDOW_OVERRUN.load(Ordering::Relaxed)
+}
+
 /// Paints the [`BOOT_WINDOW_BYTES`] below the caller's frame (down to the region's
 /// bottom at most); returns the lowest address painted, for [`paint_rest`].
 #[inline(never)]
@@ -104,6 +113,11 @@ pub fn paint_boot_window() -> usize {
 #[inline(never)]
 pub fn paint_rest(painted: usize) {
     let low = (&raw const _stack_end) as usize;
+    // SAFETY: `painted` is a word of the stack region that `paint_boot_window` painted,
+    // below every frame since unless the boot reached it: a read.
+    let reached = painted > low
+        && unsafe { core::ptr::read_volatile(painted as *const u32) } != STACK_PAINT_VALUE;
+    BOOT_WINDOW_OVERRUN.store(reached, Ordering::Relaxed);
     paint(low, painted);
 }
 

@@ -194,14 +194,13 @@ pub struct Report {
 }
 
 impl Report {
-    /// `uplink` was cut at `cut` for the reset.
+    /// The uplink was cut in `before` and `rest` for the reset.
     pub fn new(
         reset_after_us: u64,
         firmware: &Downlink,
         twin: &Downlink,
         log: &[String],
-        uplink: &[u8],
-        cut: usize,
+        (before, rest): (&[u8], &[u8]),
         boot_instructions: Option<u64>,
         config: Config,
     ) -> Result<Report> {
@@ -258,8 +257,8 @@ impl Report {
         match boot {
             None => unlike_model.push("no STATUS after the reset: nothing to model".into()),
             Some((cause, resets)) => {
-                let (before, rest) = uplink.split_at(cut.min(uplink.len()));
-                let (mut sent, after) = check::reset_twin(before, rest, cause, u32::from(resets), config)?;
+                let (mut sent, after) =
+                    check::reset_twin(before, rest, cause, u32::from(resets), config)?;
                 sent.extend_from_slice(&after);
                 let model = Downlink::decode(&sent);
                 modelled = (model.periods.len(), model.status.len());
