@@ -100,9 +100,6 @@ pub fn measure(log_to_stderr: bool) -> Result<BenchCounts> {
 /// index in the run, 0 being the empty region) too.
 fn measure_on(board: Board, log_to_stderr: bool, profile: Option<usize>) -> Result<BenchCounts> {
     ensure_target_tools()?;
-    if !tools::have("gcc") {
-        tools::apt_install(&["gcc", "libc6-dev"], "gcc (to build the QEMU plugin)")?;
-    }
     let elf = build_firmware(board, "bench", true, &["bench"], &[])?;
     let dir = elf
         .parent()
@@ -171,6 +168,9 @@ fn measure_on(board: Board, log_to_stderr: bool, profile: Option<usize>) -> Resu
 
 /// Compiles the plugin next to the bench ELF (a few hundred ms with gcc).
 pub(super) fn build_plugin(dir: &Path) -> Result<PathBuf> {
+    if !tools::have("gcc") {
+        tools::apt_install(&["gcc", "libc6-dev"], "gcc (to build the QEMU plugin)")?;
+    }
     let source = workspace_root().join(PLUGIN_SOURCE);
     let out = dir.join("libstopwatch.so");
     let status = Command::new("gcc")

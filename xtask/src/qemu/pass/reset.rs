@@ -16,7 +16,7 @@ use controller::report::Periods;
 use controller::Config;
 
 use super::check::{self, Downlink};
-use crate::qemu::{bench, tools};
+use crate::qemu::bench;
 
 /// The reset to make: between two frames of the uplink, once the firmware has answered
 /// every frame before the cut, through QEMU's QMP socket.
@@ -114,9 +114,6 @@ pub struct BootCount {
 
 impl BootCount {
     pub fn new(elf: &Path) -> Result<BootCount> {
-        if !tools::have("gcc") {
-            tools::apt_install(&["gcc", "libc6-dev"], "gcc (to build the QEMU plugin)")?;
-        }
         let dir = elf.parent().context("the ELF has no folder")?;
         let plugin = bench::build_plugin(dir)?;
         let start = bench::symbol_address(elf, |n| n == "Reset").context("`Reset`")?;
