@@ -18,12 +18,65 @@ use controller::Config;
 use super::check::{self, Downlink};
 use crate::qemu::bench;
 
+/// When to reset, and how much of the uplink the reset loses.
+#[derive(Clone, Copy, Debug)]
+pub struct Plan {
+    pub at_s: f64,
+    /// Frames tagged in `at_s .. at_s + loses_s` never reach the firmware.
+    pub loses_s: f64,
+}
+
+impl Plan {
+    /// A reset at `at_s` losing `loses_s` of frames, checked against a pass ending at
+    /// `end_us`.
+    pub fn new(at_s: f64, loses_s: f64, end_us: u64) -> Result<Plan> {
+        check_instant(at_s, end_us)?;
+        if !(loses_s >= 0.0 && (at_s + loses_s) * 1e6 < end_us as f64) {
+            bail!(
+                "--reset-loses {loses_s}: the frames lost must end before the pass does ({:.1} s)",
+                end_us as f64 * 1e-6
+            );
+        }
+        Ok(Plan { at_s, loses_s })
+    }
+
+    /// Where `uplink` is cut for the reset and where it resumes after it.
+    pub fn cuts(&self, uplink: &[u8]) -> (usize, usize) {
+        let cut = check::cut_before(uplink, (self.at_s * 1e6).round() as u64);
+        let resume = if self.loses_s > 0.0 {
+            let until_us = ((self.at_s + self.loses_s) * 1e6).round() as u64;
+            check::cut_before(uplink, until_us).max(cut)
+        } else {
+            cut
+        };
+        (cut, resume)
+    }
+}
+
+/// The uplink around a reset: what the firmware gets before it, what the reset loses,
+/// what it gets after.
+pub struct Uplink<'a> {
+    pub before: &'a [u8],
+    pub lost: &'a [u8],
+    pub rest: &'a [u8],
+}
+
+impl<'a> Uplink<'a> {
+    pub fn split(uplink: &'a [u8], cut: usize, resume: usize) -> Uplink<'a> {
+        let (before, after) = uplink.split_at(cut.min(uplink.len()));
+        let (lost, rest) = after.split_at(resume.saturating_sub(cut).min(after.len()));
+        Uplink { before, lost, rest }
+    }
+}
+
 /// The reset to make: between two frames of the uplink, once the firmware has answered
 /// every frame before the cut, through QEMU's QMP socket.
 pub struct Trigger {
     pub qmp: PathBuf,
     /// Uplink bytes sent before the reset; the rest follows once the firmware is up.
     pub cut: usize,
+    /// Where the uplink resumes after the reset: `cut` plus the bytes the reset loses.
+    pub resume: usize,
     /// Frames the firmware sends for those bytes (a host run of them says how many).
     after_frames: usize,
     decoder: Decoder,
@@ -37,16 +90,17 @@ pub struct Trigger {
 }
 
 impl Trigger {
-    /// A reset after the frames of `uplink` tagged before `at_s`; the receiver hears
-    /// when it is made.
+    /// A reset after the frames of `uplink` tagged before the plan's instant; the
+    /// receiver hears when it is made.
     pub fn new(
-        at_s: f64,
+        plan: Plan,
         qmp: PathBuf,
         uplink: &[u8],
         elf: &Path,
         config: Config,
     ) -> Result<(Trigger, Receiver<()>)> {
-        let cut = check::cut_before(uplink, (at_s * 1e6).round() as u64);
+        let at_s = plan.at_s;
+        let (cut, resume) = plan.cuts(uplink);
         let (_, sent) = check::host_run(uplink.get(..cut).unwrap_or_default(), config)?;
         let after_frames = check::frame_count(&sent);
         if after_frames == 0 {
@@ -56,6 +110,7 @@ impl Trigger {
         let trigger = Trigger {
             qmp,
             cut,
+            resume,
             after_frames,
             decoder: Decoder::new(),
             seen: 0,
@@ -186,18 +241,27 @@ pub struct Report {
     pub unlike_model: Vec<String>,
     /// Guest instructions from the reset vector to the first period written.
     pub boot_instructions: Option<u64>,
+    /// Updates whose PERIODS differ from the host's model of the same reset run on the
+    /// uplink without its injected faults, with examples: what the faults changed.
+    pub changed_by_faults: (usize, Vec<String>),
+    /// The frames the reset lost, by kind, and the last one's time tag.
+    pub lost: BTreeMap<u8, usize>,
+    pub lost_until_us: Option<u64>,
     /// The core's clock, from the firmware's boot line.
     pub core_clock_hz: Option<f64>,
 }
 
 impl Report {
-    /// The uplink was cut in `before` and `rest` for the reset.
+    /// The uplink was cut in `before`, `lost` and `rest` for the reset; `clean` is the
+    /// uplink without its injected faults, cut at the same instants.
+    #[allow(clippy::too_many_arguments)]
     pub fn new(
         reset_after_us: u64,
         firmware: &Downlink,
         twin: &Downlink,
         log: &[String],
-        (before, rest): (&[u8], &[u8]),
+        Uplink { before, lost, rest }: Uplink,
+        clean: Uplink,
         boot_instructions: Option<u64>,
         config: Config,
     ) -> Result<Report> {
@@ -249,8 +313,17 @@ impl Report {
                 }
             }
         }
+        let mut lost_kinds = BTreeMap::new();
+        let mut lost_until_us = None;
+        Decoder::new().feed(lost, |e| {
+            if let Event::Frame(f) = e {
+                *lost_kinds.entry(f.kind).or_insert(0) += 1;
+                lost_until_us = Some(f.time_us);
+            }
+        });
         let mut unlike_model = Vec::new();
         let mut modelled = (0, 0);
+        let mut changed_by_faults = (0, Vec::new());
         match boot {
             None => unlike_model.push("no STATUS after the reset: nothing to model".into()),
             Some((cause, resets)) => {
@@ -258,6 +331,11 @@ impl Report {
                     check::reset_twin(before, rest, cause, u32::from(resets), config)?;
                 sent.extend_from_slice(&after);
                 let model = Downlink::decode(&sent);
+                let (mut clean_sent, clean_after) =
+                    check::reset_twin(clean.before, clean.rest, cause, u32::from(resets), config)?;
+                clean_sent.extend_from_slice(&clean_after);
+                changed_by_faults =
+                    super::compare_with_twin(firmware, &Downlink::decode(&clean_sent));
                 modelled = (model.periods.len(), model.status.len());
                 if let Some(k) = (0..firmware.periods.len().max(model.periods.len()))
                     .find(|&k| firmware.periods.get(k) != model.periods.get(k))
@@ -293,6 +371,9 @@ impl Report {
             unlike_model,
             boot_instructions,
             core_clock_hz,
+            changed_by_faults,
+            lost: lost_kinds,
+            lost_until_us,
         })
     }
 
@@ -317,6 +398,18 @@ impl Report {
             self.cause,
             self.changed
         );
+        if let Some(until_us) = self.lost_until_us {
+            let kinds: Vec<String> = self
+                .lost
+                .iter()
+                .map(|(k, n)| format!("{n} {}", kind_name(*k)))
+                .collect();
+            println!(
+                "reset loss: the firmware never got {} (tagged up to {:.2} s); the host's model of the reset loses the same",
+                kinds.join(", "),
+                until_us as f64 * 1e-6
+            );
+        }
         let (periods, status) = self.modelled;
         let verdict = if self.unlike_model.is_empty() {
             "equal"
@@ -336,14 +429,32 @@ impl Report {
         if self.fresh_at_us.is_none() {
             p.push("no fresh update after the reset".into());
         }
-        p.extend(self.examples.iter().cloned());
+        // A reset that loses frames may change later outputs, as the same loss would
+        // without a reset: then the host's model of it is the check.
+        if self.lost.is_empty() {
+            p.extend(self.examples.iter().cloned());
+        }
         p.extend(self.unlike_model.iter().cloned());
         p
     }
 }
 
+/// A frame kind's name in the reset's loss line.
+fn kind_name(k: u8) -> String {
+    match k {
+        kind::NAV => "NAV".into(),
+        kind::SCENE => "SCENE".into(),
+        kind::TERRAIN => "TERRAIN".into(),
+        kind::TIME => "TIME".into(),
+        kind::GNSS => "GNSS".into(),
+        kind::ATTITUDE => "ATTITUDE".into(),
+        kind::TIME_SCALES => "TIME_SCALES".into(),
+        other => format!("kind {other:#04x}"),
+    }
+}
+
 /// The reset instant on the command line, checked against the pass.
-pub fn check_instant(at_s: f64, end_us: u64) -> Result<()> {
+fn check_instant(at_s: f64, end_us: u64) -> Result<()> {
     if !(at_s > 0.0 && at_s * 1e6 < end_us as f64) {
         return Err(anyhow!(
             "--reset-at {at_s}: the pass runs from 0 to {:.1} s",
