@@ -134,40 +134,34 @@ impl Controller {
         out.fill(|b| encode_periods(self, b))
     }
 
-    /// Puts `snapshot` back after a reset: each period into `sink` first (a record whose
-    /// segment the snapshot's scene does not have active, or whose period is 0, is
-    /// skipped), then the scene, planned, and its heights; every output restored is
-    /// flagged held. The NAV state, the clock, the counters stay as they are (a
-    /// controller fresh from [`Controller::blank`]: waiting for NAV).
-    ///
-    /// The checks are those of the frames: a payload that does not decode, a scene the
-    /// planner refuses or heights out of range give that fault and change nothing but
-    /// the registers already written, whose periods the snapshot held in force before.
-    // Not inlined: its frames (a decoded PERIODS payload, a scene) exist only while it
-    // runs, once after a reset, not in every frame of its caller.
-    #[inline(never)]
+    /// Puts `snapshot` back after a reset: [`write_kept_periods`], then
+    /// [`Controller::restore_kept`].
     pub fn restore<S: LinePeriodSink>(
         &mut self,
         snapshot: &Snapshot,
         sink: &mut S,
     ) -> Result<Restored, Fault> {
+        let kept = write_kept_periods(snapshot, sink)?;
+        self.restore_kept(snapshot, kept)
+    }
+
+    /// The rest of a restore once [`write_kept_periods`] has put the periods back: the
+    /// scene, planned, and its heights; every output written is flagged held. The NAV
+    /// state, the clock, the counters stay as they are (a controller fresh from
+    /// [`Controller::blank`]: waiting for NAV).
+    ///
+    /// The checks are those of the frames: heights out of range or a scene the planner
+    /// refuses give that fault and change nothing but the registers already written,
+    /// whose periods the snapshot held in force before.
+    // Not inlined: its frames (a decoded PERIODS payload, a scene) exist only while it
+    // runs, once after a reset, not in every frame of its caller.
+    #[inline(never)]
+    pub fn restore_kept(&mut self, snapshot: &Snapshot, kept: Kept) -> Result<Restored, Fault> {
+        // Decoded again rather than carried from `write_kept_periods`: the boot's
+        // deepest frames are these, and the stack budget is tighter than the time here.
+        let written = kept.written;
         let periods = Periods::decode(snapshot.periods.as_slice()).ok_or(Fault::BadLength)?;
         let scene = Scene::decode(snapshot.scene.as_slice())?;
-        let active = |index: u8| {
-            scene
-                .active()
-                .any(|(k, _)| usize::from(index) == k && k < MAX_SEGMENTS)
-        };
-        let mut written = [false; MAX_SEGMENTS];
-        for r in periods
-            .records()
-            .iter()
-            .filter(|r| r.ticks != 0 && active(r.index))
-        {
-            if let Some(w) = written.get_mut(usize::from(r.index)) {
-                *w = sink.write_period(r.index, r.ticks).is_ok();
-            }
-        }
         let terrain = Terrain::decode(snapshot.terrain.as_slice(), &scene)?;
         self.set_scene(scene)?;
         self.heights_m = terrain.heights_m;
@@ -186,4 +180,41 @@ impl Controller {
             periods: written.iter().filter(|w| **w).count(),
         })
     }
+}
+
+/// What [`write_kept_periods`] did: which segments' periods went into the sink.
+#[derive(Clone, Copy, Debug)]
+pub struct Kept {
+    written: [bool; MAX_SEGMENTS],
+}
+
+/// The first step after a reset, before the controller exists: each kept period into
+/// `sink` (a record whose segment the kept scene does not have active, or whose period
+/// is 0, is skipped). A payload that does not decode gives that fault and writes
+/// nothing. Needs no [`Controller`], so that a board can program its line clocks before
+/// it builds one (docs/target.md, "Faults and resets").
+// Not inlined: its frames (a decoded PERIODS payload, a scene) exist only while it runs.
+#[inline(never)]
+pub fn write_kept_periods<S: LinePeriodSink>(
+    snapshot: &Snapshot,
+    sink: &mut S,
+) -> Result<Kept, Fault> {
+    let periods = Periods::decode(snapshot.periods.as_slice()).ok_or(Fault::BadLength)?;
+    let scene = Scene::decode(snapshot.scene.as_slice())?;
+    let active = |index: u8| {
+        scene
+            .active()
+            .any(|(k, _)| usize::from(index) == k && k < MAX_SEGMENTS)
+    };
+    let mut written = [false; MAX_SEGMENTS];
+    for r in periods
+        .records()
+        .iter()
+        .filter(|r| r.ticks != 0 && active(r.index))
+    {
+        if let Some(w) = written.get_mut(usize::from(r.index)) {
+            *w = sink.write_period(r.index, r.ticks).is_ok();
+        }
+    }
+    Ok(Kept { written })
 }

@@ -9,51 +9,78 @@
 #![no_std]
 #![no_main]
 
+use controller::restart::{self, Kept, Snapshot};
 use controller::session::Session;
-use controller::{Controller, LinePeriodSink, Scene};
+use controller::{Controller, Fault, LinePeriodSink, Scene};
+use core::mem::MaybeUninit;
+use core::sync::atomic::{AtomicBool, Ordering};
 use cortex_m_rt::entry;
 use firmware::board::{self, Monotonic, Parts};
 use firmware::line_clock::LineClocks;
 use firmware::link::FrameTx;
 use firmware::{heartbeat, platform, retained, rx, stack, telemetry, tx};
-use static_cell::StaticCell;
 
 /// The controller and its link state live here, not on `main`'s stack: the stack
-/// budget (12 KiB, docs/target.md) cannot hold them beside the update's frames.
-static SESSION: StaticCell<Session> = StaticCell::new();
+/// budget (12 KiB, docs/target.md) cannot hold them beside the update's frames. In
+/// `.uninit`, not `.bss`: the start-up code would zero it word by word before `main`,
+/// on the way to the first period after a reset, and [`blank_session`] writes all of it
+/// anyway.
+#[link_section = ".uninit.SESSION"]
+static mut SESSION: MaybeUninit<Session> = MaybeUninit::uninit();
+/// Set once [`blank_session`] has handed out [`SESSION`].
+static SESSION_TAKEN: AtomicBool = AtomicBool::new(false);
 
 /// The session, blank (no scene yet). Its own function, never inlined: the blank value
 /// passes through this frame once, at boot, and the frame is gone before the telemetry
 /// loop runs (docs/target.md, "Stack").
-/// None only if called twice (`main` calls it once): `try_init_with`, because
-/// `init_with` would panic there (docs/no-panic.md).
+/// None only if called twice (`main` calls it once): a flag, not a panic
+/// (docs/no-panic.md).
 #[inline(never)]
 fn blank_session() -> Option<&'static mut Session> {
-    SESSION.try_init_with(|| Session::new(Controller::blank(board::controller_config())))
+    if SESSION_TAKEN.swap(true, Ordering::AcqRel) {
+        return None;
+    }
+    // SAFETY: the flag lets exactly one caller past, once, so this is the only
+    // reference to `SESSION` there will ever be.
+    let slot = unsafe { &mut *core::ptr::addr_of_mut!(SESSION) };
+    Some(slot.write(Session::new(Controller::blank(board::controller_config()))))
 }
 
-/// Puts the snapshot kept before a reset back: the periods into the registers first,
-/// then the scene and heights, every period flagged held until fresh telemetry
-/// (`controller::restart`). Err if it did not check out (then the default scene). Not
-/// inlined, so that its frames are not part of `main`'s through the whole pass.
+/// The periods of the snapshot kept before a reset, back into the registers: the first
+/// thing after the board is up, before the session exists (`controller::restart`).
+/// Not inlined, so that its frames are not part of `main`'s through the whole pass.
 #[inline(never)]
-fn restore<C: Monotonic>(
-    session: &mut Session,
-    snapshot: &controller::restart::Snapshot,
+fn write_kept_periods<C: Monotonic>(
+    snapshot: &Snapshot,
     clocks: &mut LineClocks<board::LineClock>,
     clock: &mut C,
-) -> Result<(), ()> {
+) -> Result<(Kept, Option<u64>), Fault> {
     let mut timed = FirstWrite {
         sink: clocks,
         clock,
         at_us: None,
     };
-    match session.controller.restore(snapshot, &mut timed) {
-        Ok(restored) => {
+    let kept = restart::write_kept_periods(snapshot, &mut timed)?;
+    Ok((kept, timed.at_us))
+}
+
+/// The rest of the snapshot back into the session: the scene and heights, every period
+/// written flagged held until fresh telemetry. Err if it did not check out (then the
+/// default scene). Not inlined, for the same reason.
+#[inline(never)]
+fn restore(
+    session: &mut Session,
+    snapshot: &Snapshot,
+    kept: Result<(Kept, Option<u64>), Fault>,
+) -> Result<(), ()> {
+    match kept
+        .and_then(|(kept, at_us)| Ok((session.controller.restore_kept(snapshot, kept)?, at_us)))
+    {
+        Ok((restored, at_us)) => {
             defmt::info!(
                 "restored after the reset: {=usize} periods programmed {=u64} us after the board came up, held until fresh telemetry",
                 restored.periods,
-                timed.at_us.unwrap_or(0)
+                at_us.unwrap_or(0)
             );
             Ok(())
         }
@@ -88,9 +115,46 @@ impl<S: LinePeriodSink, C: Monotonic> LinePeriodSink for FirstWrite<'_, S, C> {
     }
 }
 
+/// What [`start`] gives `main`.
+struct Start {
+    session: &'static mut Session,
+    /// Ok if the kept snapshot was put back.
+    restored: Result<(), ()>,
+    /// The lowest address of the stack's first paint, for `stack::paint_rest`.
+    painted: usize,
+}
+
+/// The kept periods into the registers, the stack's first paint, the session built and
+/// the rest of the snapshot put back. Its own frame, never inlined: what the restore
+/// carries from the first step to the last (the kept scene and periods) lives here
+/// during the boot, not in `main`'s frame through the whole pass.
+#[inline(never)]
+fn start<C: Monotonic>(
+    boot: &retained::Boot,
+    clocks: &mut LineClocks<board::LineClock>,
+    clock: &mut C,
+) -> Start {
+    let kept = retained::snapshot(boot)
+        .map(|snapshot| (snapshot, write_kept_periods(snapshot, clocks, clock)));
+    let painted = stack::paint_boot_window();
+    let Some(session) = blank_session() else {
+        defmt::error!("the session was already taken");
+        platform::exit(1)
+    };
+    session.controller.note_boot(boot.cause, boot.resets);
+    let restored = match kept {
+        Some((snapshot, kept)) => restore(session, snapshot, kept),
+        None => Err(()),
+    };
+    Start {
+        session,
+        restored,
+        painted,
+    }
+}
+
 #[entry]
 fn main() -> ! {
-    let painted = stack::paint_boot_window();
     let Parts {
         mut link,
         line_clock,
@@ -107,18 +171,15 @@ fn main() -> ! {
         }
     };
     // After a reset the last periods go back into the registers first, before anything
-    // else that takes time (logging included): docs/target.md, "Faults and resets".
+    // else that takes time (the stack's paint, the session, logging): docs/target.md,
+    // "Faults and resets".
     let boot = retained::boot(reset_cause);
     let mut clocks = LineClocks::new(line_clock);
-    let Some(session) = blank_session() else {
-        defmt::error!("the session was already taken");
-        platform::exit(1)
-    };
-    session.controller.note_boot(boot.cause, boot.resets);
-    let restored = match retained::snapshot(&boot) {
-        Some(snapshot) => restore(session, snapshot, &mut clocks, &mut clock),
-        None => Err(()),
-    };
+    let Start {
+        session,
+        restored,
+        painted,
+    } = start(&boot, &mut clocks, &mut clock);
     stack::paint_rest(painted);
     // The host's pass player starts sending when it reads this line (a link that is not
     // enabled yet may drop bytes): keep `telemetry::READY` in it.
