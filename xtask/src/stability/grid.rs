@@ -45,11 +45,54 @@ pub struct Panel<C> {
     pub bound: Option<f64>,
 }
 
-/// `best` and `slot` become `v` and `w` when there is no sample yet or `v` is larger.
-pub fn take<T>(best: &mut f64, slot: &mut Option<T>, v: f64, w: Option<T>) {
-    if slot.is_none() || v > *best {
-        *best = v;
-        *slot = w;
+/// The largest value of one quantity over a cell's samples (or an aggregate's cells),
+/// and the sample behind it: each maximum a cell keeps is one of these, so that the
+/// value and where it was found cannot drift apart.
+#[derive(Clone, Copy, Debug)]
+pub struct Worst<S> {
+    pub max: f64,
+    pub at: Option<S>,
+}
+
+impl<S> Default for Worst<S> {
+    fn default() -> Self {
+        Worst { max: 0.0, at: None }
+    }
+}
+
+impl<S: Copy> Worst<S> {
+    /// Takes `v` at `at` when nothing is held yet or `v` is larger (the first sample is
+    /// kept whatever its value, so that a cell with samples always names one).
+    pub fn offer(&mut self, v: f64, at: S) {
+        self.take(v, Some(at));
+    }
+
+    /// Takes `v` at `at` only when it is larger than what is held (0 while empty).
+    pub fn raise(&mut self, v: f64, at: S) {
+        if v > self.max {
+            *self = Worst {
+                max: v,
+                at: Some(at),
+            };
+        }
+    }
+
+    /// Folds another cell's maximum of the same quantity into this one, as `offer`.
+    pub fn merge(&mut self, o: &Worst<S>) {
+        self.take(o.max, o.at);
+    }
+
+    /// Folds another cell's maximum in, as `raise`.
+    pub fn merge_raise(&mut self, o: &Worst<S>) {
+        if o.max > self.max {
+            *self = *o;
+        }
+    }
+
+    fn take(&mut self, v: f64, at: Option<S>) {
+        if self.at.is_none() || v > self.max {
+            *self = Worst { max: v, at };
+        }
     }
 }
 
@@ -64,6 +107,18 @@ pub trait Cell: Clone + Send {
     fn n(&self) -> u64;
     /// Folds another cell (or aggregate of cells) into this one.
     fn merge(&mut self, other: &Self);
+    /// Each stated bound this cell (or aggregate) breaks, and each refusal, one line each.
+    fn broken(&self) -> Vec<String>;
+}
+
+/// What breaks a stated bound anywhere in `maps`, each line headed by its map's key.
+pub fn broken<C: Cell>(maps: &[Map<C>]) -> Vec<String> {
+    let key_each = |m: &Map<C>| {
+        let key = m.spec.key;
+        let bad = m.aggregate(|_, _| true).broken();
+        bad.into_iter().map(move |b| format!("{key}: {b}"))
+    };
+    maps.iter().flat_map(key_each).collect()
 }
 
 /// A swept map: the cells, row-major from the bottom row (index iy * nx + ix).
@@ -199,6 +254,17 @@ impl<C: Cell> Map<C> {
         }
         Ok(())
     }
+}
+
+/// Sweeps every map of `specs` with its cells divided by `div` each way and `sub`
+/// sub-samples per cell (None: the spec's).
+pub fn sweep_all<C: Cell>(
+    specs: &'static [Spec<C::Point>],
+    div: usize,
+    sub: Option<usize>,
+) -> Vec<Map<C>> {
+    let sweep = |s| Map::sweep(s, s.nx / div, s.ny / div, sub.unwrap_or(s.sub));
+    specs.iter().map(sweep).collect()
 }
 
 /// Sub-sample `s` of `sub`: offsets in (0, 1) within the cell, stratified in x and
