@@ -200,45 +200,12 @@ impl<C: Cell> Map<C> {
     pub fn samples(&self) -> u64 {
         self.cells.iter().map(C::n).sum()
     }
-
-    /// A heatmap of `value` over the cells, titled by the map's letter, the largest
-    /// cell marked, `bound` (in plotted units) marked on the colour bar;
-    /// `z_decades`: `z_range` and the values are log10.
-    pub fn heatmap(
-        &self,
-        (title, z_label): (&str, &str),
-        (z_range, z_decades): ((f64, f64), bool),
-        value: impl Fn(&C) -> f64,
-        bound: Option<f64>,
-    ) -> Heatmap {
-        let s = self.spec;
-        let mut h = Heatmap::new(
-            &format!("{}: {title}", s.letter),
-            s.x_label,
-            s.y_label,
-            z_label,
-            (self.nx, self.ny),
-            self.values(&value),
-        )
-        .x_range(s.x_range.0, s.x_range.1)
-        .y_range(s.y_range.0, s.y_range.1)
-        .y_decades(s.y_decades)
-        .z_range(z_range.0, z_range.1)
-        .z_decades(z_decades)
-        .missing_label(s.missing);
-        if let Some(b) = bound {
-            h = h.z_mark(b);
-        }
-        if let Some((ix, iy)) = self.argmax(&value) {
-            let (x, y) = self.centre(ix, iy);
-            h = h.mark(x, y);
-        }
-        h
-    }
 }
 
 impl<C: Cell> Map<C> {
-    /// Writes one PNG per panel into `dir`, named `<key>-<suffix>.png`.
+    /// Writes one PNG per panel into `dir`, named `<key>-<suffix>.png`: the panel's value
+    /// over the cells, titled by the map's letter, the largest cell ringed and the bound
+    /// marked on the colour bar.
     pub fn write_pngs<'a>(
         &self,
         panels: impl IntoIterator<Item = &'a Panel<C>>,
@@ -247,10 +214,34 @@ impl<C: Cell> Map<C> {
     where
         C: 'a,
     {
+        let s = self.spec;
         for p in panels {
+            let title = format!("{}: {}", s.letter, p.title);
+            let values = self.values(p.value);
             let bound = p.bound.map(|b| if p.linear { b } else { b.log10() });
-            let h = self.heatmap((p.title, p.z_label), (p.z_range, !p.linear), p.value, bound);
-            h.save(&dir.join(format!("{}-{}.png", self.spec.key, p.suffix)))?;
+            let argmax = self.argmax(p.value);
+            let h = Heatmap {
+                x_range: s.x_range,
+                y_range: s.y_range,
+                z_range: p.z_range,
+                y_decades: s.y_decades,
+                z_decades: !p.linear,
+                marks: argmax
+                    .map(|(ix, iy)| self.centre(ix, iy))
+                    .into_iter()
+                    .collect(),
+                z_marks: bound.into_iter().collect(),
+                missing_label: s.missing.into(),
+                ..Heatmap::new(
+                    &title,
+                    s.x_label,
+                    s.y_label,
+                    p.z_label,
+                    (self.nx, self.ny),
+                    values,
+                )
+            };
+            h.save(&dir.join(format!("{}-{}.png", s.key, p.suffix)))?;
         }
         Ok(())
     }
