@@ -58,7 +58,7 @@ pub fn run(args: &Args) -> Result<()> {
     let t1 = Instant::now();
     let gmaps = grid::sweep_all(&general::GMAPS, div, None);
     let gsecs = t1.elapsed().as_secs_f64();
-    let mut values = figures(&maps, quick, secs);
+    let mut values = figures(&maps, secs);
     values.extend(general::figures(&gmaps, gsecs));
     println!("{}", values["summary_table"]);
     println!("{}", values["bound_line"]);
@@ -107,12 +107,11 @@ fn map_by_key<'a>(maps: &'a [Map], key: &str) -> &'a Map {
 }
 
 /// Every value the document quotes, by template key.
-fn figures(maps: &[Map], quick: bool, secs: f64) -> BTreeMap<String, String> {
+fn figures(maps: &[Map], secs: f64) -> BTreeMap<String, String> {
     let mut v = BTreeMap::new();
     let mut put = |k: &str, s: String| {
         v.insert(k.to_string(), s);
     };
-    put("mode", if quick { "quick" } else { "full" }.into());
     put("secs", format!("{secs:.1}"));
     put(
         "threads",
@@ -146,13 +145,7 @@ fn figures(maps: &[Map], quick: bool, secs: f64) -> BTreeMap<String, String> {
             ),
         );
         put("others", m.spec.others.into());
-        put("key", m.spec.key.into());
-        for (what, w) in [
-            ("worst_f32", &a.ratio_f32),
-            ("worst_f32_in", &a.ratio_f32_in),
-            ("worst_fixed", &a.ratio_fixed),
-            ("max_kappa", &a.kappa),
-        ] {
+        for (what, w) in [("worst_f32", &a.ratio_f32), ("max_kappa", &a.kappa)] {
             if let Some((p, o)) = &w.at {
                 for (k, s) in sample_figures(what, p, o) {
                     put(&k, s);
@@ -167,7 +160,6 @@ fn figures(maps: &[Map], quick: bool, secs: f64) -> BTreeMap<String, String> {
         put("e_f32", e2(a.err.f32));
         put("e_f32_in", e2(a.err.f32_in));
         put("e_fixed", e2(a.err.fixed_worst()));
-        put("max_v1_terms", format!("{:.4}", a.v1_term_ratio));
         rows.push((format!("{letter}: {}", m.spec.title), a.clone()));
         all.push(a);
     }
@@ -178,11 +170,7 @@ fn figures(maps: &[Map], quick: bool, secs: f64) -> BTreeMap<String, String> {
     put("ratio_fixed", format!("{:.2}", whole.ratio_fixed.max));
     put("e_f32", e2(whole.err.f32));
     put("e_fixed", e2(whole.err.fixed_worst()));
-    for (what, w) in [
-        ("f32", &whole.ratio_f32),
-        ("f32_in", &whole.ratio_f32_in),
-        ("fixed", &whole.ratio_fixed),
-    ] {
+    for (what, w) in [("f32", &whole.ratio_f32), ("fixed", &whole.ratio_fixed)] {
         if let Some((p, o)) = &w.at {
             for (k, s) in sample_figures(&format!("worst.{what}"), p, o) {
                 put(&k, s);

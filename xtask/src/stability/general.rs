@@ -493,7 +493,6 @@ pub fn figures(maps: &[GMap], secs: f64) -> std::collections::BTreeMap<String, S
             ),
         );
         put("others", m.spec.others.into());
-        put("key", m.spec.key.into());
         put("ratio", format!("{:.2}", a.ratio.max));
         put("kappa_max", sig(a.kappa.max));
         put("err", e2(a.err.max));
@@ -632,11 +631,6 @@ pub fn figures(maps: &[GMap], secs: f64) -> std::collections::BTreeMap<String, S
                 format!("{} - {}", sig(a.kappa_min), sig(a.kappa.max)),
             );
             put(&format!("{l}.far_err"), e2(a.err.max));
-            let grey = d.cells.iter().filter(|c| c.n == 0).count();
-            put(
-                &format!("{l}.grey_pct"),
-                format!("{:.0}", 100.0 * grey as f64 / d.cells.len() as f64),
-            );
         }
     }
     // Map F: the fraction of the rate square where kappa > 30 and where err > 2e-6.
@@ -653,18 +647,6 @@ pub fn figures(maps: &[GMap], secs: f64) -> std::collections::BTreeMap<String, S
             frac(&|c| c.kappa.max > EARTH_F32_KAPPA_LIMIT),
         );
         put("F.pct_over", frac(&|c| c.over_tol > 0));
-        if let Some((c, o)) = &f.aggregate(|_, _| true).kappa.at {
-            let a = &c.geometry.attitude;
-            put("F.cancel.v", e2(o.v));
-            put(
-                "F.cancel.rates",
-                format!(
-                    "pitch rate {:.3} deg/s, roll rate {:.3} deg/s",
-                    a.pitch_rate_rad_s.to_degrees(),
-                    a.roll_rate_rad_s.to_degrees()
-                ),
-            );
-        }
         // The reference |v| at zero rates, nadir pixel, for scale.
         let k0 = case(H0_KM, I0_SSO_DEG, G0_DEG, Attitude::default(), 0.0);
         if let Ok(o) = evaluate(&k0) {
