@@ -22,12 +22,13 @@ use std::time::Instant;
 
 // Map A's limb-margin bands are the accuracy report's buckets, so that its table and
 // this document's split the margin the same way.
+use crate::accuracy::U_F32;
 use crate::accuracy::{bucket, BUCKETS_DEG};
 use crate::markdown::{e2, sig};
 use doc::{agg_table, describe, parts};
 use grid::Cell as _;
 use maps::{Cell, Map, MAPS};
-use point::{Outcome, Point, U_F32, U_FIXED};
+use point::{Outcome, Point, U_FIXED};
 
 /// The stated bounds: f32 error (at the same or at the unrounded inputs) <= C_F32 kappa u,
 /// fixed error <= C_FIXED kappa u_fx, at every sample of every map.

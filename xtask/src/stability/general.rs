@@ -24,7 +24,7 @@ use crate::markdown::{e2, sig, table};
 use super::doc::lg;
 use super::grid::{self, Cell as _, Panel, Spec, Worst};
 use super::maps::I0_SSO_DEG;
-use super::point::U_F32;
+use crate::accuracy::U_F32;
 
 /// The paper's camera on the detector line through the optical axis.
 pub const CAMERA: EarthCamera = EarthCamera {
