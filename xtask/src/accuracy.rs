@@ -24,8 +24,8 @@ use core_math::{
 
 use crate::eval::Model;
 
-/// Unit roundoff of f32.
-pub(crate) const U32: f64 = f32::EPSILON as f64 / 2.0;
+/// Unit roundoff of f32, 2^-24.
+pub(crate) const U_F32: f64 = f32::EPSILON as f64 / 2.0;
 
 /// Limb-margin buckets (deg): a case falls in the first bucket whose lower bound it meets.
 /// Shared with `stability`'s limb table, so that the two documents' bands are the same.
@@ -202,7 +202,7 @@ fn sweep_geometry(camera: &Camera, g: &Geometry<f64>, step: usize, stats: &mut [
             let e_in = ((m32.speed_mps() as f64) - exact.speed_mps()).abs() / exact.speed_mps();
             s.max_cond = s.max_cond.max(cond);
             s.max_input_rounding = s.max_input_rounding.max(e_in);
-            let bound = cond * U32 + F32_REL_TOLERANCE;
+            let bound = cond * U_F32 + F32_REL_TOLERANCE;
             s.max_explained = s.max_explained.max(e_in / bound);
         }
     }
@@ -302,7 +302,7 @@ fn earth(quick: bool) -> Result<()> {
         st.f32.push(e);
         let kappa = earth_kappa(&c.camera, &c.geometry, c.n_px).map_err(|e| anyhow!("{e}"))?;
         st.kappa_max = st.kappa_max.max(kappa);
-        st.ratio_max = st.ratio_max.max(e / (kappa * U32));
+        st.ratio_max = st.ratio_max.max(e / (kappa * U_F32));
         if kappa > EARTH_F32_KAPPA_LIMIT {
             st.stiff += 1;
         } else {

@@ -298,9 +298,7 @@ impl From<ModelError> for RowError {
     }
 }
 
-/// The output text: the input header and the model's outputs, then each input row as
-/// given followed by its numbers and an empty error, or by empty numbers and the
-/// error's name.
+/// The output text of Part I: [`write_rows`] with the model's outputs.
 fn eval_rows<M: Columns>(
     text: &str,
     eval: impl Fn(&Case<M>) -> Result<Vec<String>, RowError>,
@@ -311,28 +309,39 @@ fn eval_rows<M: Columns>(
         .iter()
         .map(|(name, _)| table.header.iter().position(|h| h == name))
         .collect();
-    let header: Vec<&str> = table
-        .header
-        .iter()
-        .map(String::as_str)
-        .chain(M::OUTPUTS.iter().copied())
-        .collect();
+    write_rows(&table, M::OUTPUTS, &[], |row| {
+        let v = parse_row(row, &required, &optional, M::OPTIONAL)?;
+        Ok((eval(&M::case(&v))?, Vec::new()))
+    })
+}
+
+/// The output text: the input header, `outputs` (`error` last) and `extra`, then each
+/// input row as given followed by its numbers, an empty error and its extra cells, or by
+/// empty numbers, the error's name and empty extra cells.
+fn write_rows(
+    table: &Table,
+    outputs: &[&str],
+    extra: &[&str],
+    row_out: impl Fn(&[String]) -> Result<(Vec<String>, Vec<String>), RowError>,
+) -> Result<String> {
+    let input = table.header.iter().map(String::as_str);
+    let header: Vec<&str> = input.chain(outputs.iter().chain(extra).copied()).collect();
     let mut out = Writer::new("", &header)?;
-    let blank = vec![String::new(); M::OUTPUTS.len() - 1];
+    let blank = (
+        vec![String::new(); outputs.len() - 1],
+        vec![String::new(); extra.len()],
+    );
     for row in &table.rows {
-        let (nums, error) = match parse_row(row, &required, &optional, M::OPTIONAL)
-            .and_then(|v| eval(&M::case(&v)))
-        {
-            Ok(nums) => (nums, ""),
+        let ((nums, more), error) = match row_out(row) {
+            Ok(cells) => (cells, ""),
             Err(e) => (blank.clone(), e.name()),
         };
-        let fields: Vec<&str> = row
-            .iter()
-            .chain(&nums)
-            .map(String::as_str)
-            .chain([error])
-            .collect();
-        out.row(&fields)?;
+        let fields = row.iter().chain(&nums).map(String::as_str).chain([error]);
+        out.row(
+            &fields
+                .chain(more.iter().map(String::as_str))
+                .collect::<Vec<_>>(),
+        )?;
     }
     out.into_string()
 }

@@ -30,7 +30,7 @@ use core_math::sphere::{
 };
 use core_math::{Backend, Camera, EarthReference, ImageMotion, GENERAL_F32, GENERAL_F64};
 
-use crate::accuracy::percentile;
+use crate::accuracy::{percentile, U_F32};
 use crate::markdown;
 use crate::qemu::{bench_counts, BenchCounts};
 
@@ -352,9 +352,7 @@ fn earth_sweep(seed: u64, cases: usize, errors: &mut [Errors]) -> (usize, EarthF
             continue;
         };
         split.all += 1;
-        split.ratio = split
-            .ratio
-            .max(err / (kappa * f64::from(f32::EPSILON) / 2.0));
+        split.ratio = split.ratio.max(err / (kappa * U_F32));
         if kappa > EARTH_F32_KAPPA_LIMIT {
             split.stiff += 1;
         } else if is_near {

@@ -132,6 +132,20 @@ fn period_err(truth: &ImageMotion<f64>, model: &ImageMotion<f64>) -> f64 {
     truth.v1_mps.abs() / model.v1_mps.abs() - 1.0
 }
 
+/// The period error of a simplification that drops what `drop` changes: the truth at
+/// `g` against the truth at `g` so changed.
+fn dropped(
+    g: &EarthGeometry<f64>,
+    cam: &EarthCamera,
+    n: f64,
+    drop: impl FnOnce(&mut EarthGeometry<f64>),
+) -> Option<f64> {
+    let t = truth(g, cam, n)?;
+    let mut m = *g;
+    drop(&mut m);
+    Some(period_err(&t, &truth(&m, cam, n)?))
+}
+
 /// How a row compares the model's motion with the truth's.
 type ErrFn = fn(&ImageMotion<f64>, &ImageMotion<f64>) -> f64;
 
@@ -344,11 +358,8 @@ pub fn costs(grid: Grid) -> Costs {
         default: Some(over_default(
             &cases,
             |c, s| {
-                let t = truth(&wgs(*s, roll_only(c.roll_rad), TERRAIN_M), &cam, c.n)?;
-                Some(period_err(
-                    &t,
-                    &truth(&wgs(*s, roll_only(c.roll_rad), 0.0), &cam, c.n)?,
-                ))
+                let g = wgs(*s, roll_only(c.roll_rad), TERRAIN_M);
+                dropped(&g, &cam, c.n, |m| m.ground_h_m = 0.0)
             },
             circ,
         )),
@@ -356,10 +367,7 @@ pub fn costs(grid: Grid) -> Costs {
             still(g);
             g.attitude.yaw_rad = 0.0;
             g.ground_h_m = TERRAIN_M;
-            let t = truth(g, cam, n)?;
-            let mut m = *g;
-            m.ground_h_m = 0.0;
-            Some(period_err(&t, &truth(&m, cam, n)?))
+            dropped(g, cam, n, |m| m.ground_h_m = 0.0)
         })),
         envelope_note: "rates 0, yaw 0, h = 9 km, the rest of the envelope",
     });
@@ -439,11 +447,7 @@ pub fn costs(grid: Grid) -> Costs {
                 |c, s| {
                     let mut a = roll_only(c.roll_rad);
                     a.pitch_rad = pitch;
-                    let t = truth(&wgs(*s, a, 0.0), &cam, c.n)?;
-                    Some(period_err(
-                        &t,
-                        &truth(&wgs(*s, roll_only(c.roll_rad), 0.0), &cam, c.n)?,
-                    ))
+                    dropped(&wgs(*s, a, 0.0), &cam, c.n, |m| m.attitude.pitch_rad = 0.0)
                 },
                 circ,
             )),
@@ -451,10 +455,7 @@ pub fn costs(grid: Grid) -> Costs {
                 over_envelope(draws, |g, cam, n| {
                     still(g);
                     g.attitude.yaw_rad = 0.0;
-                    let t = truth(g, cam, n)?;
-                    let mut m = *g;
-                    m.attitude.pitch_rad = 0.0;
-                    Some(period_err(&t, &truth(&m, cam, n)?))
+                    dropped(g, cam, n, |m| m.attitude.pitch_rad = 0.0)
                 })
             }),
             envelope_note:
@@ -468,20 +469,16 @@ pub fn costs(grid: Grid) -> Costs {
         default: Some(over_default(
             &cases,
             |c, s| {
-                let g0 = wgs(*s, roll_only(c.roll_rad), 0.0);
-                let mut g = g0;
-                g.attitude.yaw_rad = steering_yaw(&g0, &cam)?;
-                Some(period_err(&truth(&g, &cam, c.n)?, &truth(&g0, &cam, c.n)?))
+                let mut g = wgs(*s, roll_only(c.roll_rad), 0.0);
+                g.attitude.yaw_rad = steering_yaw(&g, &cam)?;
+                dropped(&g, &cam, c.n, |m| m.attitude.yaw_rad = 0.0)
             },
             circ,
         )),
         envelope: Some(over_envelope(draws, |g, cam, n| {
             still(g);
             g.attitude.yaw_rad /= 18.0;
-            let t = truth(g, cam, n)?;
-            let mut m = *g;
-            m.attitude.yaw_rad = 0.0;
-            Some(period_err(&t, &truth(&m, cam, n)?))
+            dropped(g, cam, n, |m| m.attitude.yaw_rad = 0.0)
         })),
         envelope_note: "rates 0, yaw within +-10 deg (at any yaw unbounded: v1 -> 0 as the \
                         yaw nears 90 deg), the rest of the envelope",
@@ -538,14 +535,7 @@ pub fn costs(grid: Grid) -> Costs {
         truth: "WGS 84, the attitude with its rates",
         model: "the same with the rates 0",
         default: None,
-        envelope: Some(over_envelope(draws, |g, cam, n| {
-            let t = truth(g, cam, n)?;
-            let mut m = *g;
-            m.attitude.roll_rate_rad_s = 0.0;
-            m.attitude.pitch_rate_rad_s = 0.0;
-            m.attitude.yaw_rate_rad_s = 0.0;
-            Some(period_err(&t, &truth(&m, cam, n)?))
-        })),
+        envelope: Some(over_envelope(draws, |g, cam, n| dropped(g, cam, n, still))),
         envelope_note: "the whole envelope (unbounded where the rates cancel v1)",
     });
 

@@ -399,44 +399,19 @@ pub(super) fn eval_bus_rows(
     }
     let with_ground = dem.is_some() || table.header.iter().any(|h| h == "frame");
     let extra: &[&str] = if with_ground { &GROUND_OUTPUTS } else { &[] };
-    let header: Vec<&str> = table
-        .header
-        .iter()
-        .map(String::as_str)
-        .chain(Earth::OUTPUTS.iter().copied())
-        .chain(extra.iter().copied())
-        .collect();
-    let mut out = Writer::new("", &header)?;
-    let blank = vec![String::new(); Earth::OUTPUTS.len() - 1];
-    let blank_ground = vec![String::new(); extra.len()];
-    for row in &table.rows {
+    write_rows(&table, Earth::OUTPUTS, extra, |row| {
         let cells = RowCells {
             header: &table.header,
             row,
         };
-        let result = bus_case(&cells, dem.is_some()).and_then(|case| {
-            let nums = eval(&case)?;
-            let ground = if with_ground {
-                ground_point(&case, dem)?.map(|x| x.to_string()).to_vec()
-            } else {
-                Vec::new()
-            };
-            Ok((nums, ground))
-        });
-        let (nums, ground, error) = match result {
-            Ok((nums, ground)) => (nums, ground, ""),
-            Err(e) => (blank.clone(), blank_ground.clone(), e.name()),
+        let case = bus_case(&cells, dem.is_some())?;
+        let nums = eval(&case)?;
+        let ground = match with_ground {
+            true => ground_point(&case, dem)?.map(|x| x.to_string()).to_vec(),
+            false => Vec::new(),
         };
-        let fields: Vec<&str> = row
-            .iter()
-            .chain(&nums)
-            .map(String::as_str)
-            .chain([error])
-            .chain(ground.iter().map(String::as_str))
-            .collect();
-        out.row(&fields)?;
-    }
-    out.into_string()
+        Ok((nums, ground))
+    })
 }
 
 #[cfg(test)]

@@ -4,13 +4,14 @@
 //! [`super::Plot`], and the same bytes on every run.
 //!
 //! ```ignore
-//! Heatmap::new("Title", "x (unit)", "y (unit)", "log10 err", (nx, ny), values)
-//!     .x_range(0.0, 1.0)
-//!     .y_range(-5.0, 2.0)
-//!     .y_decades(true)
-//!     .z_range(-10.0, -4.0)
-//!     .z_decades(true)
-//!     .save(Path::new("out.png"))?;
+//! let map = Heatmap {
+//!     y_range: (-5.0, 2.0),
+//!     y_decades: true,
+//!     z_range: (-10.0, -4.0),
+//!     z_decades: true,
+//!     ..Heatmap::new("Title", "x (unit)", "y (unit)", "log10 err", (nx, ny), values)
+//! };
+//! map.save(Path::new("out.png"))?;
 //! ```
 
 use anyhow::{bail, Result};
@@ -101,46 +102,6 @@ impl Heatmap {
             width: 860,
             height: 600,
         }
-    }
-
-    pub fn x_range(mut self, lo: f64, hi: f64) -> Self {
-        self.x_range = (lo, hi);
-        self
-    }
-
-    pub fn y_range(mut self, lo: f64, hi: f64) -> Self {
-        self.y_range = (lo, hi);
-        self
-    }
-
-    pub fn z_range(mut self, lo: f64, hi: f64) -> Self {
-        self.z_range = (lo, hi);
-        self
-    }
-
-    pub fn y_decades(mut self, on: bool) -> Self {
-        self.y_decades = on;
-        self
-    }
-
-    pub fn z_decades(mut self, on: bool) -> Self {
-        self.z_decades = on;
-        self
-    }
-
-    pub fn mark(mut self, x: f64, y: f64) -> Self {
-        self.marks.push((x, y));
-        self
-    }
-
-    pub fn z_mark(mut self, z: f64) -> Self {
-        self.z_marks.push(z);
-        self
-    }
-
-    pub fn missing_label(mut self, s: &str) -> Self {
-        self.missing_label = s.to_string();
-        self
     }
 
     fn axis((lo, hi): (f64, f64), decades: bool) -> Result<Axis> {
@@ -315,14 +276,16 @@ mod tests {
                 }
             })
             .collect();
-        Heatmap::new("t", "x", "y", "z", (nx, ny), values)
-            .x_range(0.0, 7.0)
-            .y_range(-5.0, 0.0)
-            .y_decades(true)
-            .z_range(-8.0, -1.0)
-            .z_decades(true)
-            .mark(3.5, -2.5)
-            .z_mark(-2.0)
+        Heatmap {
+            x_range: (0.0, 7.0),
+            y_range: (-5.0, 0.0),
+            y_decades: true,
+            z_range: (-8.0, -1.0),
+            z_decades: true,
+            marks: vec![(3.5, -2.5)],
+            z_marks: vec![-2.0],
+            ..Heatmap::new("t", "x", "y", "z", (nx, ny), values)
+        }
     }
 
     /// The maps under docs/stability/ are committed: regenerating one must give the same
@@ -350,7 +313,10 @@ mod tests {
     fn refuses_bad_shapes() {
         let h = Heatmap::new("t", "x", "y", "z", (2, 2), vec![Some(1.0); 3]);
         assert!(h.to_png().is_err());
-        let h = Heatmap::new("t", "x", "y", "z", (2, 2), vec![Some(1.0); 4]).z_range(1.0, 1.0);
+        let h = Heatmap {
+            z_range: (1.0, 1.0),
+            ..Heatmap::new("t", "x", "y", "z", (2, 2), vec![Some(1.0); 4])
+        };
         assert!(h.to_png().is_err());
     }
 }

@@ -42,7 +42,7 @@ const PANELS: [Panel; 6] = [
         z_label: "kappa",
         z_range: (0.0, 4.0),
         linear: false,
-        value: |c| lg(c.kappa),
+        value: |c| lg(c.kappa.max),
         bound: None,
     },
     Panel {
@@ -78,7 +78,7 @@ const PANELS: [Panel; 6] = [
         z_label: "err / (kappa u)",
         z_range: RATIO_RANGE,
         linear: false,
-        value: |c| lg(c.ratio_f32.max(c.ratio_f32_in)),
+        value: |c| lg(c.ratio_f32.max.max(c.ratio_f32_in.max)),
         bound: Some(C_F32),
     },
     Panel {
@@ -87,7 +87,7 @@ const PANELS: [Panel; 6] = [
         z_label: "err / (kappa u_fx)",
         z_range: RATIO_RANGE,
         linear: false,
-        value: |c| lg(c.ratio_fixed),
+        value: |c| lg(c.ratio_fixed.max),
         bound: Some(C_FIXED),
     },
 ];
@@ -112,7 +112,7 @@ fn kappa_panel(map: &Map) -> Panel {
         .iter()
         .filter(|c| c.n > 0)
         .fold((f64::INFINITY, 0.0f64), |(l, h), c| {
-            (l.min(c.kappa), h.max(c.kappa))
+            (l.min(c.kappa.max), h.max(c.kappa.max))
         });
     // Also when the map is empty (lo = inf) or flat.
     if lo.partial_cmp(&hi) != Some(std::cmp::Ordering::Less) || hi / lo >= 10.0 {
@@ -124,7 +124,7 @@ fn kappa_panel(map: &Map) -> Panel {
     Panel {
         z_range: (lo.floor(), hi.ceil()),
         linear: true,
-        value: |c| c.kappa,
+        value: |c| c.kappa.max,
         ..PANELS[0]
     }
 }
@@ -159,15 +159,15 @@ fn agg_row(first: String, a: &Cell) -> Vec<String> {
     vec![
         first,
         a.n.to_string(),
-        format!("{} - {}", sig(a.kappa_min), sig(a.kappa)),
+        format!("{} - {}", sig(a.kappa_min), sig(a.kappa.max)),
         e2(a.err.f32),
         e2(a.err.f32_v1),
         e2(a.err.f32_in),
         e2(a.err.fixed_worst()),
         e2(a.err.fixed_v1),
-        f2(a.ratio_f32),
-        f2(a.ratio_f32_in),
-        f2(a.ratio_fixed),
+        f2(a.ratio_f32.max),
+        f2(a.ratio_f32_in.max),
+        f2(a.ratio_fixed.max),
         format!("{} - {}", sig(a.kq.0), sig(a.kq.1)),
         a.refused.to_string(),
     ]
@@ -197,7 +197,7 @@ pub fn limb_slope(map: &Map, margin_deg: f64) -> Option<(f64, usize)> {
     let pts: Vec<(f64, f64)> = map
         .cells
         .iter()
-        .filter_map(|c| c.max_kappa)
+        .filter_map(|c| c.kappa.at)
         .filter(|(_, o)| o.margin_rad.to_degrees() < margin_deg)
         .map(|(_, o)| (o.q.log10(), o.kappa.log10()))
         .collect();

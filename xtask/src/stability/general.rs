@@ -22,9 +22,9 @@ use std::path::Path;
 use crate::markdown::{e2, sig, table};
 
 use super::doc::lg;
-use super::grid::{self, take, Cell as _, Panel, Spec};
+use super::grid::{self, Cell as _, Panel, Spec, Worst};
 use super::maps::I0_SSO_DEG;
-use super::point::U_F32;
+use crate::accuracy::U_F32;
 
 /// The paper's camera on the detector line through the optical axis.
 pub const CAMERA: EarthCamera = EarthCamera {
@@ -241,31 +241,29 @@ pub fn evaluate(c: &EarthCase) -> Result<GOutcome, GSkip> {
     })
 }
 
+/// A case of a general map: where, and what it measured.
+pub type GSample = (EarthCase, GOutcome);
+
 /// Maxima over a cell's (or a set of cells') cases, with the case behind each.
 #[derive(Clone, Debug, Default)]
 pub struct GCell {
     pub n: u64,
     pub refused: u64,
-    pub err: f64,
-    pub err_v1: f64,
-    pub kappa: f64,
+    pub err: Worst<GSample>,
+    pub err_v1: Worst<GSample>,
+    pub kappa: Worst<GSample>,
     pub kappa_min: f64,
-    pub ratio: f64,
+    /// err/(kappa u32).
+    pub ratio: Worst<GSample>,
     pub min_margin_rad: f64,
     /// Cases with err above EARTH_F32_REL_TOLERANCE (2e-6), and the smallest kappa among them.
     pub over_tol: u64,
     pub over_tol_kappa_min: f64,
     /// The largest error among the cases with kappa <= EARTH_F32_KAPPA_LIMIT and at least
     /// 1 deg inside the limb (where the 2e-6 bound is stated).
-    pub err_tame: f64,
-    pub tame: Option<(EarthCase, GOutcome)>,
-    /// The largest |dv1|/|v1| where the drift is under 60 deg (|v1| >= |v|/2), and the case.
-    pub err_v1_steady: f64,
-    pub steady: Option<(EarthCase, GOutcome)>,
-    pub worst: Option<(EarthCase, GOutcome)>,
-    pub max_kappa: Option<(EarthCase, GOutcome)>,
-    pub max_err: Option<(EarthCase, GOutcome)>,
-    pub max_err_v1: Option<(EarthCase, GOutcome)>,
+    pub tame: Worst<GSample>,
+    /// The largest |dv1|/|v1| where the drift is under 60 deg (|v1| >= |v|/2).
+    pub steady: Worst<GSample>,
 }
 
 impl grid::Cell for GCell {
@@ -298,23 +296,34 @@ impl grid::Cell for GCell {
         self.min_margin_rad = self.min_margin_rad.min(o.min_margin_rad);
         self.over_tol += o.over_tol;
         self.over_tol_kappa_min = self.over_tol_kappa_min.min(o.over_tol_kappa_min);
-        if o.err_tame > self.err_tame {
-            self.err_tame = o.err_tame;
-            self.tame = o.tame;
+        self.tame.merge_raise(&o.tame);
+        self.steady.merge_raise(&o.steady);
+        self.ratio.merge(&o.ratio);
+        self.kappa.merge(&o.kappa);
+        self.err.merge(&o.err);
+        self.err_v1.merge(&o.err_v1);
+    }
+
+    /// A case at least [`MIN_MARGIN_DEG`] inside the limb that breaks
+    /// err <= EARTH_F32_KAPPA_C kappa u32, or one the f32 backend refused although the
+    /// reference accepts it.
+    fn broken(&self) -> Vec<String> {
+        let mut bad = Vec::new();
+        if self.ratio.max > EARTH_F32_KAPPA_C {
+            let at = self.ratio.at.map(|(c, o)| describe(&c, &o));
+            bad.push(format!(
+                "general f32 err/(kappa u) = {:.3} > {EARTH_F32_KAPPA_C} at {}",
+                self.ratio.max,
+                at.unwrap_or_default()
+            ));
         }
-        if o.err_v1_steady > self.err_v1_steady {
-            self.err_v1_steady = o.err_v1_steady;
-            self.steady = o.steady;
+        if self.refused > 0 {
+            bad.push(format!(
+                "{} case(s) the reference accepts refused by GENERAL_F32",
+                self.refused
+            ));
         }
-        take(&mut self.ratio, &mut self.worst, o.ratio, o.worst);
-        take(&mut self.kappa, &mut self.max_kappa, o.kappa, o.max_kappa);
-        take(&mut self.err, &mut self.max_err, o.err, o.max_err);
-        take(
-            &mut self.err_v1,
-            &mut self.max_err_v1,
-            o.err_v1,
-            o.max_err_v1,
-        );
+        bad
     }
 }
 
@@ -336,62 +345,22 @@ impl GCell {
             self.over_tol += 1;
             self.over_tol_kappa_min = self.over_tol_kappa_min.min(o.kappa);
         }
-        if o.kappa <= EARTH_F32_KAPPA_LIMIT
-            && o.margin_rad.to_degrees() >= 1.0
-            && o.err > self.err_tame
-        {
-            self.err_tame = o.err;
-            self.tame = Some((*c, *o));
+        let w = (*c, *o);
+        if o.kappa <= EARTH_F32_KAPPA_LIMIT && o.margin_rad.to_degrees() >= 1.0 {
+            self.tame.raise(o.err, w);
         }
-        if o.v1.abs() >= 0.5 * o.v && o.err_v1 > self.err_v1_steady {
-            self.err_v1_steady = o.err_v1;
-            self.steady = Some((*c, *o));
+        if o.v1.abs() >= 0.5 * o.v {
+            self.steady.raise(o.err_v1, w);
         }
-        let w = Some((*c, *o));
-        take(&mut self.ratio, &mut self.worst, o.ratio(), w);
-        take(&mut self.kappa, &mut self.max_kappa, o.kappa, w);
-        take(&mut self.err, &mut self.max_err, o.err, w);
-        take(&mut self.err_v1, &mut self.max_err_v1, o.err_v1, w);
+        self.ratio.offer(o.ratio(), w);
+        self.kappa.offer(o.kappa, w);
+        self.err.offer(o.err, w);
+        self.err_v1.offer(o.err_v1, w);
     }
 }
 
 /// A swept map of the general model.
 pub type GMap = grid::Map<GCell>;
-
-/// Sweeps every general map: full grids, or every dimension divided by `coarse`.
-pub fn sweep_all(coarse: Option<usize>) -> Vec<GMap> {
-    GMAPS
-        .iter()
-        .map(|s| {
-            let c = coarse.unwrap_or(1);
-            GMap::sweep(s, s.nx / c, s.ny / c, s.sub)
-        })
-        .collect()
-}
-
-/// Err if a case at least [`MIN_MARGIN_DEG`] inside the limb breaks
-/// err <= EARTH_F32_KAPPA_C kappa u32, or the f32 backend refused a case the reference
-/// accepts.
-pub fn check_bounds(maps: &[GMap]) -> Vec<String> {
-    let mut bad = Vec::new();
-    for m in maps {
-        let a = m.aggregate(|_, _| true);
-        if a.ratio > EARTH_F32_KAPPA_C {
-            let at = a.worst.map(|(c, o)| describe(&c, &o)).unwrap_or_default();
-            bad.push(format!(
-                "{}: general f32 err/(kappa u) = {:.3} > {EARTH_F32_KAPPA_C} at {at}",
-                m.spec.key, a.ratio
-            ));
-        }
-        if a.refused > 0 {
-            bad.push(format!(
-                "{}: {} case(s) the reference accepts refused by GENERAL_F32",
-                m.spec.key, a.refused
-            ));
-        }
-    }
-    bad
-}
 
 /// Where a case is.
 pub fn describe(c: &EarthCase, o: &GOutcome) -> String {
@@ -427,7 +396,7 @@ pub fn write_pngs(m: &GMap, dir: &Path) -> Result<()> {
         .cells
         .iter()
         .filter(|c| c.n > 0)
-        .fold(1.0f64, |a, c| a.max(c.kappa));
+        .fold(1.0f64, |a, c| a.max(c.kappa.max));
     let panels: [Panel<GCell>; 3] = [
         Panel {
             suffix: "kappa",
@@ -435,7 +404,7 @@ pub fn write_pngs(m: &GMap, dir: &Path) -> Result<()> {
             z_label: "kappa",
             z_range: (0.0, lg(kmax).ceil().max(2.0)),
             linear: false,
-            value: |c| lg(c.kappa),
+            value: |c| lg(c.kappa.max),
             bound: Some(EARTH_F32_KAPPA_LIMIT),
         },
         Panel {
@@ -444,7 +413,7 @@ pub fn write_pngs(m: &GMap, dir: &Path) -> Result<()> {
             z_label: "rel. error",
             z_range: (-9.0, -3.0),
             linear: false,
-            value: |c| lg(c.err),
+            value: |c| lg(c.err.max),
             bound: Some(EARTH_F32_REL_TOLERANCE),
         },
         Panel {
@@ -453,7 +422,7 @@ pub fn write_pngs(m: &GMap, dir: &Path) -> Result<()> {
             z_label: "err / (kappa u)",
             z_range: (-3.0, 1.0),
             linear: false,
-            value: |c| lg(c.ratio),
+            value: |c| lg(c.ratio.max),
             bound: Some(EARTH_F32_KAPPA_C),
         },
     ];
@@ -481,11 +450,11 @@ fn row(name: &str, a: &GCell) -> Vec<String> {
     vec![
         name.to_string(),
         a.n.to_string(),
-        format!("{} - {}", sig(a.kappa_min), sig(a.kappa)),
-        e2(a.err),
-        e2(a.err_v1),
-        if a.err_tame > 0.0 {
-            e2(a.err_tame)
+        format!("{} - {}", sig(a.kappa_min), sig(a.kappa.max)),
+        e2(a.err.max),
+        e2(a.err_v1.max),
+        if a.tame.max > 0.0 {
+            e2(a.tame.max)
         } else {
             "-".into()
         },
@@ -495,7 +464,7 @@ fn row(name: &str, a: &GCell) -> Vec<String> {
         } else {
             "-".into()
         },
-        format!("{:.2}", a.ratio),
+        format!("{:.2}", a.ratio.max),
         sig(a.min_margin_rad.to_degrees()),
         a.refused.to_string(),
     ]
@@ -524,22 +493,21 @@ pub fn figures(maps: &[GMap], secs: f64) -> std::collections::BTreeMap<String, S
             ),
         );
         put("others", m.spec.others.into());
-        put("key", m.spec.key.into());
-        put("ratio", format!("{:.2}", a.ratio));
-        put("kappa_max", sig(a.kappa));
-        put("err", e2(a.err));
-        put("err_v1", e2(a.err_v1));
-        put("err_tame", format!("{:.3e}", a.err_tame));
+        put("ratio", format!("{:.2}", a.ratio.max));
+        put("kappa_max", sig(a.kappa.max));
+        put("err", e2(a.err.max));
+        put("err_v1", e2(a.err_v1.max));
+        put("err_tame", format!("{:.3e}", a.tame.max));
         put("over_tol", a.over_tol.to_string());
         put("over_tol_kappa", sig(a.over_tol_kappa_min));
         for (what, w) in [
-            ("worst", &a.worst),
-            ("max_kappa", &a.max_kappa),
-            ("max_err", &a.max_err),
+            ("worst", &a.ratio),
+            ("max_kappa", &a.kappa),
+            ("max_err", &a.err),
             ("tame", &a.tame),
-            ("max_err_v1", &a.max_err_v1),
+            ("max_err_v1", &a.err_v1),
         ] {
-            if let Some((c, o)) = w {
+            if let Some((c, o)) = &w.at {
                 put(&format!("{what}.at"), describe(c, o));
                 put(&format!("{what}.kappa"), sig(o.kappa));
                 put(&format!("{what}.err"), e2(o.err));
@@ -553,23 +521,23 @@ pub fn figures(maps: &[GMap], secs: f64) -> std::collections::BTreeMap<String, S
     }
     rows.push(row("all general maps", &all));
     put("G.samples", all.n.to_string());
-    put("G.ratio", format!("{:.2}", all.ratio));
-    put("G.kappa_max", sig(all.kappa));
-    put("G.err", e2(all.err));
-    put("G.err_v1", e2(all.err_v1));
-    put("G.err_v1_steady", e2(all.err_v1_steady));
+    put("G.ratio", format!("{:.2}", all.ratio.max));
+    put("G.kappa_max", sig(all.kappa.max));
+    put("G.err", e2(all.err.max));
+    put("G.err_v1", e2(all.err_v1.max));
+    put("G.err_v1_steady", e2(all.steady.max));
     put(
         "G.err_v1_steady_pct",
-        format!("{:.2}", 100.0 * all.err_v1_steady / SEGMENT_BUDGET),
+        format!("{:.2}", 100.0 * all.steady.max / SEGMENT_BUDGET),
     );
-    put("G.err_tame", format!("{:.3e}", all.err_tame));
+    put("G.err_tame", format!("{:.3e}", all.tame.max));
     put("G.over_tol_kappa", sig(all.over_tol_kappa_min));
     for (what, w) in [
-        ("worst", &all.worst),
-        ("max_err_v1", &all.max_err_v1),
+        ("worst", &all.ratio),
+        ("max_err_v1", &all.err_v1),
         ("steady", &all.steady),
     ] {
-        if let Some((c, o)) = w {
+        if let Some((c, o)) = &w.at {
             let mut put = |x: &str, s: String| put(&format!("G.{what}.{x}"), s);
             put("at", describe(c, o));
             put("kappa", sig(o.kappa));
@@ -586,17 +554,17 @@ pub fn figures(maps: &[GMap], secs: f64) -> std::collections::BTreeMap<String, S
         format!(
             "general model (>= {MIN_MARGIN_DEG} deg inside the limb): max err/(kappa u32) {:.2}, \
              bound {EARTH_F32_KAPPA_C}; max kappa {}; max f32 err {} (line period {})",
-            all.ratio,
-            sig(all.kappa),
-            e2(all.err),
-            e2(all.err_v1)
+            all.ratio.max,
+            sig(all.kappa.max),
+            e2(all.err.max),
+            e2(all.err_v1.max)
         ),
     );
     // The line period against a 96-stage segment's budget.
     put("G.budget", format!("{SEGMENT_BUDGET:.2e}"));
     put(
         "G.budget_pct",
-        format!("{:.2}", 100.0 * all.err_v1 / SEGMENT_BUDGET),
+        format!("{:.2}", 100.0 * all.err_v1.max / SEGMENT_BUDGET),
     );
     put(
         "G.budget_kappa",
@@ -634,13 +602,13 @@ pub fn figures(maps: &[GMap], secs: f64) -> std::collections::BTreeMap<String, S
         let near = e.aggregate(|_, y| y < -1.0);
         put(
             "E.near_kappa",
-            format!("{} - {}", sig(near.kappa_min), sig(near.kappa)),
+            format!("{} - {}", sig(near.kappa_min), sig(near.kappa.max)),
         );
         // kappa x margin over each cell's largest-kappa case: kappa ~ 1/q ~ 1/sqrt(margin).
         let km: Vec<f64> = e
             .cells
             .iter()
-            .filter_map(|c| c.max_kappa)
+            .filter_map(|c| c.kappa.at)
             .map(|(_, o)| o.kappa * o.margin_rad.sqrt())
             .collect();
         let (lo, hi) = km
@@ -660,14 +628,9 @@ pub fn figures(maps: &[GMap], secs: f64) -> std::collections::BTreeMap<String, S
             let l = l.replace('\'', "y");
             put(
                 &format!("{l}.far_kappa"),
-                format!("{} - {}", sig(a.kappa_min), sig(a.kappa)),
+                format!("{} - {}", sig(a.kappa_min), sig(a.kappa.max)),
             );
-            put(&format!("{l}.far_err"), e2(a.err));
-            let grey = d.cells.iter().filter(|c| c.n == 0).count();
-            put(
-                &format!("{l}.grey_pct"),
-                format!("{:.0}", 100.0 * grey as f64 / d.cells.len() as f64),
-            );
+            put(&format!("{l}.far_err"), e2(a.err.max));
         }
     }
     // Map F: the fraction of the rate square where kappa > 30 and where err > 2e-6.
@@ -679,20 +642,11 @@ pub fn figures(maps: &[GMap], secs: f64) -> std::collections::BTreeMap<String, S
                 100.0 * f.cells.iter().filter(|c| c.n > 0 && p(c)).count() as f64 / n
             )
         };
-        put("F.pct_stiff", frac(&|c| c.kappa > EARTH_F32_KAPPA_LIMIT));
+        put(
+            "F.pct_stiff",
+            frac(&|c| c.kappa.max > EARTH_F32_KAPPA_LIMIT),
+        );
         put("F.pct_over", frac(&|c| c.over_tol > 0));
-        if let Some((c, o)) = &f.aggregate(|_, _| true).max_kappa {
-            let a = &c.geometry.attitude;
-            put("F.cancel.v", e2(o.v));
-            put(
-                "F.cancel.rates",
-                format!(
-                    "pitch rate {:.3} deg/s, roll rate {:.3} deg/s",
-                    a.pitch_rate_rad_s.to_degrees(),
-                    a.roll_rate_rad_s.to_degrees()
-                ),
-            );
-        }
         // The reference |v| at zero rates, nadir pixel, for scale.
         let k0 = case(H0_KM, I0_SSO_DEG, G0_DEG, Attitude::default(), 0.0);
         if let Ok(o) = evaluate(&k0) {

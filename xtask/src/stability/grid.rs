@@ -45,11 +45,54 @@ pub struct Panel<C> {
     pub bound: Option<f64>,
 }
 
-/// `best` and `slot` become `v` and `w` when there is no sample yet or `v` is larger.
-pub fn take<T>(best: &mut f64, slot: &mut Option<T>, v: f64, w: Option<T>) {
-    if slot.is_none() || v > *best {
-        *best = v;
-        *slot = w;
+/// The largest value of one quantity over a cell's samples (or an aggregate's cells),
+/// and the sample behind it: each maximum a cell keeps is one of these, so that the
+/// value and where it was found cannot drift apart.
+#[derive(Clone, Copy, Debug)]
+pub struct Worst<S> {
+    pub max: f64,
+    pub at: Option<S>,
+}
+
+impl<S> Default for Worst<S> {
+    fn default() -> Self {
+        Worst { max: 0.0, at: None }
+    }
+}
+
+impl<S: Copy> Worst<S> {
+    /// Takes `v` at `at` when nothing is held yet or `v` is larger (the first sample is
+    /// kept whatever its value, so that a cell with samples always names one).
+    pub fn offer(&mut self, v: f64, at: S) {
+        self.take(v, Some(at));
+    }
+
+    /// Takes `v` at `at` only when it is larger than what is held (0 while empty).
+    pub fn raise(&mut self, v: f64, at: S) {
+        if v > self.max {
+            *self = Worst {
+                max: v,
+                at: Some(at),
+            };
+        }
+    }
+
+    /// Folds another cell's maximum of the same quantity into this one, as `offer`.
+    pub fn merge(&mut self, o: &Worst<S>) {
+        self.take(o.max, o.at);
+    }
+
+    /// Folds another cell's maximum in, as `raise`.
+    pub fn merge_raise(&mut self, o: &Worst<S>) {
+        if o.max > self.max {
+            *self = *o;
+        }
+    }
+
+    fn take(&mut self, v: f64, at: Option<S>) {
+        if self.at.is_none() || v > self.max {
+            *self = Worst { max: v, at };
+        }
     }
 }
 
@@ -64,6 +107,18 @@ pub trait Cell: Clone + Send {
     fn n(&self) -> u64;
     /// Folds another cell (or aggregate of cells) into this one.
     fn merge(&mut self, other: &Self);
+    /// Each stated bound this cell (or aggregate) breaks, and each refusal, one line each.
+    fn broken(&self) -> Vec<String>;
+}
+
+/// What breaks a stated bound anywhere in `maps`, each line headed by its map's key.
+pub fn broken<C: Cell>(maps: &[Map<C>]) -> Vec<String> {
+    let key_each = |m: &Map<C>| {
+        let key = m.spec.key;
+        let bad = m.aggregate(|_, _| true).broken();
+        bad.into_iter().map(move |b| format!("{key}: {b}"))
+    };
+    maps.iter().flat_map(key_each).collect()
 }
 
 /// A swept map: the cells, row-major from the bottom row (index iy * nx + ix).
@@ -145,45 +200,12 @@ impl<C: Cell> Map<C> {
     pub fn samples(&self) -> u64 {
         self.cells.iter().map(C::n).sum()
     }
-
-    /// A heatmap of `value` over the cells, titled by the map's letter, the largest
-    /// cell marked, `bound` (in plotted units) marked on the colour bar;
-    /// `z_decades`: `z_range` and the values are log10.
-    pub fn heatmap(
-        &self,
-        (title, z_label): (&str, &str),
-        (z_range, z_decades): ((f64, f64), bool),
-        value: impl Fn(&C) -> f64,
-        bound: Option<f64>,
-    ) -> Heatmap {
-        let s = self.spec;
-        let mut h = Heatmap::new(
-            &format!("{}: {title}", s.letter),
-            s.x_label,
-            s.y_label,
-            z_label,
-            (self.nx, self.ny),
-            self.values(&value),
-        )
-        .x_range(s.x_range.0, s.x_range.1)
-        .y_range(s.y_range.0, s.y_range.1)
-        .y_decades(s.y_decades)
-        .z_range(z_range.0, z_range.1)
-        .z_decades(z_decades)
-        .missing_label(s.missing);
-        if let Some(b) = bound {
-            h = h.z_mark(b);
-        }
-        if let Some((ix, iy)) = self.argmax(&value) {
-            let (x, y) = self.centre(ix, iy);
-            h = h.mark(x, y);
-        }
-        h
-    }
 }
 
 impl<C: Cell> Map<C> {
-    /// Writes one PNG per panel into `dir`, named `<key>-<suffix>.png`.
+    /// Writes one PNG per panel into `dir`, named `<key>-<suffix>.png`: the panel's value
+    /// over the cells, titled by the map's letter, the largest cell ringed and the bound
+    /// marked on the colour bar.
     pub fn write_pngs<'a>(
         &self,
         panels: impl IntoIterator<Item = &'a Panel<C>>,
@@ -192,13 +214,48 @@ impl<C: Cell> Map<C> {
     where
         C: 'a,
     {
+        let s = self.spec;
         for p in panels {
+            let title = format!("{}: {}", s.letter, p.title);
+            let values = self.values(p.value);
             let bound = p.bound.map(|b| if p.linear { b } else { b.log10() });
-            let h = self.heatmap((p.title, p.z_label), (p.z_range, !p.linear), p.value, bound);
-            h.save(&dir.join(format!("{}-{}.png", self.spec.key, p.suffix)))?;
+            let argmax = self.argmax(p.value);
+            let h = Heatmap {
+                x_range: s.x_range,
+                y_range: s.y_range,
+                z_range: p.z_range,
+                y_decades: s.y_decades,
+                z_decades: !p.linear,
+                marks: argmax
+                    .map(|(ix, iy)| self.centre(ix, iy))
+                    .into_iter()
+                    .collect(),
+                z_marks: bound.into_iter().collect(),
+                missing_label: s.missing.into(),
+                ..Heatmap::new(
+                    &title,
+                    s.x_label,
+                    s.y_label,
+                    p.z_label,
+                    (self.nx, self.ny),
+                    values,
+                )
+            };
+            h.save(&dir.join(format!("{}-{}.png", s.key, p.suffix)))?;
         }
         Ok(())
     }
+}
+
+/// Sweeps every map of `specs` with its cells divided by `div` each way and `sub`
+/// sub-samples per cell (None: the spec's).
+pub fn sweep_all<C: Cell>(
+    specs: &'static [Spec<C::Point>],
+    div: usize,
+    sub: Option<usize>,
+) -> Vec<Map<C>> {
+    let sweep = |s| Map::sweep(s, s.nx / div, s.ny / div, sub.unwrap_or(s.sub));
+    specs.iter().map(sweep).collect()
 }
 
 /// Sub-sample `s` of `sub`: offsets in (0, 1) within the cell, stratified in x and

@@ -1,8 +1,10 @@
 //! The three maps of the paper's round Earth: which variables span each, where the
 //! others sit, and what a cell keeps.
 
-use super::grid::{self, take, Spec};
+use super::doc::describe;
+use super::grid::{self, Spec, Worst};
 use super::point::{evaluate, Outcome, Point, RelErrors, Skip, EARTH_RADIUS_M};
+use super::{C_F32, C_FIXED};
 
 /// Sun-synchronous inclination of the paper's orbit (deg).
 pub const I0_SSO_DEG: f64 = 97.98;
@@ -118,8 +120,11 @@ pub const MAPS: [Spec<Point>; 3] = [
     },
 ];
 
-/// What a cell (or an aggregate of cells) keeps of its samples: maxima, and the sample
-/// behind each ratio's max.
+/// A sample of a round-Earth map: where, and what it measured.
+pub type Sample = (Point, Outcome);
+
+/// What a cell (or an aggregate of cells) keeps of its samples: maxima, each with the
+/// sample behind it where the document quotes one.
 #[derive(Clone, Debug, Default)]
 pub struct Cell {
     pub n: u32,
@@ -127,19 +132,16 @@ pub struct Cell {
     pub refused_by: Option<&'static str>,
     /// Quote `err.fixed_worst()` for the fixed |v_P| error, as the maps do.
     pub err: RelErrors,
-    pub kappa: f64,
+    pub kappa: Worst<Sample>,
     pub kappa_min: f64,
-    pub ratio_f32: f64,
-    pub ratio_f32_in: f64,
-    pub ratio_fixed: f64,
+    /// err/(kappa u) of f32 (at the same and at the unrounded inputs) and of fixed.
+    pub ratio_f32: Worst<Sample>,
+    pub ratio_f32_in: Worst<Sample>,
+    pub ratio_fixed: Worst<Sample>,
     pub v1_term_ratio: f64,
     pub min_margin_rad: f64,
     /// min and max of kappa q over the max-kappa sample of each cell.
     pub kq: (f64, f64),
-    pub worst_f32: Option<(Point, Outcome)>,
-    pub worst_f32_in: Option<(Point, Outcome)>,
-    pub worst_fixed: Option<(Point, Outcome)>,
-    pub max_kappa: Option<(Point, Outcome)>,
 }
 
 impl grid::Cell for Cell {
@@ -183,25 +185,32 @@ impl grid::Cell for Cell {
         self.min_margin_rad = self.min_margin_rad.min(o.min_margin_rad);
         self.v1_term_ratio = self.v1_term_ratio.max(o.v1_term_ratio);
         self.kq = (self.kq.0.min(o.kq.0), self.kq.1.max(o.kq.1));
-        take(
-            &mut self.ratio_f32,
-            &mut self.worst_f32,
-            o.ratio_f32,
-            o.worst_f32,
-        );
-        take(
-            &mut self.ratio_f32_in,
-            &mut self.worst_f32_in,
-            o.ratio_f32_in,
-            o.worst_f32_in,
-        );
-        take(
-            &mut self.ratio_fixed,
-            &mut self.worst_fixed,
-            o.ratio_fixed,
-            o.worst_fixed,
-        );
-        take(&mut self.kappa, &mut self.max_kappa, o.kappa, o.max_kappa);
+        self.ratio_f32.merge(&o.ratio_f32);
+        self.ratio_f32_in.merge(&o.ratio_f32_in);
+        self.ratio_fixed.merge(&o.ratio_fixed);
+        self.kappa.merge(&o.kappa);
+    }
+
+    fn broken(&self) -> Vec<String> {
+        let mut bad = Vec::new();
+        for (name, w, c) in [
+            ("f32", &self.ratio_f32, C_F32),
+            ("f32 (unrounded inputs)", &self.ratio_f32_in, C_F32),
+            ("fixed", &self.ratio_fixed, C_FIXED),
+        ] {
+            if w.max > c {
+                let at = w.at.map(|(p, o)| describe(&p, &o)).unwrap_or_default();
+                bad.push(format!("{name} err/(kappa u) = {:.3} > {c} at {at}", w.max));
+            }
+        }
+        if self.refused > 0 {
+            let by = self.refused_by.unwrap_or("a backend");
+            bad.push(format!(
+                "{} case(s) the reference accepts refused by {by}",
+                self.refused
+            ));
+        }
+        bad
     }
 }
 
@@ -212,22 +221,12 @@ impl Cell {
         self.kappa_min = self.kappa_min.min(o.kappa);
         self.min_margin_rad = self.min_margin_rad.min(o.margin_rad);
         self.v1_term_ratio = self.v1_term_ratio.max(o.v1_term_ratio);
-        let w = Some((*pt, *o));
-        take(&mut self.ratio_f32, &mut self.worst_f32, o.ratio_f32(), w);
-        take(
-            &mut self.ratio_f32_in,
-            &mut self.worst_f32_in,
-            o.ratio_f32_in(),
-            w,
-        );
-        take(
-            &mut self.ratio_fixed,
-            &mut self.worst_fixed,
-            o.ratio_fixed(),
-            w,
-        );
-        take(&mut self.kappa, &mut self.max_kappa, o.kappa, w);
-        if let Some((_, m)) = self.max_kappa {
+        let w = (*pt, *o);
+        self.ratio_f32.offer(o.ratio_f32(), w);
+        self.ratio_f32_in.offer(o.ratio_f32_in(), w);
+        self.ratio_fixed.offer(o.ratio_fixed(), w);
+        self.kappa.offer(o.kappa, w);
+        if let Some((_, m)) = self.kappa.at {
             self.kq = (m.kappa * m.q, m.kappa * m.q);
         }
     }

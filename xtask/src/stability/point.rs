@@ -6,6 +6,8 @@ use core_math::sphere::reference::RefPixel;
 use core_math::sphere::{Geometry, Reference, CLOSED_F32, FIXED};
 use core_math::{Backend, Camera, ImageMotion};
 
+use crate::accuracy::U_F32;
+
 /// The camera of every map (the paper's: f = 0.555 m, A = 13 um).
 pub const CAMERA: Camera = Camera {
     focal_m: 0.555,
@@ -13,8 +15,6 @@ pub const CAMERA: Camera = Camera {
 };
 /// Earth radius of every map (m).
 pub const EARTH_RADIUS_M: f64 = 6_371e3;
-/// Unit roundoff of f32, 2^-24.
-pub const U_F32: f64 = 1.0 / (1u64 << 24) as f64;
 /// The fixed backend's relative LSB scale, 2^-25: half the LSB of its coarsest
 /// narrowing, the I8F24 velocity bracket, relative to a bracket of one unit
 /// (2^-10 rad/s, about the orbital rate); the I7F25 rates have half that.
