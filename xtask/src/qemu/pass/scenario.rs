@@ -507,7 +507,9 @@ pub fn build(m: Manoeuvres, tick_us: u64) -> Result<Pass> {
     let (mut samples, mut terrain) = (Vec::new(), Vec::new());
     // The pass starts steered: the request of a first update at t = 0 with the yaw at 0.
     let mut target_rad = {
-        let mut probe = session.controller.clone();
+        // A controller as the session's is now (fresh, the default scene).
+        let mut probe = controller::Controller::new(controller::Config::default(), scene)
+            .map_err(|f| anyhow!("the default scene was refused: {}", f.name()))?;
         let frame = Frames::default().nav(0, &truth.nav(0.0));
         let mut decoder = controller::frame::Decoder::new();
         decoder.feed(&frame, |e| {
