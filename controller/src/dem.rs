@@ -259,6 +259,50 @@ fn node(bytes: &[u8], k: usize) -> i16 {
     }
 }
 
+/// Checks nodes `first..first + count` of a tile `cols` wide (heights in -500..9 000 m,
+/// `dem_height`) and adds them to `stats` and the CRC-32 register `crc_reg`. Node k is
+/// taken from `chunk` (little-endian pairs, its first node being node `first`) when
+/// that is not empty, else from `tile`; the earlier nodes the steps need (one to the
+/// west, one row down) from `tile` when they precede `first`. One routine for the
+/// chunks and the check after a reset: flash is scarcer than the cycles of a call.
+#[inline(never)]
+fn scan(
+    stats: &mut Stats,
+    crc_reg: &mut u32,
+    tile: &[i16],
+    first: usize,
+    count: usize,
+    cols: usize,
+    chunk: &[u8],
+) -> Result<(), Fault> {
+    let at = |k: usize| -> i16 {
+        match k.checked_sub(first) {
+            Some(i) if !chunk.is_empty() => node(chunk, i),
+            _ => tile.get(k).copied().unwrap_or(0),
+        }
+    };
+    let mut s = *stats;
+    let mut c = *crc_reg;
+    for k in first..first + count {
+        let h = at(k);
+        if !(MIN_NODE_M..=MAX_NODE_M).contains(&h) {
+            return Err(Fault::DemHeight);
+        }
+        s.min_m = s.min_m.min(h);
+        s.max_m = s.max_m.max(h);
+        if !k.is_multiple_of(cols) {
+            s.step_lon_m = s.step_lon_m.max(h.abs_diff(at(k - 1)));
+        }
+        if k >= cols {
+            s.step_lat_m = s.step_lat_m.max(h.abs_diff(at(k - cols)));
+        }
+        c = crc::update32(c, &h.to_le_bytes());
+    }
+    *stats = s;
+    *crc_reg = c;
+    Ok(())
+}
+
 impl Dem {
     /// The tile in force, as the search takes it.
     pub fn tile(&self) -> Option<DemTile<'_, i16>> {
@@ -352,34 +396,15 @@ impl Dem {
         let heights = payload.get(DEM_CHUNK_HEADER_LEN..).unwrap_or(&[]);
         let staging = store.slots.get(u.slot).ok_or(Fault::DemSequence)?;
         let first = usize::from(index) * DEM_CHUNK_NODES;
-        let cols = u.grid.ncols;
-        // Node k of the tile: from this chunk, or from the staging slot for an earlier
-        // one (the node one row down may lie in either).
-        let at = |k: usize| -> i16 {
-            if k >= first {
-                node(heights, k - first)
-            } else {
-                staging.get(k).copied().unwrap_or(0)
-            }
-        };
-        let mut s = u.stats;
-        for i in 0..count {
-            let k = first + i;
-            let h = at(k);
-            if !(MIN_NODE_M..=MAX_NODE_M).contains(&h) {
-                return Err(Fault::DemHeight);
-            }
-            s.min_m = s.min_m.min(h);
-            s.max_m = s.max_m.max(h);
-            if !k.is_multiple_of(cols) {
-                s.step_lon_m = s.step_lon_m.max(h.abs_diff(at(k - 1)));
-            }
-            if k >= cols {
-                s.step_lat_m = s.step_lat_m.max(h.abs_diff(at(k - cols)));
-            }
-        }
-        u.stats = s;
-        u.crc_reg = crc::update32(u.crc_reg, heights);
+        scan(
+            &mut u.stats,
+            &mut u.crc_reg,
+            staging,
+            first,
+            count,
+            u.grid.ncols,
+            heights,
+        )?;
         u.next += 1;
         let commit = u.next == u.chunks;
         if commit && crc::finish32(u.crc_reg) != u.crc32 {
@@ -397,8 +422,8 @@ impl Dem {
         let dest = slot
             .get_mut(first..first + heights.len() / 2)
             .ok_or(Fault::DemSequence)?;
-        for (k, h) in dest.iter_mut().enumerate() {
-            *h = node(heights, k);
+        for (h, b) in dest.iter_mut().zip(heights.chunks_exact(2)) {
+            *h = i16::from_le_bytes([b[0], b[1]]);
         }
         if !ok.commit {
             self.upload = Some(u);
@@ -455,21 +480,7 @@ impl Dem {
             .ok_or(Fault::DemGrid)?;
         let mut s = Stats::EMPTY;
         let mut crc_reg = crc::INIT32;
-        for (k, &h) in heights.iter().enumerate() {
-            if !(MIN_NODE_M..=MAX_NODE_M).contains(&h) {
-                return Err(Fault::DemHeight);
-            }
-            s.min_m = s.min_m.min(h);
-            s.max_m = s.max_m.max(h);
-            let before = |d: usize| heights.get(k - d).copied().unwrap_or(h);
-            if !k.is_multiple_of(g.ncols) {
-                s.step_lon_m = s.step_lon_m.max(h.abs_diff(before(1)));
-            }
-            if k >= g.ncols {
-                s.step_lat_m = s.step_lat_m.max(h.abs_diff(before(g.ncols)));
-            }
-            crc_reg = crc::update32(crc_reg, &h.to_le_bytes());
-        }
+        scan(&mut s, &mut crc_reg, heights, 0, nodes, g.ncols, &[])?;
         if crc::finish32(crc_reg) != rec.crc32 {
             return Err(Fault::DemCrc);
         }

@@ -90,6 +90,9 @@ impl Fault {
         Fault::DemCrc,
     ];
 
+    // Out of line: the firmware's log lines name faults in several places, and each
+    // inlined copy brought its own table.
+    #[inline(never)]
     pub const fn name(self) -> &'static str {
         match self {
             Fault::BadCrc => "bad_crc",
