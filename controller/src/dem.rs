@@ -422,8 +422,8 @@ impl Dem {
         let dest = slot
             .get_mut(first..first + heights.len() / 2)
             .ok_or(Fault::DemSequence)?;
-        for (h, b) in dest.iter_mut().zip(heights.chunks_exact(2)) {
-            *h = i16::from_le_bytes([b[0], b[1]]);
+        for (k, h) in dest.iter_mut().enumerate() {
+            *h = node(heights, k);
         }
         if !ok.commit {
             self.upload = Some(u);
