@@ -18,6 +18,7 @@ use core_math::earth::frames::{CelestialPole, TimeScales};
 use core_math::earth::Attitude;
 
 use crate::config::Config;
+use crate::dem::Dem;
 use crate::fault::{Counters, Fault};
 use crate::nav::Propagator;
 use crate::plan::Plan;
@@ -97,8 +98,8 @@ pub enum Mode {
 }
 
 /// The controller: its state here, frame intake in [`crate::intake`], the update in
-/// [`crate::update`].
-#[derive(Clone)]
+/// [`crate::update`]. Not `Clone`: it may borrow its DEM tile memory exclusively
+/// ([`crate::dem`]).
 pub struct Controller {
     pub config: Config,
     pub(crate) scene: Scene,
@@ -150,6 +151,8 @@ pub struct Controller {
     /// Why the core last started and the resets since power-on, as the firmware noted
     /// them ([`Controller::note_boot`]): STATUS reports them.
     pub(crate) boot: Option<(ResetCause, u32)>,
+    /// The DEM tile upload and the tile in force ([`crate::dem`]).
+    pub(crate) dem: Dem,
 }
 
 impl Controller {
@@ -203,6 +206,7 @@ impl Controller {
             update_mode: Mode::WaitingForNav,
             inputs_generation: 0,
             boot: None,
+            dem: Dem::default(),
         }
     }
 

@@ -49,10 +49,22 @@ pub enum Fault {
     FixTime,
     /// Leap seconds (GPS - UTC) outside 0..=60 s, or |UT1 - UTC| of 0.9 s or more.
     TimeScales,
+    /// A DEM_BEGIN whose grid the camera cannot take: upload id 0, more nodes than
+    /// the store holds, a side of fewer than 2 nodes, a spacing not positive, a tile
+    /// reaching past 88 deg of latitude or across the antimeridian (`crate::dem`).
+    DemGrid,
+    /// A DEM frame out of sequence: a chunk of no upload or of another, a chunk missing,
+    /// repeated or out of order, a DEM_BEGIN repeating the upload in progress or the
+    /// tile in force.
+    DemSequence,
+    /// A DEM chunk with a height outside -500..9 000 m.
+    DemHeight,
+    /// A DEM tile whose heights do not have the CRC-32 its DEM_BEGIN announced.
+    DemCrc,
 }
 
 impl Fault {
-    pub const COUNT: usize = 18;
+    pub const COUNT: usize = 22;
     pub const ALL: [Fault; Fault::COUNT] = [
         Fault::BadCrc,
         Fault::Truncated,
@@ -72,8 +84,15 @@ impl Fault {
         Fault::BadQuaternion,
         Fault::FixTime,
         Fault::TimeScales,
+        Fault::DemGrid,
+        Fault::DemSequence,
+        Fault::DemHeight,
+        Fault::DemCrc,
     ];
 
+    // Out of line: the firmware's log lines name faults in several places, and each
+    // inlined copy brought its own table.
+    #[inline(never)]
     pub const fn name(self) -> &'static str {
         match self {
             Fault::BadCrc => "bad_crc",
@@ -94,6 +113,10 @@ impl Fault {
             Fault::BadQuaternion => "bad_quaternion",
             Fault::FixTime => "fix_time",
             Fault::TimeScales => "time_scales",
+            Fault::DemGrid => "dem_grid",
+            Fault::DemSequence => "dem_sequence",
+            Fault::DemHeight => "dem_height",
+            Fault::DemCrc => "dem_crc",
         }
     }
 }

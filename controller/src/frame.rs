@@ -45,6 +45,11 @@ pub mod kind {
     pub const ATTITUDE: u8 = 0x07;
     /// GPS - UTC and UT1 - UTC (payload: `bus::TIME_SCALES_LEN` bytes).
     pub const TIME_SCALES: u8 = 0x08;
+    /// The start of a DEM tile upload: its id, grid and CRC-32 (payload:
+    /// `dem::DEM_BEGIN_LEN` bytes).
+    pub const DEM_BEGIN: u8 = 0x09;
+    /// One chunk of a DEM tile's heights (payload: `dem` module).
+    pub const DEM_CHUNK: u8 = 0x0A;
     /// Line periods, one record per active segment.
     pub const PERIODS: u8 = 0x81;
     /// Fault counters and state.

@@ -94,6 +94,8 @@ impl Controller {
             kind::GNSS => self.check_gnss(frame).map(|_| ()),
             kind::ATTITUDE => self.check_attitude(frame).map(|_| ()),
             kind::TIME_SCALES => decode_time_scales(frame.payload).map(|_| ()),
+            kind::DEM_BEGIN => self.check_dem_begin(frame.payload),
+            kind::DEM_CHUNK => self.check_dem_chunk(frame.payload),
             kind::TIME if frame.payload.is_empty() => Ok(()),
             kind::TIME => Err(Fault::BadLength),
             _ => Err(Fault::UnknownKind),
@@ -141,6 +143,8 @@ impl Controller {
                 self.rederive_attitude();
                 Ok(())
             }
+            kind::DEM_BEGIN => self.accept_dem_begin(frame.payload),
+            kind::DEM_CHUNK => self.accept_dem_chunk(frame.payload),
             kind::TIME if frame.payload.is_empty() => Ok(()),
             kind::TIME => Err(Fault::BadLength),
             _ => Err(Fault::UnknownKind),

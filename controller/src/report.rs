@@ -5,6 +5,7 @@ use heapless::Vec;
 
 use crate::bytes::{Reader, Writer};
 use crate::control::{Controller, Mode, SegmentOutput};
+use crate::dem::DemStatus;
 use crate::fault::Fault;
 use crate::restart::ResetCause;
 use crate::scene::MAX_SEGMENTS;
@@ -15,7 +16,9 @@ pub const PERIODS_HEADER_LEN: usize = 8;
 pub const RECORD_LEN: usize = 28;
 /// STATUS payload length: the header and four counters, one counter per [`Fault`], and
 /// the downlink frames dropped (84 bytes).
-pub const STATUS_LEN: usize = 20 + 4 * Fault::COUNT + 4;
+pub const STATUS_LEN: usize = 20 + 4 * Fault::COUNT + 4 + DEM_STATUS_LEN;
+/// STATUS's DEM block: the tile in force, the upload in progress, tiles committed.
+pub const DEM_STATUS_LEN: usize = 16;
 
 /// Flag bit of a record: the value is the last good one, held over a fault.
 pub const FLAG_HELD: u8 = 1;
@@ -100,7 +103,9 @@ impl Periods {
 /// 255), frames
 /// accepted, updates run, bytes skipped by the decoder, time re-synchronisations, then
 /// one u32 counter per [`Fault`] in [`Fault::ALL`] order, then the downlink frames the
-/// transmit queue had no room for (dropped whole: [`crate::downlink`]). What each
+/// transmit queue had no room for (dropped whole: [`crate::downlink`]), then the DEM
+/// upload's state ([`DemStatus`]: the id of the tile in force, the id of the upload in
+/// progress, its next chunk and chunk count, tiles committed). What each
 /// counts, and the identities between them: docs/telemetry.md, "Counters".
 pub fn encode_status(
     c: &Controller,
@@ -126,6 +131,12 @@ pub fn encode_status(
         w.put(&n.to_le_bytes())?;
     }
     w.put(&downlink_dropped.to_le_bytes())?;
+    let d = c.dem_status();
+    w.put(&d.in_force_id.to_le_bytes())?;
+    w.put(&d.upload_id.to_le_bytes())?;
+    w.put(&d.next_chunk.to_le_bytes())?;
+    w.put(&d.chunks.to_le_bytes())?;
+    w.put(&d.tiles_committed.to_le_bytes())?;
     Some(w.len())
 }
 
@@ -144,6 +155,8 @@ pub struct Status {
     pub counts: [u32; Fault::COUNT],
     /// Downlink frames dropped whole because the transmit queue had no room for them.
     pub downlink_dropped: u32,
+    /// The DEM upload's state.
+    pub dem: DemStatus,
 }
 
 impl Status {
@@ -162,6 +175,13 @@ impl Status {
             *c = r.u32()?;
         }
         let downlink_dropped = r.u32()?;
+        let dem = DemStatus {
+            in_force_id: r.u32()?,
+            upload_id: r.u32()?,
+            next_chunk: r.u16()?,
+            chunks: r.u16()?,
+            tiles_committed: r.u32()?,
+        };
         let last_fault = Fault::ALL.get(usize::from(last)).copied();
         r.is_done().then_some(Status {
             mode,
@@ -174,6 +194,7 @@ impl Status {
             time_resyncs,
             counts,
             downlink_dropped,
+            dem,
         })
     }
 

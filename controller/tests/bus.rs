@@ -354,7 +354,7 @@ fn bus_periods_match_the_reference_of_the_same_itrf_state_quaternion_and_time() 
 fn every_bus_fault_changes_no_output() {
     let bus = Bus::new();
     let mut clean = Controller::new(Config::default(), Scene::paper_default()).unwrap();
-    let mut faulty = clean.clone();
+    let mut faulty = Controller::new(Config::default(), Scene::paper_default()).unwrap();
     let (mut clean_regs, mut faulty_regs) = (Registers::default(), Registers::default());
     let mut last_tag = 0u64;
     let mut expected: Vec<Fault> = Vec::new();

@@ -519,6 +519,69 @@ fn tile_refusals() {
     );
 }
 
+/// A tile made from known bounds (`DemTile::with_bounds`, what a controller that
+/// checked each node as it arrived does) is the tile `DemTile::new` makes: the same
+/// bounds, the same heights, the same crossings; its refusals are the grid's and the
+/// bounds' range.
+#[test]
+fn a_tile_from_its_bounds_is_the_same_tile() {
+    let grid = DemGrid {
+        lat0_deg: 10.0,
+        lon0_deg: 20.0,
+        dlat_deg: 0.01,
+        dlon_deg: 0.02,
+        nrows: 3,
+        ncols: 4,
+    };
+    // Steps by hand: along a column at most |1500 - 20| = 1480, along a row at most
+    // |-200 - 1500| = 1700.
+    let nodes: [i16; 12] = [0, 10, 20, 30, 700, -200, 1500, 30, 0, 10, 20, 30];
+    let tile = DemTile::new(grid, &nodes).unwrap();
+    let b = tile.bounds();
+    assert_eq!((b.min_m, b.max_m), (-200.0, 1500.0));
+    assert!((b.step_lat_m - 1480.0).abs() < 1e-9, "{b:?}");
+    assert!((b.step_lon_m - 1700.0).abs() < 1e-9, "{b:?}");
+    let again = DemTile::with_bounds(grid, &nodes, b).unwrap();
+    assert_eq!(again.bounds(), b);
+    for (lat, lon) in [(10.005, 20.01), (10.013, 20.05), (10.02, 20.06)] {
+        let (lat, lon) = (f64::to_radians(lat), f64::to_radians(lon));
+        assert_eq!(again.height_at(lat, lon), tile.height_at(lat, lon));
+    }
+    let bad =
+        |g: DemGrid, b: core_math::earth::dem::DemBounds| DemTile::with_bounds(g, &nodes, b).err();
+    assert_eq!(
+        bad(
+            DemGrid {
+                lon0_deg: 179.99,
+                ..grid
+            },
+            b
+        ),
+        Some(ModelError::OutOfDomain(Param::DemGrid))
+    );
+    assert_eq!(
+        bad(DemGrid { ncols: 3, ..grid }, b),
+        Some(ModelError::InvalidInput(Param::DemGrid))
+    );
+    assert_eq!(
+        bad(
+            grid,
+            core_math::earth::dem::DemBounds { max_m: 9001.0, ..b }
+        ),
+        Some(ModelError::OutOfDomain(Param::DemHeight))
+    );
+    assert_eq!(
+        bad(
+            grid,
+            core_math::earth::dem::DemBounds {
+                step_lat_m: -1.0,
+                ..b
+            }
+        ),
+        Some(ModelError::InvalidInput(Param::DemGrid))
+    );
+}
+
 /// The search's cost on the golden rays, in points of the ray evaluated (each a
 /// geodetic conversion and, inside the tile, a bilinear height): printed for
 /// `docs/earth-model.md`, and bounded so that a change that slows it shows.

@@ -94,6 +94,24 @@ fn restore(
     }
 }
 
+/// Lends the controller its DEM tile memory and, after a reset, puts the tile kept
+/// there back in force if it checks out. Not inlined, as `restore`.
+#[inline(never)]
+fn restore_dem(session: &mut Session, boot: &retained::Boot) {
+    let Some(store) = retained::dem_store(boot) else {
+        defmt::error!("no DEM tile memory: DEM frames will be refused");
+        return;
+    };
+    session.controller.attach_dem(store);
+    if boot.cause == retained::ResetCause::PowerOn {
+        return;
+    }
+    match session.controller.restore_dem() {
+        Ok(id) => defmt::info!("DEM tile {=u32} kept through the reset, in force", id),
+        Err(f) => defmt::info!("no DEM tile kept through the reset ({=str})", f.name()),
+    }
+}
+
 /// A period sink that notes when its first write went through (the board's clock).
 struct FirstWrite<'a, S, C> {
     sink: &'a mut S,
@@ -146,6 +164,9 @@ fn start<C: Monotonic>(
         Some((snapshot, kept)) => restore(session, snapshot, kept),
         None => Err(()),
     };
+    // The DEM tile kept before the reset, after the periods: its check is a pass over
+    // 32 KiB, far more than the boot's budget for the periods.
+    restore_dem(session, boot);
     Start {
         session,
         restored,

@@ -16,6 +16,7 @@
 //! them to [`boot`], and they win over a noted cause.
 
 use controller::crc;
+use controller::dem::DemStore;
 pub use controller::restart::ResetCause;
 use controller::restart::{Payload, Snapshot};
 use controller::Controller;
@@ -89,6 +90,9 @@ extern "C" {
     /// The start of the board's `RETAINED` region (its memory layout defines it).
     static mut __sretained: Region;
     static __eretained: u8;
+    /// The board's `RETAINED_DEM` region: the DEM tile memory.
+    static mut __sretained_dem: DemStore;
+    static __eretained_dem: u8;
 }
 
 const _: () = assert!(core::mem::size_of::<Region>() <= 4096);
@@ -235,4 +239,30 @@ pub fn capacity_bytes() -> usize {
         (&raw const __eretained) as usize,
     );
     end.saturating_sub(start)
+}
+
+/// Whether [`dem_store`] has lent the tile memory.
+static DEM_LENT: core::sync::atomic::AtomicBool = core::sync::atomic::AtomicBool::new(false);
+
+/// The DEM tile memory in the region `RETAINED_DEM`, once (`None` after, or if the
+/// layout's region is too small for it). After power-on its record is forgotten (the
+/// RAM holds noise); after a reset it is left for `Controller::restore_dem` to check.
+pub fn dem_store(boot: &Boot) -> Option<&'static mut DemStore> {
+    let (start, end) = (
+        (&raw const __sretained_dem) as usize,
+        (&raw const __eretained_dem) as usize,
+    );
+    let fits = end.saturating_sub(start) >= core::mem::size_of::<DemStore>()
+        && start % core::mem::align_of::<DemStore>() == 0;
+    if !fits || DEM_LENT.swap(true, core::sync::atomic::Ordering::Relaxed) {
+        return None;
+    }
+    // SAFETY: the region is mapped RAM that the memory layout reserves for the store
+    // alone, large and aligned enough (checked above); any contents are a valid
+    // `DemStore` (integers only); `DEM_LENT` makes this the only reference ever made.
+    let store = unsafe { &mut *core::ptr::addr_of_mut!(__sretained_dem) };
+    if boot.cause == ResetCause::PowerOn {
+        store.forget();
+    }
+    Some(store)
 }

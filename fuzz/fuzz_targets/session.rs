@@ -2,8 +2,9 @@
 //! model as `controller/tests/session_model.rs`): every 25 bytes of input are one
 //! action (a selector and three numbers: valid NAV, TIME, SCENE edits, ticks, time tags
 //! backwards, too far ahead, past the largest tag, re-synchronisations, unknown kinds,
-//! bit flips, cut frames, noise, bad versions and lengths), run through a real
-//! `Session` byte by byte; after each action the model's invariants are asserted (a
+//! bit flips, cut frames, noise, bad versions and lengths, DEM uploads and their
+//! faults), run through a real `Session` byte by byte; after each action the model's
+//! invariants are asserted (a
 //! refused input changes nothing and counts exactly its counter, an accepted frame
 //! takes effect, the counters reconcile, every period written is inside the physical
 //! bounds, every MTF in [0, 1]), and at the end an END frame's final STATUS must
@@ -27,18 +28,16 @@ fn u64_at(b: &[u8], at: usize) -> u64 {
     u64::from_le_bytes(a)
 }
 
-/// The boot controller, planned once.
-static BOOT: std::sync::OnceLock<controller::Controller> = std::sync::OnceLock::new();
-
 fuzz_target!(|data: &[u8]| {
-    let boot = BOOT.get_or_init(|| {
+    // A fresh controller per input (it is not `Clone`: it borrows its DEM tile memory,
+    // which the harness lends from a pool).
+    let mut h = Harness::with(
         controller::Controller::new(
             controller::Config::default(),
             controller::Scene::paper_default(),
         )
-        .expect("the default scene")
-    });
-    let mut h = Harness::with(boot.clone());
+        .expect("the default scene"),
+    );
     for chunk in data.chunks_exact(ACTION_LEN).take(MAX_ACTIONS) {
         let a = Action::decode(
             chunk[0],

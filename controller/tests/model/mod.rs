@@ -76,6 +76,11 @@ pub enum Action {
     /// A bus frame (GNSS, ATTITUDE, TIME_SCALES), in the window, whose content is
     /// refused with one of the bus's faults.
     BadBus { dt_us: u64, what: u8 },
+    /// A DEM upload frame, in the window: a DEM_BEGIN or the next chunk, valid, or one
+    /// of the upload's faults (a bad grid, a repeated DEM_BEGIN, a chunk missing,
+    /// repeated, of another upload, with a height out of range, a tile whose CRC is
+    /// wrong).
+    Dem { dt_us: u64, what: u8, x: u64 },
 }
 
 /// Kinds the camera takes (and END, which ends a run): anything else is unknown.
@@ -90,6 +95,8 @@ fn is_known_kind(k: u8) -> bool {
             | kind::GNSS
             | kind::ATTITUDE
             | kind::TIME_SCALES
+            | kind::DEM_BEGIN
+            | kind::DEM_CHUNK
     )
 }
 
@@ -106,7 +113,7 @@ impl Action {
                 1 + (x >> 3) % 60_000
             }
         };
-        match sel % 34 {
+        match sel % 38 {
             0..=7 => Action::Nav {
                 dt_us: dt(a),
                 u_rad: frac(b) * core::f64::consts::TAU,
@@ -168,9 +175,14 @@ impl Action {
                 what: b as u8,
                 x: c,
             },
-            _ => Action::BadBus {
+            32 | 33 => Action::BadBus {
                 dt_us: dt(a),
                 what: b as u8,
+            },
+            _ => Action::Dem {
+                dt_us: dt(a),
+                what: b as u8,
+                x: c,
             },
         }
     }
@@ -192,6 +204,59 @@ pub struct Model {
     pub frames_delivered: u32,
     pub delivered_bytes: u64,
     pub max_jump_us: u64,
+    /// The DEM tile in force (its upload id, 0: none) and the upload in progress.
+    pub dem_in_force: u32,
+    pub dem_upload: Option<DemUpload>,
+    pub dem_committed: u32,
+}
+
+/// An upload in progress, as the model sees it.
+#[derive(Clone, Copy, Debug)]
+pub struct DemUpload {
+    pub id: u32,
+    pub next: u16,
+    /// Whether its DEM_BEGIN announced the tile's true CRC.
+    pub crc_ok: bool,
+}
+
+/// The model's tiles: 8 x 60 nodes (3 chunks: 224, 224, 32), heights from the upload id.
+pub const DEM_ROWS: usize = 8;
+pub const DEM_COLS: usize = 60;
+pub const DEM_CHUNKS: u16 = 3;
+
+pub fn dem_grid() -> core_math::earth::dem::DemGrid {
+    core_math::earth::dem::DemGrid {
+        lat0_deg: -12.5,
+        lon0_deg: -70.25,
+        dlat_deg: 0.001,
+        dlon_deg: 0.002,
+        nrows: DEM_ROWS,
+        ncols: DEM_COLS,
+    }
+}
+
+pub fn dem_heights(id: u32) -> Vec<i16> {
+    (0..DEM_ROWS * DEM_COLS)
+        .map(|k| ((u64::from(id) * 7919 + k as u64 * 131) % 9501) as i16 - 500)
+        .collect()
+}
+
+fn dem_chunk(id: u32, index: u16, heights: &[i16]) -> Vec<u8> {
+    let mut out = [0u8; MAX_PAYLOAD];
+    let n = controller::dem::encode_chunk(id, index, heights, &mut out).expect("a chunk");
+    out[..n].to_vec()
+}
+
+thread_local! {
+    /// Tile memories given back by finished harnesses (each is 64 KiB, lent for good).
+    static DEM_STORES: std::cell::RefCell<Vec<&'static mut controller::dem::DemStore>> =
+        const { std::cell::RefCell::new(Vec::new()) };
+}
+
+fn dem_store() -> &'static mut controller::dem::DemStore {
+    DEM_STORES
+        .with(|p| p.borrow_mut().pop())
+        .unwrap_or_else(|| Box::leak(Box::new(controller::dem::DemStore::new())))
 }
 
 /// The model's verdict on one delivered frame.
@@ -562,6 +627,14 @@ pub struct Harness {
     pub steps: u32,
 }
 
+impl Drop for Harness {
+    fn drop(&mut self) {
+        if let Some(store) = self.session.controller.detach_dem() {
+            DEM_STORES.with(|p| p.borrow_mut().push(store));
+        }
+    }
+}
+
 impl Default for Harness {
     fn default() -> Self {
         Self::new()
@@ -575,8 +648,11 @@ impl Harness {
 
     /// A harness around `c`, a controller fresh from `Controller::new` (the fuzz target
     /// clones one, which saves planning the default scene per input).
-    pub fn with(c: Controller) -> Harness {
+    pub fn with(mut c: Controller) -> Harness {
         let config = c.config;
+        let store = dem_store();
+        store.forget();
+        c.attach_dem(store);
         Harness {
             session: Session::new(c),
             model: Model {
@@ -650,7 +726,17 @@ impl Harness {
         sent
     }
 
-    fn snapshot(&self) -> (Option<u64>, Scene, Vec<f32>, Vec<SegmentOutput>, u32) {
+    #[allow(clippy::type_complexity)]
+    fn snapshot(
+        &self,
+    ) -> (
+        Option<u64>,
+        Scene,
+        Vec<f32>,
+        Vec<SegmentOutput>,
+        u32,
+        controller::dem::DemStatus,
+    ) {
         let c = &self.session.controller;
         (
             c.nav().map(|n| n.time_us),
@@ -658,6 +744,7 @@ impl Harness {
             c.heights_m().to_vec(),
             c.outputs().copied().collect(),
             c.updates,
+            c.dem_status(),
         )
     }
 
@@ -775,6 +862,10 @@ impl Harness {
             Fault::BadQuaternion,
             Fault::FixTime,
             Fault::TimeScales,
+            Fault::DemGrid,
+            Fault::DemSequence,
+            Fault::DemHeight,
+            Fault::DemCrc,
         ]
         .iter()
         .map(|&f| c.counters.get(f))
@@ -793,6 +884,26 @@ impl Harness {
             "stale episodes"
         );
         assert!(c.now_us() <= MAX_TIME_TAG_US);
+        // The DEM upload's state, and the tile in force is the model's, node bounds
+        // and all.
+        let d = c.dem_status();
+        assert_eq!(d.in_force_id, m.dem_in_force, "DEM tile in force");
+        assert_eq!(d.upload_id, m.dem_upload.map_or(0, |u| u.id), "DEM upload");
+        assert_eq!(
+            d.next_chunk,
+            m.dem_upload.map_or(0, |u| u.next),
+            "DEM next chunk"
+        );
+        assert_eq!(d.tiles_committed, m.dem_committed, "DEM tiles committed");
+        match c.dem_tile() {
+            None => assert_eq!(m.dem_in_force, 0, "no DEM tile in force"),
+            Some(t) => {
+                let h = dem_heights(m.dem_in_force);
+                let want = core_math::earth::dem::DemTile::new(dem_grid(), &h).unwrap();
+                assert_eq!(t.bounds(), want.bounds(), "DEM tile bounds");
+                assert_eq!(*t.grid(), dem_grid(), "DEM grid");
+            }
+        }
     }
 
     /// Runs one action, then checks.
@@ -909,6 +1020,7 @@ impl Harness {
                     );
                 }
             }
+            Action::Dem { dt_us, what, x } => self.dem_step(now + dt_us, what, x),
             Action::Tick { dt_us } => {
                 let mut out = Vec::new();
                 let mut sink = Recorder::default();
@@ -1082,6 +1194,146 @@ impl Harness {
         self.check();
     }
 
+    /// One DEM frame tagged `t_us` (see [`Action::Dem`]).
+    fn dem_step(&mut self, t_us: u64, what: u8, x: u64) {
+        let grid = dem_grid();
+        let m = &self.model;
+        // A fresh id: neither the tile in force's nor the upload's, never 0.
+        let mut fresh = 1 + (x % 1000) as u32;
+        while fresh == m.dem_in_force || m.dem_upload.is_some_and(|u| u.id == fresh) {
+            fresh += 1;
+        }
+        let upload = m.dem_upload;
+        let begin = |id: u32, g: &core_math::earth::dem::DemGrid, crc_ok: bool| {
+            let crc = controller::dem::heights_crc32(&dem_heights(id));
+            controller::dem::encode_begin(id, g, if crc_ok { crc } else { !crc }).to_vec()
+        };
+        let (k, payload, verdict) = match what % 12 {
+            // A new upload (one in progress is given up); 1 in 4 with a wrong CRC.
+            0 => {
+                let crc_ok = !x.is_multiple_of(4);
+                (kind::DEM_BEGIN, begin(fresh, &grid, crc_ok), Ok(()))
+            }
+            // The next chunk of the upload in progress.
+            1..=6 => match upload {
+                Some(u) => {
+                    let last = u.next + 1 == DEM_CHUNKS;
+                    let verdict = if last && !u.crc_ok {
+                        Err(Fault::DemCrc)
+                    } else {
+                        Ok(())
+                    };
+                    let p = dem_chunk(u.id, u.next, &dem_heights(u.id));
+                    (kind::DEM_CHUNK, p, verdict)
+                }
+                None => (
+                    kind::DEM_CHUNK,
+                    dem_chunk(fresh, 0, &dem_heights(fresh)),
+                    Err(Fault::DemSequence),
+                ),
+            },
+            // A chunk missing (the one after next), repeated (the one before), or of
+            // another upload.
+            7 => {
+                let (id, index) = match upload {
+                    Some(u) if x.is_multiple_of(3) && u.next > 0 => (u.id, u.next - 1),
+                    Some(u) if x % 3 == 1 && u.next + 1 < DEM_CHUNKS => (u.id, u.next + 1),
+                    _ => (fresh, 0),
+                };
+                (
+                    kind::DEM_CHUNK,
+                    dem_chunk(id, index, &dem_heights(id)),
+                    Err(Fault::DemSequence),
+                )
+            }
+            // The next chunk with a height out of range.
+            8 => match upload {
+                Some(u) => {
+                    let mut h = dem_heights(u.id);
+                    let j =
+                        usize::from(u.next) * controller::dem::DEM_CHUNK_NODES + (x % 32) as usize;
+                    h[j] = if x.is_multiple_of(2) { 9_001 } else { -501 };
+                    (
+                        kind::DEM_CHUNK,
+                        dem_chunk(u.id, u.next, &h),
+                        Err(Fault::DemHeight),
+                    )
+                }
+                None => (
+                    kind::DEM_CHUNK,
+                    dem_chunk(fresh, 0, &dem_heights(fresh)),
+                    Err(Fault::DemSequence),
+                ),
+            },
+            // A grid the camera cannot take: a pole, the antimeridian, too many nodes.
+            9 => {
+                let bad = match x % 3 {
+                    0 => core_math::earth::dem::DemGrid {
+                        lat0_deg: 88.0,
+                        ..grid
+                    },
+                    1 => core_math::earth::dem::DemGrid {
+                        lon0_deg: 179.9,
+                        ..grid
+                    },
+                    _ => core_math::earth::dem::DemGrid {
+                        nrows: 200,
+                        ncols: 100,
+                        ..grid
+                    },
+                };
+                (
+                    kind::DEM_BEGIN,
+                    begin(fresh, &bad, true),
+                    Err(Fault::DemGrid),
+                )
+            }
+            // A DEM_BEGIN repeating the upload in progress or the tile in force.
+            10 => match (upload, m.dem_in_force) {
+                (Some(u), _) => (
+                    kind::DEM_BEGIN,
+                    begin(u.id, &grid, true),
+                    Err(Fault::DemSequence),
+                ),
+                (None, id) if id != 0 => (
+                    kind::DEM_BEGIN,
+                    begin(id, &grid, true),
+                    Err(Fault::DemSequence),
+                ),
+                _ => (kind::DEM_BEGIN, begin(0, &grid, true), Err(Fault::DemGrid)),
+            },
+            // A chunk whose count is not its length's.
+            _ => {
+                let mut p = dem_chunk(fresh, 0, &dem_heights(fresh));
+                p.truncate(p.len() - 2 * (1 + (x % 5) as usize));
+                (kind::DEM_CHUNK, p, Err(Fault::BadLength))
+            }
+        };
+        let accepted = self.session.controller.frames_accepted;
+        self.one_frame(k, t_us, &payload, verdict, None);
+        if self.session.controller.frames_accepted == accepted {
+            return;
+        }
+        // Accepted: the model follows.
+        let m = &mut self.model;
+        if k == kind::DEM_BEGIN {
+            m.dem_upload = Some(DemUpload {
+                id: fresh,
+                next: 0,
+                crc_ok: !x.is_multiple_of(4),
+            });
+        } else if let Some(mut u) = m.dem_upload {
+            u.next += 1;
+            if u.next == DEM_CHUNKS {
+                m.dem_in_force = u.id;
+                m.dem_upload = None;
+                m.dem_committed += 1;
+            } else {
+                m.dem_upload = Some(u);
+            }
+        }
+    }
+
     /// END: the final STATUS carries every counter, and they reconcile.
     pub fn finish(&mut self) {
         let t = self.model.now_us;
@@ -1100,6 +1352,7 @@ impl Harness {
         assert_eq!(&s.counts, c.counters.as_array());
         // The model's link takes every frame.
         assert_eq!(s.downlink_dropped, 0);
+        assert_eq!(s.dem, c.dem_status(), "STATUS's DEM block");
         self.check();
     }
 }

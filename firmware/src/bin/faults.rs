@@ -5,11 +5,13 @@
 //! Each boot brings the board up as the flight binary does (watchdog started, stack
 //! guard and heartbeat set up), reads the reset record and goes on by its cause:
 //! 1. after power-on it runs the controller once (the default scene, a synthetic NAV
-//!    frame at 20 deg of roll and 10 of pitch), keeps its snapshot in retained RAM as
+//!    frame at 20 deg of roll and 10 of pitch), uploads a small DEM tile into the tile
+//!    memory in retained RAM (`RETAINED_DEM`), keeps its snapshot in retained RAM as
 //!    the flight loop does, then stops feeding the watchdog (the heartbeat still wakes
 //!    the core): the watchdog's early warning notes the cause and resets the core;
 //! 2. after the watchdog's reset it restores the kept snapshot into a fresh controller
-//!    and checks that every period comes back, held, equal to a recomputation; then it
+//!    and checks that every period comes back, held, equal to a recomputation, and that
+//!    the DEM tile comes back in force with the bounds of its heights; then it
 //!    recurses until the stack runs into its guard: the HardFault handler notes a stack
 //!    overflow and resets the core;
 //! 3. after that reset it exits with status 0.
@@ -19,7 +21,10 @@
 #![no_std]
 #![no_main]
 
+use controller::dem::{encode_begin, encode_chunk, heights_crc32, DEM_CHUNK_NODES};
+use controller::frame::{kind, Frame, MAX_PAYLOAD};
 use controller::{Controller, LinePeriodSink};
+use core_math::earth::dem::{DemGrid, DemTile};
 use cortex_m_rt::entry;
 use firmware::board::{self, Monotonic, Parts, WATCHDOG_TIMEOUT_MS};
 use firmware::retained::{self, ResetCause};
@@ -35,6 +40,82 @@ fn flown() -> Option<Controller> {
     };
     let mut c = controller_with_nav(controller::Scene::paper_default(), false, attitude).ok()?;
     c.advance(1_000_000, &mut NoRegisters).then_some(c)
+}
+
+/// The tile step 1 uploads: 16 x 20 nodes (two chunks), 100 m to 8 000 m.
+const DEM_ID: u32 = 0x2300;
+const DEM_ROWS: usize = 16;
+const DEM_COLS: usize = 20;
+
+fn dem_grid() -> DemGrid {
+    DemGrid {
+        lat0_deg: 46.0,
+        lon0_deg: 7.5,
+        dlat_deg: 0.01,
+        dlon_deg: 0.01,
+        nrows: DEM_ROWS,
+        ncols: DEM_COLS,
+    }
+}
+
+fn dem_heights() -> [i16; DEM_ROWS * DEM_COLS] {
+    core::array::from_fn(|k| 100 + ((k * 397) % 7_901) as i16)
+}
+
+/// Step 1's upload through the controller's frame intake; true if the tile is in force.
+fn upload_tile(c: &mut Controller, boot: &retained::Boot) -> bool {
+    let Some(store) = retained::dem_store(boot) else {
+        return false;
+    };
+    c.attach_dem(store);
+    let h = dem_heights();
+    let mut t_us = c.now_us();
+    let mut send = |c: &mut Controller, kind: u8, payload: &[u8]| {
+        t_us += 1_000;
+        let before = c.frames_accepted;
+        c.on_frame(&Frame {
+            kind,
+            sequence: 0,
+            time_us: t_us,
+            payload,
+        });
+        c.frames_accepted == before + 1
+    };
+    let mut ok = send(
+        c,
+        kind::DEM_BEGIN,
+        &encode_begin(DEM_ID, &dem_grid(), heights_crc32(&h)),
+    );
+    let mut buf = [0u8; MAX_PAYLOAD];
+    for k in 0..(h.len().div_ceil(DEM_CHUNK_NODES) as u16) {
+        let Some(n) = encode_chunk(DEM_ID, k, &h, &mut buf) else {
+            return false;
+        };
+        ok &= send(c, kind::DEM_CHUNK, buf.get(..n).unwrap_or(&[]));
+    }
+    ok && c.dem_status().in_force_id == DEM_ID
+}
+
+/// Step 2's check of the tile: a fresh controller lent the tile memory puts the tile
+/// back in force, with the bounds core-math finds in the same heights.
+fn tile_as_kept(boot: &retained::Boot) -> bool {
+    let Some(store) = retained::dem_store(boot) else {
+        return false;
+    };
+    let mut c = Controller::blank(board::controller_config());
+    c.attach_dem(store);
+    let restored = c.restore_dem();
+    let h = dem_heights();
+    let same = match (c.dem_tile(), DemTile::new(dem_grid(), &h)) {
+        (Some(got), Ok(want)) => got.bounds() == want.bounds() && *got.grid() == dem_grid(),
+        _ => false,
+    };
+    defmt::info!(
+        "DEM tile from retained RAM: id {=u32}, bounds as uploaded: {=bool}",
+        restored.unwrap_or(0),
+        same
+    );
+    restored == Ok(DEM_ID) && same
 }
 
 /// Period registers that remember what was written.
@@ -110,7 +191,14 @@ fn main() -> ! {
     };
     match (boot.resets, boot.cause) {
         (0, ResetCause::PowerOn) => {
-            let Some(c) = flown() else { platform::exit(1) };
+            let Some(mut c) = flown() else {
+                platform::exit(1)
+            };
+            if !upload_tile(&mut c, &boot) {
+                defmt::error!("the DEM tile was not taken");
+                platform::exit(1)
+            }
+            defmt::info!("DEM tile {=u32} in force", DEM_ID);
             retained::keep(&c, &mut retained::Kept::default());
             defmt::info!(
                 "kept a snapshot: {=usize} periods, segment 0 at {=u32} ticks",
@@ -130,6 +218,10 @@ fn main() -> ! {
         (1, ResetCause::Watchdog) => {
             if !restored_as_kept(&boot) {
                 defmt::error!("the snapshot did not come back as kept");
+                platform::exit(1)
+            }
+            if !tile_as_kept(&boot) {
+                defmt::error!("the DEM tile did not come back as kept");
                 platform::exit(1)
             }
             defmt::info!(

@@ -176,9 +176,27 @@ fn size_line(board: Board, elf: &Path) -> Result<String> {
             format!("{name} {size}")
         })
         .collect();
+    let sections: u64 = RAM_SECTIONS
+        .iter()
+        .map(|name| file.section_by_name(name).map_or(0, |s| s.size()))
+        .sum();
+    // The retained regions hold no section: their size is their symbols' distance.
+    use object::{Object as _, ObjectSymbol as _};
+    let symbol = |name: &str| {
+        file.symbols()
+            .find(|s| s.name() == Ok(name))
+            .map(|s| s.address())
+    };
+    let region = |start: &str, end: &str| match (symbol(start), symbol(end)) {
+        (Some(a), Some(b)) => b.saturating_sub(a),
+        _ => 0,
+    };
+    let retained = region("__sretained", "__eretained");
+    let dem = region("__sretained_dem", "__eretained_dem");
     Ok(format!(
-        "{:<11} flash {flash}, static RAM: {}",
+        "{:<11} flash {flash}, static RAM: {}, retained {retained} + DEM tile memory {dem}, total {}",
         board.name(),
-        ram.join(", ")
+        ram.join(", "),
+        sections + retained + dem
     ))
 }

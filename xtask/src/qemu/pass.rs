@@ -429,6 +429,19 @@ fn play(elf: &Path, pass: &Pass, plan: Option<reset::Plan>) -> Result<Played> {
                     "the firmware's final STATUS differs from the host run of the same bytes: {fw:?} vs {host:?}"
                 ));
             }
+            // The built-in passes upload a DEM tile at their start (stream.rs).
+            if pass.truth.agile().is_some() {
+                let d = fw.dem;
+                println!(
+                    "DEM upload: tile {} in force, {} committed, upload in progress {} (128 x 128 nodes in 74 chunks, away from the ground track)",
+                    d.in_force_id, d.tiles_committed, d.upload_id
+                );
+                if d.in_force_id != scenario::PASS_DEM_ID || d.tiles_committed != 1 {
+                    count_failures.push(format!(
+                        "the DEM tile uploaded at the start is not in force: {d:?}"
+                    ));
+                }
+            }
         }
         _ => count_failures.push("no final STATUS frame".into()),
     }

@@ -133,6 +133,17 @@ pub struct DemTile<'a, H> {
     slope_lon_m_per_rad: f64,
 }
 
+/// What [`DemTile::new`] finds in one pass over the heights and the search needs: the
+/// lowest and highest node (m), and the largest |H(i+1, j) - H(i, j)| (`step_lat_m`) and
+/// |H(i, j+1) - H(i, j)| (`step_lon_m`) (m).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DemBounds {
+    pub min_m: f64,
+    pub max_m: f64,
+    pub step_lat_m: f64,
+    pub step_lon_m: f64,
+}
+
 impl<'a, H: DemHeight> DemTile<'a, H> {
     /// The tile of `grid` with `heights_m` (nrows x ncols, row-major). Refusals:
     /// - `InvalidInput(DemGrid)`: fewer than 2 or more than [`MAX_DEM_NODES`] nodes along
@@ -144,26 +155,9 @@ impl<'a, H: DemHeight> DemTile<'a, H> {
     ///   [`MAX_DEM_HEIGHT_M`].
     pub fn new(grid: DemGrid, heights_m: &'a [H]) -> Result<Self, ModelError> {
         let g = grid;
-        let angles = [g.lat0_deg, g.lon0_deg, g.dlat_deg, g.dlon_deg];
-        if !angles.iter().all(|x| x.is_finite()) {
-            return Err(ModelError::NonFinite(Param::DemGrid));
-        }
-        let sides = 2..=MAX_DEM_NODES;
-        if !(sides.contains(&g.nrows)
-            && sides.contains(&g.ncols)
-            && g.dlat_deg > 0.0
-            && g.dlon_deg > 0.0
-            && heights_m.len() == g.nrows * g.ncols)
-        {
+        g.check()?;
+        if heights_m.len() != g.nrows * g.ncols {
             return Err(ModelError::InvalidInput(Param::DemGrid));
-        }
-        let (lat1, lon1) = (g.lat_deg(g.nrows - 1), g.lon_deg(g.ncols - 1));
-        if !(g.lat0_deg >= -MAX_DEM_ABS_LAT_DEG
-            && lat1 <= MAX_DEM_ABS_LAT_DEG
-            && g.lon0_deg >= -180.0
-            && lon1 < 180.0)
-        {
-            return Err(ModelError::OutOfDomain(Param::DemGrid));
         }
         let (mut min_m, mut max_m) = (f64::INFINITY, f64::NEG_INFINITY);
         for &h in heights_m {
@@ -197,6 +191,53 @@ impl<'a, H: DemHeight> DemTile<'a, H> {
             slope_lat_m_per_rad: step_lat_m / g.dlat_deg.to_radians(),
             slope_lon_m_per_rad: step_lon_m / g.dlon_deg.to_radians(),
         })
+    }
+
+    /// The tile of `grid` and `heights_m` whose bounds are already known, without the
+    /// pass over every node that [`DemTile::new`] makes: `bounds` must be the heights'
+    /// own, as [`DemTile::bounds`] of a tile of the same heights gives them (a
+    /// controller that checked each node as it arrived keeps them beside the heights).
+    /// The grid and the count are checked as [`DemTile::new`] checks them, and the
+    /// bounds for their range (`OutOfDomain(DemHeight)`, `InvalidInput(DemGrid)` for
+    /// a negative step).
+    pub fn with_bounds(
+        grid: DemGrid,
+        heights_m: &'a [H],
+        bounds: DemBounds,
+    ) -> Result<Self, ModelError> {
+        grid.check()?;
+        if heights_m.len() != grid.nrows * grid.ncols {
+            return Err(ModelError::InvalidInput(Param::DemGrid));
+        }
+        let range = MIN_DEM_HEIGHT_M..=MAX_DEM_HEIGHT_M;
+        if !(range.contains(&bounds.min_m)
+            && range.contains(&bounds.max_m)
+            && bounds.min_m <= bounds.max_m)
+        {
+            return Err(ModelError::OutOfDomain(Param::DemHeight));
+        }
+        if !(bounds.step_lat_m >= 0.0 && bounds.step_lon_m >= 0.0) {
+            return Err(ModelError::InvalidInput(Param::DemGrid));
+        }
+        Ok(DemTile {
+            grid,
+            heights_m,
+            min_m: bounds.min_m,
+            max_m: bounds.max_m,
+            slope_lat_m_per_rad: bounds.step_lat_m / grid.dlat_deg.to_radians(),
+            slope_lon_m_per_rad: bounds.step_lon_m / grid.dlon_deg.to_radians(),
+        })
+    }
+
+    /// The bounds [`DemTile::new`] found: lowest and highest node, and the largest
+    /// height step between neighbours along a column and along a row (m).
+    pub fn bounds(&self) -> DemBounds {
+        DemBounds {
+            min_m: self.min_m,
+            max_m: self.max_m,
+            step_lat_m: self.slope_lat_m_per_rad * self.grid.dlat_deg.to_radians(),
+            step_lon_m: self.slope_lon_m_per_rad * self.grid.dlon_deg.to_radians(),
+        }
     }
 
     pub fn grid(&self) -> &DemGrid {
@@ -284,6 +325,38 @@ fn cell<T: Real>(x: T, last: u32) -> (T, u32) {
 }
 
 impl DemGrid {
+    /// The grid's own checks, those of [`DemTile::new`] but the heights':
+    /// - `NonFinite(DemGrid)`: an origin or spacing not finite;
+    /// - `InvalidInput(DemGrid)`: fewer than 2 or more than [`MAX_DEM_NODES`] nodes along
+    ///   a side, or a spacing not positive;
+    /// - `OutOfDomain(DemGrid)`: a node beyond [`MAX_DEM_ABS_LAT_DEG`] (so no tile
+    ///   reaches a pole), or a longitude outside [-180, 180) (so none crosses the
+    ///   antimeridian).
+    pub fn check(&self) -> Result<(), ModelError> {
+        let g = self;
+        let angles = [g.lat0_deg, g.lon0_deg, g.dlat_deg, g.dlon_deg];
+        if !angles.iter().all(|x| x.is_finite()) {
+            return Err(ModelError::NonFinite(Param::DemGrid));
+        }
+        let sides = 2..=MAX_DEM_NODES;
+        if !(sides.contains(&g.nrows)
+            && sides.contains(&g.ncols)
+            && g.dlat_deg > 0.0
+            && g.dlon_deg > 0.0)
+        {
+            return Err(ModelError::InvalidInput(Param::DemGrid));
+        }
+        let (lat1, lon1) = (g.lat_deg(g.nrows - 1), g.lon_deg(g.ncols - 1));
+        if !(g.lat0_deg >= -MAX_DEM_ABS_LAT_DEG
+            && lat1 <= MAX_DEM_ABS_LAT_DEG
+            && g.lon0_deg >= -180.0
+            && lon1 < 180.0)
+        {
+            return Err(ModelError::OutOfDomain(Param::DemGrid));
+        }
+        Ok(())
+    }
+
     pub fn lat_deg(&self, i: usize) -> f64 {
         self.lat0_deg + i as f64 * self.dlat_deg
     }

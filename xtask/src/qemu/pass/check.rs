@@ -71,6 +71,8 @@ pub fn new_controller(config: Config) -> Result<Controller> {
     let mut c = Controller::new(config, Scene::paper_default())
         .map_err(|f| anyhow!("the default scene was refused: {}", f.name()))?;
     c.note_boot(controller::restart::ResetCause::PowerOn, 0);
+    // The firmware's tile memory (retained RAM there); a host run's is never given back.
+    c.attach_dem(Box::leak(Box::new(controller::dem::DemStore::new())));
     Ok(c)
 }
 
@@ -139,7 +141,7 @@ pub fn reset_twin(
     resets: u32,
     config: Config,
 ) -> Result<(Vec<u8>, Vec<u8>)> {
-    let (before, out_before) = host_run(prefix, config)?;
+    let (mut before, out_before) = host_run(prefix, config)?;
     let mut snapshot = controller::restart::Snapshot::EMPTY;
     let kept = before.controller.snapshot_inputs(&mut snapshot)
         && before.controller.snapshot_periods(&mut snapshot.periods);
@@ -150,6 +152,13 @@ pub fn reset_twin(
     c.note_boot(cause, resets);
     c.restore(&snapshot, &mut Accept)
         .map_err(|f| anyhow!("the host run refused its own snapshot: {}", f.name()))?;
+    // The DEM tile memory outlives the reset, as the firmware's retained RAM does; the
+    // firmware puts the tile recorded there back after the periods, and so does this.
+    if let Some(store) = before.controller.detach_dem() {
+        c.attach_dem(store);
+        // Nothing recorded (no tile before the reset) is a refusal here, as there.
+        let _ = c.restore_dem();
+    }
     let mut after = Session::new(c);
     let mut out_after = Vec::new();
     after.feed(suffix, &mut Accept, |f| out_after.extend_from_slice(f));

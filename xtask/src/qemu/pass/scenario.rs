@@ -5,8 +5,9 @@
 //! CSV file.
 
 use anyhow::{anyhow, bail, Context, Result};
+use controller::frame::kind;
 use controller::nav::{Attitude, Nav};
-use controller::EARTH;
+use controller::{Fault, EARTH};
 use core_math::earth::kepler::Kepler;
 use core_math::vector::{add, dot, scale};
 use core_math::{StateVector, GM_M3_S2};
@@ -268,6 +269,78 @@ pub enum FaultSpec {
     /// An extra NAV frame at `t_s` whose roll rate (0.5 rad/s) would carry it out of
     /// the scene's envelope: refused as `attitude_outside_model` (issue 12).
     Envelope { t_s: f64 },
+    /// An extra DEM frame at `t_s` the camera refuses (issue 23).
+    Dem { t_s: f64, probe: DemProbe },
+}
+
+/// The DEM frames the pass injects, each refused alone (the upload's multi-frame faults,
+/// a height out of range or a wrong CRC in the middle of an upload, are the session
+/// model's: `controller/tests/model/mod.rs`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum DemProbe {
+    /// A DEM_BEGIN of a tile reaching past 88 deg of latitude: `dem_grid`.
+    Pole,
+    /// A DEM_CHUNK of no upload in progress: `dem_sequence`.
+    StrayChunk,
+    /// A DEM_BEGIN with the id of the tile in force: `dem_sequence`.
+    SameId,
+}
+
+/// The tile the built-in passes upload at their start: 128 x 128 nodes at 3 arc-seconds
+/// in the South Pacific, far from their ground track, so that it exercises the upload
+/// (74 chunks through the UART, the commit, STATUS) and leaves the ground of every
+/// segment to TERRAIN.
+pub const PASS_DEM_ID: u32 = 23;
+
+pub fn pass_dem() -> (core_math::earth::dem::DemGrid, Vec<i16>) {
+    let grid = core_math::earth::dem::DemGrid {
+        lat0_deg: -45.0,
+        lon0_deg: -150.0,
+        dlat_deg: 1.0 / 1200.0,
+        dlon_deg: 1.0 / 1200.0,
+        nrows: 128,
+        ncols: 128,
+    };
+    let heights = (0..128 * 128)
+        .map(|k: i32| ((k * 37 + (k / 128) * 11) % 4_500 - 300) as i16)
+        .collect();
+    (grid, heights)
+}
+
+impl DemProbe {
+    pub fn label(&self) -> &'static str {
+        match self {
+            DemProbe::Pole => "a tile past 88 deg",
+            DemProbe::StrayChunk => "a chunk of no upload",
+            DemProbe::SameId => "the id of the tile in force",
+        }
+    }
+
+    /// The payload's kind, the payload, and the fault it must be refused with.
+    pub fn frame(&self) -> (u8, Vec<u8>, Fault) {
+        let (grid, heights) = pass_dem();
+        let crc = controller::dem::heights_crc32(&heights);
+        match self {
+            DemProbe::Pole => {
+                let g = core_math::earth::dem::DemGrid {
+                    lat0_deg: 87.99,
+                    ..grid
+                };
+                let p = controller::dem::encode_begin(PASS_DEM_ID + 1, &g, crc).to_vec();
+                (kind::DEM_BEGIN, p, Fault::DemGrid)
+            }
+            DemProbe::StrayChunk => {
+                let mut out = [0u8; controller::frame::MAX_PAYLOAD];
+                let n = controller::dem::encode_chunk(PASS_DEM_ID + 2, 0, &heights, &mut out)
+                    .unwrap_or(0);
+                (kind::DEM_CHUNK, out[..n].to_vec(), Fault::DemSequence)
+            }
+            DemProbe::SameId => {
+                let p = controller::dem::encode_begin(PASS_DEM_ID, &grid, crc).to_vec();
+                (kind::DEM_BEGIN, p, Fault::DemSequence)
+            }
+        }
+    }
 }
 
 /// The SCENE uploads an outside client found accepted before issue 13.
@@ -364,6 +437,7 @@ impl FaultSpec {
                 format!("TERRAIN at {height_m} m at {t_s} s")
             }
             FaultSpec::Envelope { t_s } => format!("NAV rolling at 0.5 rad/s at {t_s} s"),
+            FaultSpec::Dem { t_s, probe } => format!("DEM frame with {} at {t_s} s", probe.label()),
         }
     }
 }
@@ -507,7 +581,9 @@ pub fn build(m: Manoeuvres, tick_us: u64) -> Result<Pass> {
     let (mut samples, mut terrain) = (Vec::new(), Vec::new());
     // The pass starts steered: the request of a first update at t = 0 with the yaw at 0.
     let mut target_rad = {
-        let mut probe = session.controller.clone();
+        // A controller as the session's is now (fresh, the default scene).
+        let mut probe = controller::Controller::new(controller::Config::default(), scene)
+            .map_err(|f| anyhow!("the default scene was refused: {}", f.name()))?;
         let frame = Frames::default().nav(0, &truth.nav(0.0));
         let mut decoder = controller::frame::Decoder::new();
         decoder.feed(&frame, |e| {
@@ -687,6 +763,18 @@ pub fn short_pass(tick_us: u64) -> Result<Pass> {
         FaultSpec::Gap {
             from_s: 52.0,
             len_s: 2.0,
+        },
+        FaultSpec::Dem {
+            t_s: 33.0105,
+            probe: DemProbe::Pole,
+        },
+        FaultSpec::Dem {
+            t_s: 33.0305,
+            probe: DemProbe::StrayChunk,
+        },
+        FaultSpec::Dem {
+            t_s: 33.0505,
+            probe: DemProbe::SameId,
         },
     ];
     faults.extend(link_probes(28.0));

@@ -183,6 +183,10 @@ pub fn build(pass: &Pass) -> Result<Stream> {
                     frames.frame(kind::TERRAIN, us(t_s), &terrain_payload(&vec![height_m; n]));
                 (Some((t_s, bytes)), Some(Fault::OutOfRange))
             }
+            FaultSpec::Dem { t_s, probe } => {
+                let (k, payload, fault) = probe.frame();
+                (Some((t_s, frames.frame(k, us(t_s), &payload))), Some(fault))
+            }
             FaultSpec::Envelope { t_s } => {
                 let mut nav = truth_nav(t_s)?;
                 nav.attitude.roll_rate_rad_s = 0.5;
@@ -209,6 +213,28 @@ pub fn build(pass: &Pass) -> Result<Stream> {
                 .context("the default scene does not fit a SCENE frame")?;
             let bytes = frames.frame(kind::SCENE, t0 + 1, &p[..n]);
             extra.push((1, Item { bytes, fault: None }));
+        }
+        // Then a DEM tile, its DEM_BEGIN and 74 chunks 1 us apart, before the next
+        // tick: away from the ground track ([`super::scenario::pass_dem`]).
+        if pass.truth.agile().is_some() && t1 > t0 + 100 {
+            let (grid, heights) = super::scenario::pass_dem();
+            let id = super::scenario::PASS_DEM_ID;
+            let crc = controller::dem::heights_crc32(&heights);
+            let begin = controller::dem::encode_begin(id, &grid, crc);
+            extra.push((
+                1,
+                Item {
+                    bytes: frames.frame(kind::DEM_BEGIN, t0 + 2, &begin),
+                    fault: None,
+                },
+            ));
+            let mut out = [0u8; controller::frame::MAX_PAYLOAD];
+            let mut k = 0u16;
+            while let Some(n) = controller::dem::encode_chunk(id, k, &heights, &mut out) {
+                let bytes = frames.frame(kind::DEM_CHUNK, t0 + 3 + u64::from(k), &out[..n]);
+                extra.push((1, Item { bytes, fault: None }));
+                k += 1;
+            }
         }
     }
     // Insert from the back so that earlier indices stay valid; equal indices keep
