@@ -21,6 +21,14 @@ use crate::control::Controller;
 use crate::crc;
 use crate::fault::Fault;
 
+mod codec;
+mod store;
+
+use codec::{decode_begin, node};
+pub use codec::{encode_begin, encode_chunk, heights_crc32};
+pub use store::DemStore;
+use store::{Record, MAGIC};
+
 /// The most nodes a tile may hold (128 x 128, or any rows x cols up to it).
 pub const DEM_MAX_NODES: usize = 128 * 128;
 /// Nodes per DEM_CHUNK (the last one of a tile takes what is left): 8 + 2 x 224 = 456
@@ -33,93 +41,6 @@ pub const DEM_CHUNK_HEADER_LEN: usize = 8;
 /// Node heights a tile may hold (m), core-math's limits as integers.
 const MIN_NODE_M: i16 = MIN_DEM_HEIGHT_M as i16;
 const MAX_NODE_M: i16 = MAX_DEM_HEIGHT_M as i16;
-
-/// The record of the tile in force, in the store. Only `u32`s and `u64`s: any contents
-/// (RAM after power-on) are a valid value, checked by its seal before use.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-struct Record {
-    magic: u32,
-    /// The slot holding the tile in force (0 or 1).
-    slot: u32,
-    id: u32,
-    crc32: u32,
-    rows: u32,
-    cols: u32,
-    /// lat0, lon0, dlat, dlon (deg, f64 bits).
-    angles: [u64; 4],
-    /// CRC-32 of the fields above.
-    seal: u32,
-    reserved: u32,
-}
-
-const MAGIC: u32 = 0x4D45_4454; // "TDEM"
-
-impl Record {
-    fn seal_of(&self) -> u32 {
-        let mut c = crc::INIT32;
-        for w in [
-            self.magic, self.slot, self.id, self.crc32, self.rows, self.cols,
-        ] {
-            c = crc::update32(c, &w.to_le_bytes());
-        }
-        for a in self.angles {
-            c = crc::update32(c, &a.to_le_bytes());
-        }
-        crc::finish32(c)
-    }
-
-    fn grid(&self) -> DemGrid {
-        let [lat0, lon0, dlat, dlon] = self.angles.map(f64::from_bits);
-        DemGrid {
-            lat0_deg: lat0,
-            lon0_deg: lon0,
-            dlat_deg: dlat,
-            dlon_deg: dlon,
-            nrows: self.rows as usize,
-            ncols: self.cols as usize,
-        }
-    }
-}
-
-/// The tile memory: two slots of [`DEM_MAX_NODES`] heights (m, row-major from the
-/// south-west) and the record of the tile in force. 65 600 bytes.
-#[repr(C)]
-pub struct DemStore {
-    record: Record,
-    slots: [[i16; DEM_MAX_NODES]; 2],
-}
-
-impl DemStore {
-    /// An empty store (no tile recorded).
-    pub const fn new() -> DemStore {
-        DemStore {
-            record: Record {
-                magic: 0,
-                slot: 0,
-                id: 0,
-                crc32: 0,
-                rows: 0,
-                cols: 0,
-                angles: [0; 4],
-                seal: 0,
-                reserved: 0,
-            },
-            slots: [[0; DEM_MAX_NODES]; 2],
-        }
-    }
-
-    /// Forgets the recorded tile (after power-on, when the RAM holds noise).
-    pub fn forget(&mut self) {
-        self.record = Record::default();
-    }
-}
-
-impl Default for DemStore {
-    fn default() -> Self {
-        Self::new()
-    }
-}
 
 /// The tile in force.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -224,39 +145,6 @@ struct ChunkOk {
     upload: Upload,
     /// The tile goes in force (the last chunk, its CRC right).
     commit: bool,
-}
-
-/// The DEM_BEGIN payload's fields.
-struct Begin {
-    id: u32,
-    grid: DemGrid,
-    crc32: u32,
-}
-
-fn decode_begin(payload: &[u8]) -> Option<Begin> {
-    let mut r = Reader::new(payload);
-    let id = r.u32()?;
-    let rows = r.u16()?;
-    let cols = r.u16()?;
-    let crc32 = r.u32()?;
-    let _reserved = r.u32()?;
-    let grid = DemGrid {
-        lat0_deg: r.f64()?,
-        lon0_deg: r.f64()?,
-        dlat_deg: r.f64()?,
-        dlon_deg: r.f64()?,
-        nrows: usize::from(rows),
-        ncols: usize::from(cols),
-    };
-    r.is_done().then_some(Begin { id, grid, crc32 })
-}
-
-/// Node `k` of a chunk's heights (little-endian i16 pairs).
-fn node(bytes: &[u8], k: usize) -> i16 {
-    match bytes.get(2 * k..2 * k + 2) {
-        Some(&[lo, hi]) => i16::from_le_bytes([lo, hi]),
-        _ => 0,
-    }
 }
 
 /// Checks nodes `first..first + count` of a tile `cols` wide (heights in -500..9 000 m,
@@ -552,55 +440,4 @@ impl Controller {
         let ok = self.dem.check_chunk(payload)?;
         self.dem.apply_chunk(payload, ok)
     }
-}
-
-/// The DEM_BEGIN payload of an upload `id` of `grid` whose heights have CRC-32 `crc32`
-/// (host tools and tests; the camera only decodes).
-pub fn encode_begin(id: u32, grid: &DemGrid, crc32: u32) -> [u8; DEM_BEGIN_LEN] {
-    let mut out = [0u8; DEM_BEGIN_LEN];
-    let mut put = |at: usize, b: &[u8]| {
-        if let Some(d) = out.get_mut(at..at + b.len()) {
-            d.copy_from_slice(b);
-        }
-    };
-    put(0, &id.to_le_bytes());
-    put(4, &(grid.nrows as u16).to_le_bytes());
-    put(6, &(grid.ncols as u16).to_le_bytes());
-    put(8, &crc32.to_le_bytes());
-    let angles = [grid.lat0_deg, grid.lon0_deg, grid.dlat_deg, grid.dlon_deg];
-    for (k, a) in angles.iter().enumerate() {
-        put(16 + 8 * k, &a.to_le_bytes());
-    }
-    out
-}
-
-/// The CRC-32 of a tile's heights as DEM_BEGIN carries it: over their little-endian
-/// bytes, row-major from the south-west node.
-pub fn heights_crc32(heights_m: &[i16]) -> u32 {
-    let c = heights_m
-        .iter()
-        .fold(crc::INIT32, |c, h| crc::update32(c, &h.to_le_bytes()));
-    crc::finish32(c)
-}
-
-/// Writes chunk `index` of an upload `id` of `heights_m` (row-major) into `out`;
-/// returns its length, `None` past the last chunk or when `out` is too small.
-pub fn encode_chunk(id: u32, index: u16, heights_m: &[i16], out: &mut [u8]) -> Option<usize> {
-    let first = usize::from(index) * DEM_CHUNK_NODES;
-    let nodes = heights_m.get(first..)?;
-    let nodes = nodes.get(..nodes.len().min(DEM_CHUNK_NODES))?;
-    if nodes.is_empty() {
-        return None;
-    }
-    let len = DEM_CHUNK_HEADER_LEN + 2 * nodes.len();
-    let out = out.get_mut(..len)?;
-    out.get_mut(0..4)?.copy_from_slice(&id.to_le_bytes());
-    out.get_mut(4..6)?.copy_from_slice(&index.to_le_bytes());
-    out.get_mut(6..8)?
-        .copy_from_slice(&(nodes.len() as u16).to_le_bytes());
-    for (k, h) in nodes.iter().enumerate() {
-        let at = DEM_CHUNK_HEADER_LEN + 2 * k;
-        out.get_mut(at..at + 2)?.copy_from_slice(&h.to_le_bytes());
-    }
-    Some(len)
 }
