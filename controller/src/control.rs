@@ -150,6 +150,9 @@ pub struct Controller {
     /// Why the core last started and the resets since power-on, as the firmware noted
     /// them ([`Controller::note_boot`]): STATUS reports them.
     pub(crate) boot: Option<(ResetCause, u32)>,
+    /// The DEM tile in force and the per-sample state of its route
+    /// ([`crate::dem_ground`]); None: the TERRAIN heights are the ground.
+    pub(crate) dem: Option<crate::dem_ground::DemGround>,
 }
 
 impl Controller {
@@ -203,6 +206,7 @@ impl Controller {
             update_mode: Mode::WaitingForNav,
             inputs_generation: 0,
             boot: None,
+            dem: None,
         }
     }
 

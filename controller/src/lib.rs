@@ -16,6 +16,7 @@ pub mod bytes;
 pub mod config;
 pub mod control;
 pub mod crc;
+pub mod dem_ground;
 pub mod downlink;
 pub mod fault;
 pub mod frame;
