@@ -45,6 +45,11 @@ pub const MAX_TILE_HALF_DEG: f64 = 2.5;
 /// Share of the ray's stretch, in cells, added to the margin of the tile-edge test (the
 /// Jacobian's error over the tile, doubled).
 const EDGE_SHARE: f32 = 0.1;
+/// The march in height stops this close above the surface (m; the f32 march's 0.5 m
+/// with the f32 geodetic height's rounding).
+pub const TRACE_TOLERANCE_M: f32 = 1.0;
+/// Most evaluations of the march in height.
+pub const MAX_TRACE: u32 = 128;
 /// Largest tan^2(theta) for which the tile-edge tests extrapolate along the ray (72 deg
 /// from the vertical; beyond, the march).
 const MAX_TAN2: f32 = 9.0;
@@ -57,10 +62,17 @@ pub struct DemStats {
     /// Evaluations of the tile those took (the samples off the tile or marched take
     /// one or more too, not counted).
     pub evaluations: u32,
-    /// Samples the march decided.
-    pub marched: u32,
+    /// Samples the march in height decided ([`DemGround::trace`]).
+    pub traced: u32,
+    /// Samples neither could place (grazing rays, traces too long): the segment's
+    /// TERRAIN height.
+    pub unresolved: u32,
     /// Samples outside the tile: the segment's TERRAIN height.
     pub outside: u32,
+    /// Samples whose ray's stretch through the band meets the tile's edge, settled
+    /// there (the ray enters the tile on or below its surface: the ground is on the
+    /// tile's side).
+    pub edges: u32,
 }
 
 /// The tile's constants for the route, in f32, made once per tile.
@@ -86,6 +98,12 @@ struct TileFrame {
     /// Rows and columns per metre of ITRF displacement at the tile's centre.
     rows_per_m: [f32; 3],
     cols_per_m: [f32; 3],
+    /// A row's footprint bows from its chord in grid coordinates by at most this share
+    /// of the chord ([`DemGround::footprint`]): an eighth of L/R for the rays' plane's
+    /// section (R over 5 000 km for pitches to 40 deg), and L tan(lat) / (2R) for the
+    /// converging meridians, with L at most 500 km: 0.02 + 0.02 tan(lat) at the tile's
+    /// largest |latitude|.
+    bow_share: f32,
 }
 
 /// The DEM tile in force and what the route keeps between updates.
@@ -157,6 +175,8 @@ impl DemGround {
             slope2: (slope * slope) as f32,
             rows_per_m: north.map(|x| (x * rows_per_rad / meridian_m) as f32),
             cols_per_m: east.map(|x| (x * cols_per_rad / parallel_m) as f32),
+            bow_share: (0.02 + 0.02 * libm::tan(libm::fabs(lat_c) + MAX_TILE_HALF_DEG.to_radians()))
+                as f32,
         };
         Ok(DemGround {
             tile,
@@ -169,6 +189,34 @@ impl DemGround {
 
     pub fn tile(&self) -> &DemTile<'static, i16> {
         &self.tile
+    }
+}
+
+/// A segment's row's view of the tile ([`DemGround::footprint`]).
+#[derive(Clone, Copy)]
+pub(crate) struct Footprint {
+    a_m: f32,
+    row: f32,
+    col: f32,
+    row_per_m: f32,
+    col_per_m: f32,
+    row_margin: f32,
+    col_margin: f32,
+    last_row: f32,
+    last_col: f32,
+}
+
+impl Footprint {
+    /// Whether the sample at p2 sees ground off the tile.
+    #[inline(always)]
+    pub(crate) fn off_tile(&self, p2_m: f32) -> bool {
+        let dp = p2_m - self.a_m;
+        let row = self.row + self.row_per_m * dp;
+        let col = self.col + self.col_per_m * dp;
+        row + self.row_margin < 0.0
+            || row - self.row_margin > self.last_row
+            || col + self.col_margin < 0.0
+            || col - self.col_margin > self.last_col
     }
 }
 
@@ -231,31 +279,53 @@ pub(crate) enum SampleGround {
     Outside,
 }
 
+/// Where the ray meets the ellipsoid raised by h: its range, the point's grid
+/// coordinates, and the changes of both per metre of h.
+#[derive(Clone, Copy)]
+struct Located {
+    s: f32,
+    ds_dh: f32,
+    row: f32,
+    col: f32,
+    drow_dh: f32,
+    dcol_dh: f32,
+    /// tan^2 of the ray's angle from the vertical there.
+    tan2: f32,
+}
+
 /// One evaluation of the tile at height h on one ray.
 enum Evaluation {
+    /// In the tile: g = D - h and dg/dh, q^2 = S^2 tan^2(theta).
     At {
-        s: f32,
-        /// g = D - h, dg/dh, ds/dh.
+        at: Located,
         g: f32,
         dg_dh: f32,
-        ds_dh: f32,
-        /// q^2 = S^2 tan^2(theta).
         q2: f32,
-        /// The point's grid coordinates and their change per metre of h.
-        row: f32,
-        col: f32,
-        drow_dh: f32,
-        dcol_dh: f32,
     },
     /// The ray's stretch through the band lies outside the tile.
     Outside,
-    /// The march decides (grazing, steep, or the tile's edge within reach).
+    /// Outside the tile, its stretch through the band reaching into it.
+    Off(Located),
+    /// The march decides (grazing or steep).
     March,
 }
+
+/// What the tile's edges leave of a ray's search.
+enum Edges {
+    Done(SampleGround),
+    /// The stretch in the tile, as the heights of its ends (m).
+    Within(f32, f32),
+}
+
+/// Grid coordinates within this many cells outside the tile count as on its edge.
+const EDGE_SLACK_CELLS: f32 = 1e-3;
+/// The edges' heights are found to this (m of height).
+const EDGE_TOLERANCE_M: f32 = 0.5;
 
 impl DemGround {
     /// The ground of sample `j` of plan segment `k` at pixel p2 (m) on `rays`: see the
     /// module. `terrain_h_m` starts the search on the first update.
+    #[inline(never)]
     pub(crate) fn sample(
         &mut self,
         k: usize,
@@ -272,72 +342,301 @@ impl DemGround {
             jr: rays.jr0 + p2_m * rays.jry,
             jc: rays.jc0 + p2_m * rays.jcy,
         };
-        let t = self.frame;
+        let (band_lo, band_hi) = (self.frame.lo_m, self.frame.hi_m);
         let (last, step) = (self.slot(k, j, true), self.slot(k, j, false));
         let start = if last.is_finite() {
             last + step
         } else {
             terrain_h_m
         };
-        let mut h = clamp(start, t.lo_m, t.hi_m);
-        let (mut lo, mut hi) = (t.lo_m, t.hi_m);
+        let mut h = clamp(start, band_lo, band_hi);
+        let (mut lo, mut hi) = (band_lo, band_hi);
+        let mut edges_done = false;
         for n in 1..=MAX_EVALUATIONS {
-            match self.evaluate(rays, &ray, h) {
-                Evaluation::Outside => {
-                    self.stats.outside += 1;
-                    self.remember(k, j, f32::NAN);
-                    return Ok(SampleGround::Outside);
-                }
+            let found = match self.evaluate(rays, &ray, h) {
+                Evaluation::Outside => Some(SampleGround::Outside),
                 Evaluation::March => break,
-                Evaluation::At {
-                    s,
-                    g,
-                    dg_dh,
-                    ds_dh,
-                    q2,
-                    row,
-                    col,
-                    drow_dh,
-                    dcol_dh,
-                } => {
+                Evaluation::Off(at) if !edges_done => {
+                    edges_done = true;
+                    match self.edges(rays, &ray, h, &at) {
+                        None => break,
+                        Some(Edges::Done(found)) => Some(found),
+                        Some(Edges::Within(l, u)) => {
+                            (lo, hi) = (l, u);
+                            h = 0.5 * (l + u);
+                            None
+                        }
+                    }
+                }
+                // An iterate off the tile once its edges are known: rounding at them.
+                Evaluation::Off(_) => break,
+                Evaluation::At { at, g, dg_dh, q2 } => {
                     let tol = HEIGHT_TOLERANCE_M;
                     // q (|g| + tol) <= tol: the fixed-point step h + g is within
                     // q |g| / (1 - q) <= tol of H*.
                     let a = g.abs() + tol;
                     if q2 * a * a <= tol * tol {
-                        // H* lies within |g| / (1 - q) of h: that stretch must lie in
-                        // the tile, where the crossing is then the only one.
+                        // H* lies within |g| / (1 - q) of h: where that stretch lies in
+                        // the tile, the crossing there is the only one in it.
                         let reach = g.abs() * 5.0 + 1.0;
-                        if !self.inside_over(row, col, drow_dh, dcol_dh, -reach, reach) {
+                        if self.inside_over(&at, -reach, reach) {
+                            self.stats.searched += 1;
+                            self.stats.evaluations += n;
+                            self.remember(k, j, h + g);
+                            return Ok(SampleGround::Range(at.s + g * at.ds_dh));
+                        }
+                        if edges_done {
                             break;
                         }
-                        self.stats.searched += 1;
-                        self.stats.evaluations += n;
-                        self.remember(k, j, h + g);
-                        return Ok(SampleGround::Range(s + g * ds_dh));
-                    }
-                    if g > 0.0 {
-                        lo = h;
+                        edges_done = true;
+                        match self.edges(rays, &ray, h, &at) {
+                            None => break,
+                            Some(Edges::Done(found)) => Some(found),
+                            Some(Edges::Within(l, u)) => {
+                                (lo, hi) = (l, u);
+                                h = clamp(h + g, l, u);
+                                None
+                            }
+                        }
                     } else {
-                        hi = h;
+                        if g > 0.0 {
+                            lo = h;
+                        } else {
+                            hi = h;
+                        }
+                        // Newton on g (dg/dh <= q - 1 < 0), else bisection.
+                        let next = h - g / dg_dh;
+                        h = if next > lo && next < hi {
+                            next
+                        } else {
+                            0.5 * (lo + hi)
+                        };
+                        None
                     }
-                    // Newton on g (dg/dh <= q - 1 < 0), else bisection.
-                    let next = h - g / dg_dh;
-                    h = if next > lo && next < hi {
-                        next
-                    } else {
-                        0.5 * (lo + hi)
-                    };
                 }
+            };
+            if let Some(found) = found {
+                match found {
+                    SampleGround::Outside => self.stats.outside += 1,
+                    SampleGround::Range(_) => self.stats.edges += 1,
+                }
+                self.remember(k, j, f32::NAN);
+                return Ok(found);
             }
         }
-        self.stats.marched += 1;
         self.remember(k, j, f32::NAN);
-        match self.tile.first_crossing(&EARTH, rays.r, d) {
-            Ok(s) => Ok(SampleGround::Range(s)),
-            Err(ModelError::OutsideDem) => Ok(SampleGround::Outside),
-            Err(e) => Err(e),
+        Ok(match self.trace(rays, &ray) {
+            Some(found) => {
+                self.stats.traced += 1;
+                found
+            }
+            None => {
+                self.stats.unresolved += 1;
+                SampleGround::Outside
+            }
+        })
+    }
+
+    /// The march in height, for what the search in height cannot certify (steep
+    /// terrain, the steps not settling): from the top of the band (or where the ray
+    /// enters the tile) down, steps of |g| / (1 + q) in h, which cannot pass a crossing
+    /// (g changes by at most 1 + q per metre of h in the tile), until the ray is within
+    /// [`TRACE_TOLERANCE_M`] above the surface (the march's own test), leaves the tile,
+    /// or [`MAX_TRACE`] evaluations. `None` (the segment's TERRAIN height, counted
+    /// `unresolved`): a ray beyond 72 deg from the vertical, where the descending half of
+    /// the ray is not the whole story, or a trace too long.
+    #[inline(never)]
+    fn trace(&self, rays: &SegmentRays, ray: &Ray) -> Option<SampleGround> {
+        let t = &self.frame;
+        let (mut h, mut lo) = (t.hi_m, t.lo_m);
+        let mut edges_done = false;
+        for _ in 0..MAX_TRACE {
+            let at = self.locate(rays, ray, h)?;
+            if !(at.tan2 < MAX_TAN2) {
+                return None;
+            }
+            let (row, col) = (at.row, at.col);
+            if !(row >= 0.0 && row <= t.last_row && col >= 0.0 && col <= t.last_col) {
+                if edges_done || self.outside_over(&at, h) {
+                    // Left the tile above its surface, or never in it.
+                    return Some(SampleGround::Outside);
+                }
+                edges_done = true;
+                match self.edges(rays, ray, h, &at)? {
+                    Edges::Done(found) => return Some(found),
+                    Edges::Within(l, u) => {
+                        (h, lo) = (u, l);
+                        continue;
+                    }
+                }
+            }
+            let (height, _, _) = self.bilinear(row, col);
+            let g = height - h;
+            if g >= -TRACE_TOLERANCE_M {
+                return Some(SampleGround::Range(at.s));
+            }
+            let q = Real::sqrt(t.slope2 * at.tan2);
+            let step = -g / (1.0 + q);
+            h -= if step > 0.01 { step } else { 0.01 };
+            if h < lo {
+                return Some(SampleGround::Outside);
+            }
         }
+        None
+    }
+
+    /// Where a segment's row sees the tile: its grid coordinates at mid-band as an
+    /// affine function of p2, from the samples at p2 `a_m` and `b_m` (the row's ends),
+    /// with a margin for the footprint's bow between them (its section by the rays'
+    /// plane, and the grid's meridians converging: [`TileFrame`]'s share of the ends'
+    /// distance) and for each sample's stretch through the band. A sample the function
+    /// puts beyond an edge by more than the margin sees ground off the tile, for no
+    /// evaluation. `None`: an end the route cannot place (the samples are each
+    /// evaluated).
+    pub(crate) fn footprint(&self, rays: &SegmentRays, a_m: f32, b_m: f32) -> Option<Footprint> {
+        let t = &self.frame;
+        let h = 0.5 * (t.lo_m + t.hi_m);
+        let ray = |p2: f32| Ray {
+            d: core::array::from_fn(|i| rays.d0[i] + p2 * rays.dy[i]),
+            rd: rays.rd0 + p2 * rays.rdy,
+            uu: rays.uu0 + p2 * p2,
+            jr: rays.jr0 + p2 * rays.jry,
+            jc: rays.jc0 + p2 * rays.jcy,
+        };
+        let x = self.locate(rays, &ray(a_m), h)?;
+        let y = self.locate(rays, &ray(b_m), h)?;
+        if !(x.tan2 < MAX_TAN2 && y.tan2 < MAX_TAN2 && b_m != a_m) {
+            return None;
+        }
+        let bow = t.bow_share * ((x.row - y.row).abs() + (x.col - y.col).abs()) + 2.0;
+        let half = 0.5 * (t.hi_m - t.lo_m) * (1.0 + EDGE_SHARE);
+        let larger = |p: f32, q: f32| if p.abs() > q.abs() { p.abs() } else { q.abs() };
+        let per_m = 1.0 / (b_m - a_m);
+        Some(Footprint {
+            a_m,
+            row: x.row,
+            col: x.col,
+            row_per_m: (y.row - x.row) * per_m,
+            col_per_m: (y.col - x.col) * per_m,
+            row_margin: bow + larger(x.drow_dh, y.drow_dh) * half,
+            col_margin: bow + larger(x.dcol_dh, y.dcol_dh) * half,
+            last_row: t.last_row,
+            last_col: t.last_col,
+        })
+    }
+
+    /// The stretch of the ray through the band that lies in the tile, from a point of
+    /// it `at` height h: its ends from the grid coordinates' rates, the edge it enters
+    /// by and the one it leaves by found exactly ([`DemGround::edge_height`]). Entering
+    /// the tile on or below its surface, the ray meets the tile's side: the march's
+    /// ground, and this one's. Leaving it above the surface, it meets none in the tile.
+    /// `None`: the march decides.
+    fn edges(&self, rays: &SegmentRays, ray: &Ray, h: f32, at: &Located) -> Option<Edges> {
+        let t = &self.frame;
+        let (mut lo, mut hi) = (t.lo_m, t.hi_m);
+        let (mut top, mut bottom) = (None, None);
+        for (axis, x, dx, last) in [
+            (0, at.row, at.drow_dh, t.last_row),
+            (1, at.col, at.dcol_dh, t.last_col),
+        ] {
+            if !(dx.abs() > 1e-9) {
+                if !(x >= 0.0 && x <= last) {
+                    return None;
+                }
+                continue;
+            }
+            // The heights where the coordinate reaches 0 and `last`.
+            let (h0, h1) = (h - x / dx, h + (last - x) / dx);
+            let (a, edge_a, b, edge_b) = if h0 < h1 {
+                (h0, 0.0, h1, last)
+            } else {
+                (h1, last, h0, 0.0)
+            };
+            if a > lo {
+                lo = a;
+                bottom = Some((axis, edge_a));
+            }
+            if b < hi {
+                hi = b;
+                top = Some((axis, edge_b));
+            }
+        }
+        // Clearly no stretch in the tile (the rates' error, 10 %, on the way there).
+        let way = (hi - h).abs() + (lo - h).abs();
+        if lo - hi > EDGE_SHARE * way + 10.0 {
+            return Some(Edges::Done(SampleGround::Outside));
+        }
+        if let Some((axis, edge)) = top {
+            let (h_in, s_in) = self.edge_height(rays, ray, axis, edge, hi)?;
+            let (g, _) = self.g_on_edge(rays, ray, h_in)?;
+            if g >= 0.0 {
+                return Some(Edges::Done(SampleGround::Range(s_in)));
+            }
+            hi = h_in;
+        }
+        if let Some((axis, edge)) = bottom {
+            let (h_out, _) = self.edge_height(rays, ray, axis, edge, lo)?;
+            let (g, _) = self.g_on_edge(rays, ray, h_out)?;
+            if g < 0.0 {
+                return Some(Edges::Done(SampleGround::Outside));
+            }
+            lo = h_out;
+        }
+        (lo < hi).then_some(Edges::Within(lo, hi))
+    }
+
+    /// The height where the ray's grid coordinate `axis` (0: row, 1: column) equals
+    /// `edge`, from the estimate `h_est`: a Newton step on the coordinate's rate, then
+    /// secant steps on exact points, to [`EDGE_TOLERANCE_M`]; with the range there.
+    fn edge_height(
+        &self,
+        rays: &SegmentRays,
+        ray: &Ray,
+        axis: u8,
+        edge: f32,
+        h_est: f32,
+    ) -> Option<(f32, f32)> {
+        let mut h = h_est;
+        let mut prev: Option<(f32, f32)> = None;
+        for _ in 0..4 {
+            let at = self.locate(rays, ray, h)?;
+            let (x, dx) = if axis == 0 {
+                (at.row, at.drow_dh)
+            } else {
+                (at.col, at.dcol_dh)
+            };
+            let next = match prev {
+                Some((hp, xp)) if xp != x => h + (edge - x) * (h - hp) / (x - xp),
+                _ => h + (edge - x) / dx,
+            };
+            if (next - h).abs() <= EDGE_TOLERANCE_M {
+                return Some((next, at.s + (next - h) * at.ds_dh));
+            }
+            prev = Some((h, x));
+            h = next;
+        }
+        None
+    }
+
+    /// g = D - h at a point of the ray on the tile's edge (its grid coordinates within
+    /// [`EDGE_SLACK_CELLS`] of the tile, clamped onto it), and the range there.
+    fn g_on_edge(&self, rays: &SegmentRays, ray: &Ray, h: f32) -> Option<(f32, f32)> {
+        let t = &self.frame;
+        let at = self.locate(rays, ray, h)?;
+        let e = EDGE_SLACK_CELLS;
+        if !(at.row >= -e && at.row <= t.last_row + e && at.col >= -e && at.col <= t.last_col + e) {
+            return None;
+        }
+        let row = clamp(at.row, 0.0, t.last_row);
+        let col = clamp(at.col, 0.0, t.last_col);
+        let (height, _, _) = self.bilinear(row, col);
+        Some((height - h, at.s))
+    }
+
+    /// Notes sample `j` of plan segment `k` as off the tile by its segment's footprint.
+    pub(crate) fn off_tile(&mut self, k: usize, j: usize) {
+        self.stats.outside += 1;
+        self.remember(k, j, f32::NAN);
     }
 
     fn slot(&self, k: usize, j: usize, last: bool) -> f32 {
@@ -366,8 +665,8 @@ impl DemGround {
     }
 
     /// Whether the ray's points from h + dh_lo to h + dh_hi (linear in h from the grid
-    /// coordinates at h, with the Jacobian's margin) lie in the tile.
-    fn inside_over(&self, row: f32, col: f32, dr: f32, dc: f32, dh_lo: f32, dh_hi: f32) -> bool {
+    /// coordinates `at` h, with the rates' margin) lie in the tile.
+    fn inside_over(&self, at: &Located, dh_lo: f32, dh_hi: f32) -> bool {
         let t = &self.frame;
         let span = |x: f32, dx: f32, last: f32| {
             let (a, b) = (x + dx * dh_lo, x + dx * dh_hi);
@@ -375,11 +674,11 @@ impl DemGround {
             let (lo, hi) = if a < b { (a, b) } else { (b, a) };
             lo - margin >= 0.0 && hi + margin <= last
         };
-        span(row, dr, t.last_row) && span(col, dc, t.last_col)
+        span(at.row, at.drow_dh, t.last_row) && span(at.col, at.dcol_dh, t.last_col)
     }
 
     /// Whether the ray's points over the whole band lie on one side outside the tile.
-    fn outside_over(&self, row: f32, col: f32, dr: f32, dc: f32, h: f32) -> bool {
+    fn outside_over(&self, at: &Located, h: f32) -> bool {
         let t = &self.frame;
         let (dh_lo, dh_hi) = (t.lo_m - h, t.hi_m - h);
         let beyond = |x: f32, dx: f32, last: f32| {
@@ -388,15 +687,14 @@ impl DemGround {
             let (lo, hi) = if a < b { (a, b) } else { (b, a) };
             hi + margin < 0.0 || lo - margin > last
         };
-        beyond(row, dr, t.last_row) || beyond(col, dc, t.last_col)
+        beyond(at.row, at.drow_dh, t.last_row) || beyond(at.col, at.dcol_dh, t.last_col)
     }
 
-    /// The tile at height h on the ray: the raised ellipsoid's near root (the general
-    /// form's quadratic, written in the ITRF), the point's grid coordinates, the
-    /// bilinear height and its gradient along the ray.
-    #[inline(always)]
-    fn evaluate(&self, rays: &SegmentRays, ray: &Ray, h: f32) -> Evaluation {
-        let t = &self.frame;
+    /// Where the ray meets the ellipsoid raised by h (the general form's quadratic,
+    /// written in the ITRF), and that point's grid coordinates; `None` where it misses
+    /// that ellipsoid, or the point is beyond the grid coordinates' reach.
+    #[inline(never)]
+    fn locate(&self, rays: &SegmentRays, ray: &Ray, h: f32) -> Option<Located> {
         let a = EARTH.a_m as f32;
         let big_a = a + h;
         let big_b = EARTH.b_m() as f32 + h;
@@ -409,59 +707,67 @@ impl DemGround {
         let beta = ray.rd + k * r[2] * d[2];
         let disc = beta * beta - alpha * c;
         if !(beta < 0.0 && disc > 0.0) {
-            return Evaluation::March;
+            return None;
         }
         let sq = Real::sqrt(disc);
         let s = c / (sq - beta);
-        // tan^2(theta) = |d|^2 A^2 / disc - 1 (the incidence on the raised ellipsoid).
-        let tan2 = ray.uu * big_a * big_a / disc - 1.0;
-        // Beyond 72 deg from the vertical the straight-line reach below is not trusted.
-        if !(tan2 < MAX_TAN2) {
+        let ds_dh = -big_a / sq;
+        let x: [f32; 3] = core::array::from_fn(|i| r[i] + s * d[i]);
+        let (row, col) = self.grid_at(big_a / big_b, x)?;
+        Some(Located {
+            s,
+            ds_dh,
+            row,
+            col,
+            drow_dh: ray.jr * ds_dh,
+            dcol_dh: ray.jc * ds_dh,
+            // tan^2(theta) = |d|^2 A^2 / disc - 1 (the incidence on the raised
+            // ellipsoid).
+            tan2: ray.uu * big_a * big_a / disc - 1.0,
+        })
+    }
+
+    /// The tile at height h on the ray: [`DemGround::locate`], then the bilinear height
+    /// and its gradient along the ray.
+    #[inline(always)]
+    fn evaluate(&self, rays: &SegmentRays, ray: &Ray, h: f32) -> Evaluation {
+        let t = &self.frame;
+        let Some(at) = self.locate(rays, ray, h) else {
+            // A miss of this raised ellipsoid (a grazing ray), or a point a quarter of
+            // the globe from the tile.
+            return Evaluation::March;
+        };
+        // Beyond 72 deg from the vertical the straight-line reach is not trusted.
+        if !(at.tan2 < MAX_TAN2) {
             return Evaluation::March;
         }
-        let ds_dh = -big_a / sq;
-        let (drow_dh, dcol_dh) = (ray.jr * ds_dh, ray.jc * ds_dh);
-        let x: [f32; 3] = core::array::from_fn(|i| r[i] + s * d[i]);
-        let Some((row, col)) = self.grid_at(big_a / big_b, x) else {
-            // Beyond the arctangents' reach: far outside the tile unless the ray's
-            // stretch through the band spans degrees, which only a grazing one does.
-            let stretch_rad = (drow_dh / t.rows_per_rad).abs() + (dcol_dh / t.cols_per_rad).abs();
-            return if stretch_rad * (t.hi_m - t.lo_m) < 0.01 {
-                Evaluation::Outside
-            } else {
-                Evaluation::March
-            };
-        };
+        let (row, col) = (at.row, at.col);
         if !(row >= 0.0 && row <= t.last_row && col >= 0.0 && col <= t.last_col) {
-            return if self.outside_over(row, col, drow_dh, dcol_dh, h) {
+            return if self.outside_over(&at, h) {
                 Evaluation::Outside
             } else {
-                Evaluation::March
+                Evaluation::Off(at)
             };
         }
         // Outside checked first: a tile with steep cells sends the rays it covers to
         // the march, not those it does not.
-        let q2 = t.slope2 * tan2;
+        let q2 = t.slope2 * at.tan2;
         if !(q2 < MAX_CONTRACTION * MAX_CONTRACTION) {
             return Evaluation::March;
         }
         let (height, per_row, per_col) = self.bilinear(row, col);
         Evaluation::At {
-            s,
+            at,
             g: height - h,
-            dg_dh: per_row * drow_dh + per_col * dcol_dh - 1.0,
-            ds_dh,
+            dg_dh: per_row * at.drow_dh + per_col * at.dcol_dh - 1.0,
             q2,
-            row,
-            col,
-            drow_dh,
-            dcol_dh,
         }
     }
 
     /// Grid coordinates (row, column) of a point X of the ellipsoid raised by H (with
     /// k = (a + H)/(b + H)), by the arctangents about the tile's centre
-    /// (`HeightSearch::grid_at`'s method); `None` beyond their series' reach.
+    /// (`HeightSearch::grid_at`'s method); `None` for a point a quarter of the globe
+    /// from the tile's meridian.
     #[inline(always)]
     fn grid_at(&self, k: f32, x: [f32; 3]) -> Option<(f32, f32)> {
         let t = &self.frame;
@@ -527,15 +833,22 @@ fn clamp(x: f32, lo: f32, hi: f32) -> f32 {
     }
 }
 
-/// atan(t) for |t| <= 0.1 by its series to t^9 (below 1e-12 left out); `None` beyond
-/// (and for NaN).
+/// atan(t): for |t| <= 0.1 (the tile and its surroundings) by its series to t^9
+/// (below 1e-12 left out), beyond by `core_math::trig::atan_f32` (points far off the
+/// tile, whose coordinates only place them there); `None` for NaN.
 #[inline(always)]
 fn atan_small(t: f32) -> Option<f32> {
     if !(t.abs() <= 0.1) {
-        return None;
+        return t.is_finite().then(|| atan_far(t));
     }
     let t2 = t * t;
     Some(t * (1.0 - t2 * (1.0 / 3.0 - t2 * (0.2 - t2 * (1.0 / 7.0 - t2 * (1.0 / 9.0))))))
+}
+
+#[cold]
+#[inline(never)]
+fn atan_far(t: f32) -> f32 {
+    core_math::trig::atan_f32(t)
 }
 
 /// (v1, v2) at the row's pixel p2 with the ground at range s: the row form

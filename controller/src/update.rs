@@ -135,24 +135,16 @@ impl Controller {
                 ground = self.make_ground(&instant, height_m);
                 ground_h_m = height_m;
             }
-            // With a DEM tile in force, each sample's own ground on it.
-            let dem = match (&ground, self.dem.as_mut(), &itrf) {
-                (Ok(update), Some(dem), Some(frame)) => Some(dem_extremes(
-                    dem,
-                    k,
-                    frame,
-                    float(update),
-                    seg,
-                    instant.r2_minus_a2_m2,
-                    height_m,
-                )),
-                _ => None,
-            };
-            let result = match (&ground, dem) {
+            let result = match (&ground, &itrf) {
                 (Err(f), _) => Err(*f),
-                (_, Some(Err(f))) => Err(f),
-                (Ok(update), Some(Ok(e))) => self.segment(update, seg, steer, Some(e)),
-                (Ok(update), None) => self.segment(update, seg, steer, None),
+                // With a DEM tile in force, each sample's own ground on it.
+                (Ok(update), Some(frame)) if self.dem.is_some() => self
+                    .dem_segment(k, frame, update, &instant, height_m)
+                    .and_then(|e| match self.plan.segments.get(k) {
+                        Some(seg) => self.segment(update, seg, steer, Some(&e)),
+                        None => Err(Fault::InvalidScene),
+                    }),
+                (Ok(update), _) => self.segment(update, seg, steer, None),
             };
             let slot = usize::from(index);
             match result {
@@ -214,7 +206,7 @@ impl Controller {
         update: &Ground,
         seg: &SegmentPlan,
         steer: Option<(f32, f32, f32)>,
-        dem: Option<Extremes>,
+        dem: Option<&Extremes>,
     ) -> Result<SegmentOutput, Fault> {
         // |v1| extremes and the largest |v2/v1| over the samples and the centre; every
         // one must move the same way along P1 (one transfer direction per segment). In
@@ -229,7 +221,7 @@ impl Controller {
             drift_v2,
             drift_v1,
         } = match dem {
-            Some(e) => e,
+            Some(e) => *e,
             None => self.extremes(update, seg)?,
         };
         let reversed = centre.v1_mps > 0.0;
@@ -400,6 +392,7 @@ fn float(g: &Ground) -> &GeneralUpdate<f32> {
 
 /// What a segment's samples show: v1's signed extremes, and the (|v2|, |v1|) of the
 /// largest |v2/v1| over the samples and the centre.
+#[derive(Clone, Copy)]
 struct Extremes {
     centre: ImageMotion<f32>,
     lo: f32,
@@ -455,10 +448,18 @@ fn dem_extremes(
     r2_minus_a2_m2: f32,
     terrain_h_m: f32,
 ) -> Result<Extremes, Fault> {
-    let row = GENERAL_F32.row_motion(update, &seg.row);
     let r = &seg.row;
     let rays = SegmentRays::new(dem, frame, r.p1_m, r.focal_m, r.uu0_m2, r2_minus_a2_m2);
+    let footprint = match (seg.samples.get(1), seg.samples.last()) {
+        (Some(a), Some(b)) => dem.footprint(&rays, a.p2_m, b.p2_m),
+        _ => None,
+    };
+    let row = GENERAL_F32.row_motion(update, &seg.row);
     sweep(seg, |j, p2| {
+        if footprint.is_some_and(|f| f.off_tile(p2)) {
+            dem.off_tile(k, j);
+            return row.motion_at(p2);
+        }
         match dem.sample(k, j, &rays, p2, terrain_h_m)? {
             SampleGround::Range(s) => motion_at_range(&row, update.c_m2, p2, s),
             SampleGround::Outside => row.motion_at(p2),
@@ -467,6 +468,30 @@ fn dem_extremes(
 }
 
 impl Controller {
+    /// [`dem_extremes`] of plan segment `k`, whose TERRAIN height `update` is made for.
+    #[inline(never)]
+    fn dem_segment(
+        &mut self,
+        k: usize,
+        frame: &ItrfFrame,
+        update: &Ground,
+        instant: &GeneralInstant<f32>,
+        terrain_h_m: f32,
+    ) -> Result<Extremes, Fault> {
+        let (Some(dem), Some(seg)) = (self.dem.as_mut(), self.plan.segments.get(k)) else {
+            return Err(Fault::InvalidScene);
+        };
+        dem_extremes(
+            dem,
+            k,
+            frame,
+            float(update),
+            seg,
+            instant.r2_minus_a2_m2,
+            terrain_h_m,
+        )
+    }
+
     /// Puts `tile` in force as the ground of every plan sample it covers, or (None)
     /// takes the tile out of force; the TERRAIN heights hold where no tile covers a
     /// sample, and while the state comes from NAV frames. The seam for the tile's
