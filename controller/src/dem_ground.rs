@@ -69,9 +69,8 @@ pub struct DemStats {
     pub unresolved: u32,
     /// Samples outside the tile: the segment's TERRAIN height.
     pub outside: u32,
-    /// Samples whose ray's stretch through the band meets the tile's edge, settled
-    /// there (the ray enters the tile on or below its surface: the ground is on the
-    /// tile's side).
+    /// Samples whose ray's stretch through the band meets the tile's edge, settled by
+    /// its entry and exit heights (counted also as searched or outside).
     pub edges: u32,
 }
 
@@ -313,8 +312,9 @@ enum Evaluation {
 /// What the tile's edges leave of a ray's search.
 enum Edges {
     Done(SampleGround),
-    /// The stretch in the tile, as the heights of its ends (m).
-    Within(f32, f32),
+    /// The stretch in the tile, as the heights of its ends (m), and whether the ray
+    /// enters the tile on or below its surface.
+    Within(f32, f32, bool),
 }
 
 /// Grid coordinates within this many cells outside the tile count as on its edge.
@@ -358,14 +358,16 @@ impl DemGround {
                 Evaluation::March => break,
                 Evaluation::Off(at) if !edges_done => {
                     edges_done = true;
-                    match self.edges(rays, &ray, h, &at) {
-                        None => break,
+                    let monotone = self.frame.slope2 * at.tan2 < MAX_CONTRACTION * MAX_CONTRACTION;
+                    match self.edges(rays, &ray, h, &at, monotone) {
                         Some(Edges::Done(found)) => Some(found),
-                        Some(Edges::Within(l, u)) => {
+                        Some(Edges::Within(l, u, false)) if monotone => {
+                            self.stats.edges += 1;
                             (lo, hi) = (l, u);
                             h = 0.5 * (l + u);
                             None
                         }
+                        _ => break,
                     }
                 }
                 // An iterate off the tile once its edges are known: rounding at them.
@@ -389,14 +391,15 @@ impl DemGround {
                             break;
                         }
                         edges_done = true;
-                        match self.edges(rays, &ray, h, &at) {
-                            None => break,
+                        match self.edges(rays, &ray, h, &at, true) {
                             Some(Edges::Done(found)) => Some(found),
-                            Some(Edges::Within(l, u)) => {
+                            Some(Edges::Within(l, u, false)) => {
+                                self.stats.edges += 1;
                                 (lo, hi) = (l, u);
                                 h = clamp(h + g, l, u);
                                 None
                             }
+                            _ => break,
                         }
                     } else {
                         if g > 0.0 {
@@ -416,10 +419,9 @@ impl DemGround {
                 }
             };
             if let Some(found) = found {
-                match found {
-                    SampleGround::Outside => self.stats.outside += 1,
-                    SampleGround::Range(_) => self.stats.edges += 1,
-                }
+                // Only the edges' route settles a sample here: off the tile.
+                self.stats.outside += 1;
+                self.stats.edges += 1;
                 self.remember(k, j, f32::NAN);
                 return Ok(found);
             }
@@ -450,6 +452,9 @@ impl DemGround {
         let t = &self.frame;
         let (mut h, mut lo) = (t.hi_m, t.lo_m);
         let mut edges_done = false;
+        // A crossing is a passage from above: the top of the band is above the surface,
+        // a ray entering through the tile's edge may not be.
+        let mut above = true;
         for _ in 0..MAX_TRACE {
             let at = self.locate(rays, ray, h)?;
             if !(at.tan2 < MAX_TAN2) {
@@ -462,10 +467,11 @@ impl DemGround {
                     return Some(SampleGround::Outside);
                 }
                 edges_done = true;
-                match self.edges(rays, ray, h, &at)? {
+                match self.edges(rays, ray, h, &at, false)? {
                     Edges::Done(found) => return Some(found),
-                    Edges::Within(l, u) => {
-                        (h, lo) = (u, l);
+                    Edges::Within(l, u, below) => {
+                        // Just inside the entry, found to within EDGE_TOLERANCE_M.
+                        (h, lo, above) = (u - 2.0 * EDGE_TOLERANCE_M, l, !below);
                         continue;
                     }
                 }
@@ -473,10 +479,16 @@ impl DemGround {
             let (height, _, _) = self.bilinear(row, col);
             let g = height - h;
             if g >= -TRACE_TOLERANCE_M {
-                return Some(SampleGround::Range(at.s));
+                if above {
+                    return Some(SampleGround::Range(at.s));
+                }
+            } else {
+                above = true;
             }
+            // From below the surface the same step cannot pass the point the ray comes
+            // out above it.
             let q = Real::sqrt(t.slope2 * at.tan2);
-            let step = -g / (1.0 + q);
+            let step = g.abs() / (1.0 + q);
             h -= if step > 0.01 { step } else { 0.01 };
             if h < lo {
                 return Some(SampleGround::Outside);
@@ -527,11 +539,19 @@ impl DemGround {
 
     /// The stretch of the ray through the band that lies in the tile, from a point of
     /// it `at` height h: its ends from the grid coordinates' rates, the edge it enters
-    /// by and the one it leaves by found exactly ([`DemGround::edge_height`]). Entering
-    /// the tile on or below its surface, the ray meets the tile's side: the march's
-    /// ground, and this one's. Leaving it above the surface, it meets none in the tile.
-    /// `None`: the march decides.
-    fn edges(&self, rays: &SegmentRays, ray: &Ray, h: f32, at: &Located) -> Option<Edges> {
+    /// by and the one it leaves by found exactly ([`DemGround::edge_height`]). A ray
+    /// entering the tile on or below its surface has not passed from above it there
+    /// (the march's rule); where g is `monotone` (q < 1) it then stays below in the
+    /// tile, and one leaving the tile above the surface was above all along: no ground
+    /// in the tile. `None`: the march in height decides.
+    fn edges(
+        &self,
+        rays: &SegmentRays,
+        ray: &Ray,
+        h: f32,
+        at: &Located,
+        monotone: bool,
+    ) -> Option<Edges> {
         let t = &self.frame;
         let (mut lo, mut hi) = (t.lo_m, t.hi_m);
         let (mut top, mut bottom) = (None, None);
@@ -566,28 +586,32 @@ impl DemGround {
         if lo - hi > EDGE_SHARE * way + 10.0 {
             return Some(Edges::Done(SampleGround::Outside));
         }
+        let mut below = false;
         if let Some((axis, edge)) = top {
-            let (h_in, s_in) = self.edge_height(rays, ray, axis, edge, hi)?;
-            let (g, _) = self.g_on_edge(rays, ray, h_in)?;
-            if g >= 0.0 {
-                return Some(Edges::Done(SampleGround::Range(s_in)));
+            let h_in = self.edge_height(rays, ray, axis, edge, hi)?;
+            let g = self.g_on_edge(rays, ray, h_in)?;
+            // Entering on or below the surface is no crossing (one is a passage from
+            // above); where g is monotone the ray stays below in the tile.
+            below = g >= -TRACE_TOLERANCE_M;
+            if below && monotone {
+                return Some(Edges::Done(SampleGround::Outside));
             }
             hi = h_in;
         }
         if let Some((axis, edge)) = bottom {
-            let (h_out, _) = self.edge_height(rays, ray, axis, edge, lo)?;
-            let (g, _) = self.g_on_edge(rays, ray, h_out)?;
-            if g < 0.0 {
+            let h_out = self.edge_height(rays, ray, axis, edge, lo)?;
+            // Leaving above the surface where g is monotone: it was above all along.
+            if monotone && self.g_on_edge(rays, ray, h_out)? < 0.0 {
                 return Some(Edges::Done(SampleGround::Outside));
             }
             lo = h_out;
         }
-        (lo < hi).then_some(Edges::Within(lo, hi))
+        (lo < hi).then_some(Edges::Within(lo, hi, below))
     }
 
     /// The height where the ray's grid coordinate `axis` (0: row, 1: column) equals
     /// `edge`, from the estimate `h_est`: a Newton step on the coordinate's rate, then
-    /// secant steps on exact points, to [`EDGE_TOLERANCE_M`]; with the range there.
+    /// secant steps on exact points, to [`EDGE_TOLERANCE_M`].
     fn edge_height(
         &self,
         rays: &SegmentRays,
@@ -595,7 +619,7 @@ impl DemGround {
         axis: u8,
         edge: f32,
         h_est: f32,
-    ) -> Option<(f32, f32)> {
+    ) -> Option<f32> {
         let mut h = h_est;
         let mut prev: Option<(f32, f32)> = None;
         for _ in 0..4 {
@@ -610,7 +634,7 @@ impl DemGround {
                 _ => h + (edge - x) / dx,
             };
             if (next - h).abs() <= EDGE_TOLERANCE_M {
-                return Some((next, at.s + (next - h) * at.ds_dh));
+                return Some(next);
             }
             prev = Some((h, x));
             h = next;
@@ -619,8 +643,8 @@ impl DemGround {
     }
 
     /// g = D - h at a point of the ray on the tile's edge (its grid coordinates within
-    /// [`EDGE_SLACK_CELLS`] of the tile, clamped onto it), and the range there.
-    fn g_on_edge(&self, rays: &SegmentRays, ray: &Ray, h: f32) -> Option<(f32, f32)> {
+    /// [`EDGE_SLACK_CELLS`] of the tile, clamped onto it).
+    fn g_on_edge(&self, rays: &SegmentRays, ray: &Ray, h: f32) -> Option<f32> {
         let t = &self.frame;
         let at = self.locate(rays, ray, h)?;
         let e = EDGE_SLACK_CELLS;
@@ -630,7 +654,7 @@ impl DemGround {
         let row = clamp(at.row, 0.0, t.last_row);
         let col = clamp(at.col, 0.0, t.last_col);
         let (height, _, _) = self.bilinear(row, col);
-        Some((height - h, at.s))
+        Some(height - h)
     }
 
     /// Notes sample `j` of plan segment `k` as off the tile by its segment's footprint.
@@ -871,4 +895,168 @@ pub(crate) fn motion_at_range(
         v1_mps: v1,
         v2_mps: c[0] + p2_m * (c[1] + c[2] * p2_m) - (c[3] + c[4] * p2_m) * q,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    extern crate std;
+    use std::boxed::Box;
+    use std::vec::Vec;
+
+    use super::{DemGround, SampleGround, SegmentRays};
+    use crate::config::EARTH;
+    use crate::track::ItrfFrame;
+    use core_math::earth::dem::{DemGrid, DemTile};
+    use core_math::ModelError;
+
+    /// ITRF point of geodetic (lat, lon, h) on WGS 84 (deg, deg, m).
+    fn itrf(lat_deg: f64, lon_deg: f64, h_m: f64) -> [f64; 3] {
+        let (lat, lon) = (lat_deg.to_radians(), lon_deg.to_radians());
+        let e2 = EARTH.flattening * (2.0 - EARTH.flattening);
+        let n = EARTH.a_m / (1.0 - e2 * lat.sin() * lat.sin()).sqrt();
+        [
+            (n + h_m) * lat.cos() * lon.cos(),
+            (n + h_m) * lat.cos() * lon.sin(),
+            (n * (1.0 - e2) + h_m) * lat.sin(),
+        ]
+    }
+
+    fn unit(x: [f64; 3]) -> [f64; 3] {
+        let n = (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
+        x.map(|v| v / n)
+    }
+
+    fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+        [
+            a[1] * b[2] - a[2] * b[1],
+            a[2] * b[0] - a[0] * b[2],
+            a[0] * b[1] - a[1] * b[0],
+        ]
+    }
+
+    /// Rays swept across each edge of a tile whose relief rises to 5 000 m along its
+    /// edges, from a satellite 700 km up looking 40 deg from the vertical into the
+    /// tile (entering it through the edge) and out of it (leaving through the edge):
+    /// each sample's range against `DemTile::first_crossing` in f64 (the march, the
+    /// reference's ground), the ray's side of the tile included.
+    #[test]
+    fn rays_across_the_edges_match_the_march() {
+        // A rim rising to 5 000 m over 6 cells (slopes to 0.6 with the ripple: the march
+        // in height), and to 3 500 m over 12 cells (0.35: the search in height).
+        let searched = edges_against_the_march(4_000.0, 6.0);
+        assert_eq!(searched, 0);
+        let searched = edges_against_the_march(2_500.0, 12.0);
+        assert!(searched > 1_000, "{searched}");
+    }
+
+    /// [`rays_across_the_edges_match_the_march`] over a rim of `rim_m` falling off over
+    /// `width` cells; the samples the search in height took.
+    fn edges_against_the_march(rim_m: f64, width: f64) -> u32 {
+        let (lat_c, lon_c, side, step) = (45.0, 10.0, 61usize, 0.01);
+        let half = 0.5 * (side - 1) as f64 * step;
+        let grid = DemGrid {
+            lat0_deg: lat_c - half,
+            lon0_deg: lon_c - half,
+            dlat_deg: step,
+            dlon_deg: step,
+            nrows: side,
+            ncols: side,
+        };
+        let last = (side - 1) as f64;
+        let heights: Vec<i16> = (0..side * side)
+            .map(|k| {
+                let (i, j) = ((k / side) as f64, (k % side) as f64);
+                let d = i.min(j).min(last - i).min(last - j);
+                (1_000.0 + rim_m * (-d / width).exp() + 300.0 * (0.3 * i + 0.2 * j).sin()) as i16
+            })
+            .collect();
+        let tile = DemTile::new(grid, Box::leak(heights.into_boxed_slice())).unwrap();
+        let mut ground = DemGround::new(tile).unwrap();
+        let focal = 0.555f64;
+        let (mut checked, mut walls, mut worst_m) = (0, 0, 0f64);
+        // (edge point, direction into the tile) for the west, east, south, north edges.
+        let edges = [
+            ((lat_c, lon_c - half), (0.0, 1.0)),
+            ((lat_c, lon_c + half), (0.0, -1.0)),
+            ((lat_c - half, lon_c), (1.0, 0.0)),
+            ((lat_c + half, lon_c), (-1.0, 0.0)),
+        ];
+        for ((lat, lon), (north_in, east_in)) in edges {
+            for inward in [1.0, -1.0] {
+                let t = itrf(lat, lon, 3_000.0);
+                let up = unit(t);
+                let east = unit([-t[1], t[0], 0.0]);
+                let north = cross(up, east);
+                let across: [f64; 3] =
+                    core::array::from_fn(|i| inward * (north_in * north[i] + east_in * east[i]));
+                // The satellite 700 km along the ray back from the edge point.
+                let (c, s) = (40f64.to_radians().cos(), 40f64.to_radians().sin());
+                let look = unit(core::array::from_fn(|i| -c * up[i] + s * across[i]));
+                let r: [f64; 3] = core::array::from_fn(|i| t[i] - 700e3 / c * look[i]);
+                // Camera axes: z = -look, y across the edge's normal plane (so the row
+                // sweeps across the edge), x = y cross z.
+                let z = look.map(|v| -v);
+                let y = unit(cross(z, cross(across, z)));
+                let x = cross(y, z);
+                let b: [[f64; 3]; 3] = core::array::from_fn(|i| [x[i], y[i], z[i]]);
+                let frame = ItrfFrame {
+                    position_m: r.map(|v| v as f32),
+                    camera_to_itrf: b.map(|row| row.map(|v| v as f32)),
+                };
+                let r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+                let rays = SegmentRays::new(
+                    &ground,
+                    &frame,
+                    0.0,
+                    focal as f32,
+                    (focal * focal) as f32,
+                    (r2 - EARTH.a_m * EARTH.a_m) as f32,
+                );
+                for n in -400..=400 {
+                    // p2 over +-8 mm: +-10 km across the edge at 700 km.
+                    let p2 = n as f64 * 2e-5;
+                    let d: [f64; 3] = core::array::from_fn(|i| b[i][1] * p2 - b[i][2] * focal);
+                    let want = tile.first_crossing::<f64>(&EARTH, r, d);
+                    let got = ground.sample(0, 0, &rays, p2 as f32, 0.0).unwrap();
+                    let len = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+                    match (got, want) {
+                        (SampleGround::Range(s), Ok(s_ref)) => {
+                            let off_m = (f64::from(s) - s_ref).abs() * len;
+                            worst_m = worst_m.max(off_m);
+                            assert!(off_m <= 10.0, "p2 {p2}: {s} vs {s_ref} ({off_m} m)");
+                        }
+                        (SampleGround::Outside, Err(ModelError::OutsideDem)) => {}
+                        (g, w) => {
+                            // Either outcome only where the march's answer is a hair
+                            // from the edge (the contract's rule at the tile's edge).
+                            let g = match g {
+                                SampleGround::Range(s) => Some(s),
+                                SampleGround::Outside => None,
+                            };
+                            let geo = w.ok().map(|s| {
+                                let x: [f64; 3] = core::array::from_fn(|i| r[i] + s * d[i]);
+                                core_math::earth::frames::geodetic_from_itrf(x, &EARTH)
+                                    .map(|(la, lo, h)| (la.to_degrees(), lo.to_degrees(), h))
+                            });
+                            panic!(
+                                "edge ({lat}, {lon}) inward {inward} p2 {p2}: route {g:?}, \
+                                 march {w:?} at {geo:?}; {:?}",
+                                ground.stats
+                            );
+                        }
+                    }
+                    checked += 1;
+                }
+                walls += ground.stats.edges;
+                ground.stats.edges = 0;
+            }
+        }
+        std::eprintln!(
+            "edges (rim {rim_m} m over {width} cells): {checked} rays, worst range \
+             {worst_m:.2} m from the march's, {walls} settled at the edge; {:?}",
+            ground.stats
+        );
+        assert!(walls > 0, "no ray's stretch met the tile's edge");
+        ground.stats.searched
+    }
 }

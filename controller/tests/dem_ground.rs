@@ -334,7 +334,7 @@ fn report(name: &str, f: &Flight) {
     eprintln!(
         "{name}: {} updates, periods vs the DEM reference {:.2e} relative (TERRAIN \
          heights alone {:.2e}); samples: {} searched in {} evaluations ({:.2} each), {} \
-         traced, {} unresolved, {} off the tile, {} on its side",
+         traced, {} unresolved, {} off the tile, {} settled at its edge",
         f.updates,
         f.worst_dem,
         f.worst_terrain,

@@ -332,7 +332,7 @@ fn dem_update_regions(
     )?;
     let after = c.dem_stats().unwrap_or_default();
     defmt::info!(
-        "DEM update: {=u32} samples searched in {=u32} evaluations, {=u32} traced, {=u32} unresolved, {=u32} off the tile, {=u32} on its side",
+        "DEM update: {=u32} samples searched in {=u32} evaluations, {=u32} traced, {=u32} unresolved, {=u32} off the tile, {=u32} settled at its edge",
         after.searched - before.searched,
         after.evaluations - before.evaluations,
         after.traced - before.traced,
@@ -353,7 +353,7 @@ fn dem_update_regions(
     )?;
     let first = c.dem_stats().unwrap_or_default();
     defmt::info!(
-        "DEM first update: {=u32} samples searched in {=u32} evaluations, {=u32} traced, {=u32} unresolved, {=u32} off the tile, {=u32} on its side",
+        "DEM first update: {=u32} samples searched in {=u32} evaluations, {=u32} traced, {=u32} unresolved, {=u32} off the tile, {=u32} settled at its edge",
         first.searched,
         first.evaluations,
         first.traced,
