@@ -124,6 +124,8 @@ impl Controller {
         // place in memory, which the out-of-line `segment` and `extremes` read.
         let mut ground_h_m = f32::NAN;
         let mut ground: Result<Ground, Fault> = Err(Fault::OutOfRange);
+        // The DEM's route needs a tile in force and the ITRF of the instant.
+        let dem_frame = if self.dem.is_some() { itrf } else { None };
         for k in 0..self.plan.segments.len() {
             let Some(seg) = self.plan.segments.get(k) else {
                 break;
@@ -135,10 +137,10 @@ impl Controller {
                 ground = self.make_ground(&instant, height_m);
                 ground_h_m = height_m;
             }
-            let result = match (&ground, &itrf) {
+            let result = match (&ground, &dem_frame) {
                 (Err(f), _) => Err(*f),
                 // With a DEM tile in force, each sample's own ground on it.
-                (Ok(update), Some(frame)) if self.dem.is_some() => self
+                (Ok(update), Some(frame)) => self
                     .dem_segment(k, frame, update, &instant, height_m)
                     .and_then(|e| match self.plan.segments.get(k) {
                         Some(seg) => self.segment(update, seg, steer, Some(&e)),
