@@ -153,6 +153,9 @@ pub struct Controller {
     pub(crate) boot: Option<(ResetCause, u32)>,
     /// The DEM tile upload and the tile in force ([`crate::dem`]).
     pub(crate) dem: Dem,
+    /// The DEM tile in force and the per-sample state of its route
+    /// ([`crate::dem_ground`]); None: the TERRAIN heights are the ground.
+    pub(crate) dem_ground: Option<crate::dem_ground::DemGround>,
 }
 
 impl Controller {
@@ -207,6 +210,7 @@ impl Controller {
             inputs_generation: 0,
             boot: None,
             dem: Dem::default(),
+            dem_ground: None,
         }
     }
 

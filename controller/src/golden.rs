@@ -13,6 +13,7 @@
 use core_math::earth::bus::{
     bus_geometry, AttitudeFrame, BusAttitude, BusState, BusTime, StateFrame,
 };
+use core_math::earth::dem::DemTile;
 use core_math::earth::frames::{self, TimeScales};
 use core_math::earth::kepler::Kepler;
 use core_math::earth::reference::EarthRefPixel;
@@ -117,6 +118,48 @@ pub fn bus_update(
     scales: &TimeScales,
     t_us: u64,
 ) -> Result<UpdateGolden, ModelError> {
+    bus_update_on(scene, plan, heights_m, gnss, attitude, scales, t_us, None)
+}
+
+/// [`bus_update`] with the ground on a DEM `tile` (Part II, "The ground from a DEM"):
+/// each pixel's ground point the tile's first crossing in f64
+/// (`EarthReference::motion_on_dem`: `DemTile::first_crossing`, then the construction
+/// on dual numbers), and the segment's height in `heights_m` where the tile does not
+/// cover the pixel (`outside_dem`).
+#[allow(clippy::too_many_arguments)]
+pub fn bus_update_on_dem(
+    scene: &Scene,
+    plan: &Plan,
+    heights_m: &[f32],
+    gnss: &Gnss,
+    attitude: &StarAttitude,
+    scales: &TimeScales,
+    t_us: u64,
+    tile: &DemTile<'_, i16>,
+) -> Result<UpdateGolden, ModelError> {
+    bus_update_on(
+        scene,
+        plan,
+        heights_m,
+        gnss,
+        attitude,
+        scales,
+        t_us,
+        Some(tile),
+    )
+}
+
+#[allow(clippy::too_many_arguments)]
+fn bus_update_on(
+    scene: &Scene,
+    plan: &Plan,
+    heights_m: &[f32],
+    gnss: &Gnss,
+    attitude: &StarAttitude,
+    scales: &TimeScales,
+    t_us: u64,
+    tile: Option<&DemTile<'_, i16>>,
+) -> Result<UpdateGolden, ModelError> {
     let secs = |us: u64| us as f64 * 1e-6;
     let t_s = secs(t_us);
     let (r, v, w) = (gnss.position_m, gnss.velocity_mps, EARTH_RATE_RAD_S);
@@ -170,7 +213,11 @@ pub fn bus_update(
                 p2_m,
                 focal_m: camera.focal_m,
             };
-            EarthReference::motion_of(&geometry(h_m)?, &pixel)
+            let g = geometry(h_m)?;
+            match tile.map(|t| EarthReference::motion_on_dem(&g, &pixel, t)) {
+                None | Some(Err(ModelError::OutsideDem)) => EarthReference::motion_of(&g, &pixel),
+                Some(found) => found,
+            }
         };
     let (segments, yaw_request_rad) = segments_of(scene, plan, heights_m, evaluate)?;
     Ok(UpdateGolden {

@@ -17,6 +17,7 @@ pub mod config;
 pub mod control;
 pub mod crc;
 pub mod dem;
+pub mod dem_ground;
 pub mod downlink;
 pub mod fault;
 pub mod frame;

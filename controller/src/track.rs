@@ -152,6 +152,16 @@ fn turned(b: &[[f32; 3]; 3], omega: [f32; 3], dt_s: f32) -> [[f32; 3]; 3] {
     })
 }
 
+/// The satellite and the camera's axes in the ITRF of an update instant: what the DEM's
+/// ground needs besides the general form's constants (a line of sight r + s B u).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ItrfFrame {
+    /// r (m).
+    pub position_m: [f32; 3],
+    /// B, row-major: x_ITRF = B x_camera.
+    pub camera_to_itrf: [[f32; 3]; 3],
+}
+
 /// The general form's per-instant constants at the update instant from the GNSS state
 /// `dt_fix_s` after its fix and the attitude `dt_att_s` after its validity.
 pub fn instant(
@@ -160,6 +170,17 @@ pub fn instant(
     dt_fix_s: f32,
     dt_att_s: f32,
 ) -> Result<GeneralInstant<f32>, ModelError> {
+    instant_in_itrf(gnss, attitude, dt_fix_s, dt_att_s).map(|(i, _)| i)
+}
+
+/// [`instant`] with the satellite and the camera's axes in the ITRF of the instant.
+#[inline(always)]
+pub fn instant_in_itrf(
+    gnss: &GnssState,
+    attitude: &AttitudeState,
+    dt_fix_s: f32,
+    dt_att_s: f32,
+) -> Result<(GeneralInstant<f32>, ItrfFrame), ModelError> {
     let state = gnss.propagator.parts_at(dt_fix_s);
     let turn = earth_turn(dt_fix_s);
     let b = turned(&attitude.camera_to_inertial, attitude.omega_rad_s, dt_att_s);
@@ -170,8 +191,9 @@ pub fn instant(
         core::array::from_fn(|j| c * b[1][j] - s * b[0][j]),
         b[2],
     ];
-    GENERAL_F32.instant_inertial_parts(
-        to_later_itrf(state.position_m, turn),
+    let position_m = to_later_itrf(state.position_m, turn);
+    let instant = GENERAL_F32.instant_inertial_parts(
+        position_m,
         to_later_itrf(state.velocity_mps, turn),
         // A turn about z changes no length.
         state.r2_minus_a2_m2,
@@ -180,5 +202,12 @@ pub fn instant(
             omega_rad_s: attitude.omega_rad_s,
         },
         EARTH_RATE_RAD_S as f32,
-    )
+    )?;
+    Ok((
+        instant,
+        ItrfFrame {
+            position_m,
+            camera_to_itrf: b_t,
+        },
+    ))
 }

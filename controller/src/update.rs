@@ -11,11 +11,14 @@ use core_math::{nearest_ticks, smear_mtf, Backend, Real, GENERAL_F32};
 
 use crate::config::{EARTH, EARTH_RATE_RAD_S, MAX_TIME_TAG_US};
 use crate::control::{Controller, Mode, SegmentOutput};
+use crate::dem_ground::{
+    motion_at_range, DemGround, DemStats, SampleGround, SegmentRays, TileRefusal,
+};
 use crate::fault::Fault;
 use crate::nav::attitude_at;
 use crate::plan::SegmentPlan;
 use crate::sink::LinePeriodSink;
-use crate::track;
+use crate::track::{self, ItrfFrame};
 
 impl Controller {
     /// Moves the clock to `now_us` (from the time source) and runs the update that is due,
@@ -57,6 +60,9 @@ impl Controller {
 
     fn update_at<S: LinePeriodSink>(&mut self, t_us: u64, sink: &mut S) {
         self.yaw_request_rad = None;
+        // The satellite and the camera in the ITRF: the DEM's ground needs them, and
+        // only the bus's frames give them (NAV's frame has no longitude).
+        let mut itrf: Option<ItrfFrame> = None;
         let instant = match (&self.nav, &self.gnss, &self.attitude) {
             (Some(nav), _, _) if self.update_mode != Mode::Stale => {
                 let dt_s = seconds_since(t_us, nav.time_us);
@@ -71,12 +77,16 @@ impl Controller {
                 )
             }
             (None, Some(gnss), Some(attitude)) if self.update_mode != Mode::Stale => {
-                track::instant(
+                track::instant_in_itrf(
                     gnss,
                     attitude,
                     seconds_since(t_us, gnss.fix_us),
                     seconds_since(t_us, attitude.received.valid_us),
                 )
+                .map(|(instant, frame)| {
+                    itrf = Some(frame);
+                    instant
+                })
             }
             (None, None, _) | (None, _, None) => return,
             _ => {
@@ -114,6 +124,12 @@ impl Controller {
         // place in memory, which the out-of-line `segment` and `extremes` read.
         let mut ground_h_m = f32::NAN;
         let mut ground: Result<Ground, Fault> = Err(Fault::OutOfRange);
+        // The DEM's route needs a tile in force and the ITRF of the instant.
+        let dem_frame = if self.dem_ground.is_some() {
+            itrf
+        } else {
+            None
+        };
         for k in 0..self.plan.segments.len() {
             let Some(seg) = self.plan.segments.get(k) else {
                 break;
@@ -125,9 +141,16 @@ impl Controller {
                 ground = self.make_ground(&instant, height_m);
                 ground_h_m = height_m;
             }
-            let result = match &ground {
-                Ok(update) => self.segment(update, seg, steer),
-                Err(f) => Err(*f),
+            let result = match (&ground, &dem_frame) {
+                (Err(f), _) => Err(*f),
+                // With a DEM tile in force, each sample's own ground on it.
+                (Ok(update), Some(frame)) => self
+                    .dem_segment(k, frame, update, &instant, height_m)
+                    .and_then(|e| match self.plan.segments.get(k) {
+                        Some(seg) => self.segment(update, seg, steer, Some(&e)),
+                        None => Err(Fault::InvalidScene),
+                    }),
+                (Ok(update), _) => self.segment(update, seg, steer, None),
             };
             let slot = usize::from(index);
             match result {
@@ -189,6 +212,7 @@ impl Controller {
         update: &Ground,
         seg: &SegmentPlan,
         steer: Option<(f32, f32, f32)>,
+        dem: Option<&Extremes>,
     ) -> Result<SegmentOutput, Fault> {
         // |v1| extremes and the largest |v2/v1| over the samples and the centre; every
         // one must move the same way along P1 (one transfer direction per segment). In
@@ -202,7 +226,10 @@ impl Controller {
             hi,
             drift_v2,
             drift_v1,
-        } = self.extremes(update, seg)?;
+        } = match dem {
+            Some(e) => *e,
+            None => self.extremes(update, seg)?,
+        };
         let reversed = centre.v1_mps > 0.0;
         let tan_centre = centre.v2_mps / centre.v1_mps;
         // v1's extremes are tracked signed, and its sign checked once after the loop;
@@ -371,6 +398,7 @@ fn float(g: &Ground) -> &GeneralUpdate<f32> {
 
 /// What a segment's samples show: v1's signed extremes, and the (|v2|, |v1|) of the
 /// largest |v2/v1| over the samples and the centre.
+#[derive(Clone, Copy)]
 struct Extremes {
     centre: ImageMotion<f32>,
     lo: f32,
@@ -400,7 +428,7 @@ fn extremes(update: &GeneralUpdate<f32>, seg: &SegmentPlan) -> Result<Extremes, 
     let ends = (seg.samples.get(1), seg.samples.last());
     match ends {
         (Some(a), Some(b)) if row.faces_ground_over(a.p2_m, b.p2_m) => {
-            sweep(seg, |p2| row.motion_at_facing(p2))
+            sweep(seg, |_, p2| row.motion_at_facing(p2))
         }
         _ => sweep_checked(&row, seg),
     }
@@ -409,7 +437,92 @@ fn extremes(update: &GeneralUpdate<f32>, seg: &SegmentPlan) -> Result<Extremes, 
 #[cold]
 #[inline(never)]
 fn sweep_checked(row: &GeneralRowMotion<f32>, seg: &SegmentPlan) -> Result<Extremes, Fault> {
-    sweep(seg, |p2| row.motion_at(p2))
+    sweep(seg, |_, p2| row.motion_at(p2))
+}
+
+/// The segment's [`Extremes`] with every sample's ground on the DEM tile (or, where the
+/// tile does not cover it, at the segment's TERRAIN height `terrain_h_m`, which `update`
+/// is made for): [`DemGround::sample`] per sample, then the row form at that range.
+/// Out of line: the flat route's registers stay as they were.
+#[inline(never)]
+fn dem_extremes(
+    dem: &mut DemGround,
+    k: usize,
+    frame: &ItrfFrame,
+    update: &GeneralUpdate<f32>,
+    seg: &SegmentPlan,
+    r2_minus_a2_m2: f32,
+    terrain_h_m: f32,
+) -> Result<Extremes, Fault> {
+    let r = &seg.row;
+    let rays = SegmentRays::new(dem, frame, r.p1_m, r.focal_m, r.uu0_m2, r2_minus_a2_m2);
+    let footprint = match (seg.samples.get(1), seg.samples.last()) {
+        (Some(a), Some(b)) => dem.footprint(&rays, a.p2_m, b.p2_m),
+        _ => None,
+    };
+    let row = GENERAL_F32.row_motion(update, &seg.row);
+    sweep(seg, |j, p2| {
+        if footprint.is_some_and(|f| f.off_tile(p2)) {
+            dem.off_tile(k, j);
+            return row.motion_at(p2);
+        }
+        match dem.sample(k, j, &rays, p2, terrain_h_m)? {
+            SampleGround::Range(s) => motion_at_range(&row, update.c_m2, p2, s),
+            SampleGround::Outside => row.motion_at(p2),
+        }
+    })
+}
+
+impl Controller {
+    /// [`dem_extremes`] of plan segment `k`, whose TERRAIN height `update` is made for.
+    #[inline(never)]
+    fn dem_segment(
+        &mut self,
+        k: usize,
+        frame: &ItrfFrame,
+        update: &Ground,
+        instant: &GeneralInstant<f32>,
+        terrain_h_m: f32,
+    ) -> Result<Extremes, Fault> {
+        let (Some(dem), Some(seg)) = (self.dem_ground.as_mut(), self.plan.segments.get(k)) else {
+            return Err(Fault::InvalidScene);
+        };
+        dem_extremes(
+            dem,
+            k,
+            frame,
+            float(update),
+            seg,
+            instant.r2_minus_a2_m2,
+            terrain_h_m,
+        )
+    }
+
+    /// Puts `tile` in force as the ground of every plan sample it covers, or (None)
+    /// takes the tile out of force; the TERRAIN heights hold where no tile covers a
+    /// sample, and while the state comes from NAV frames. The seam for the tile's
+    /// upload (protocol 4), which checks it; the route's constants are made here, once.
+    #[doc(hidden)]
+    pub fn set_dem_tile(
+        &mut self,
+        tile: Option<core_math::earth::dem::DemTile<'static, i16>>,
+    ) -> Result<(), TileRefusal> {
+        self.dem_ground = match tile {
+            Some(t) => Some(DemGround::new(t)?),
+            None => None,
+        };
+        Ok(())
+    }
+
+    /// The DEM tile in force, if any.
+    pub fn dem_tile_in_force(&self) -> Option<&core_math::earth::dem::DemTile<'static, i16>> {
+        self.dem_ground.as_ref().map(|d| d.tile())
+    }
+
+    /// How the DEM route found the samples' ground since the tile was set.
+    pub fn dem_stats(&self) -> Option<DemStats> {
+        self.dem_ground.as_ref().map(|d| d.stats)
+    }
 }
 
 /// The centre's motion, then the extremes over the centre and the samples, by
@@ -417,12 +530,12 @@ fn sweep_checked(row: &GeneralRowMotion<f32>, seg: &SegmentPlan) -> Result<Extre
 #[inline(always)]
 fn sweep(
     seg: &SegmentPlan,
-    motion_at: impl Fn(f32) -> Result<ImageMotion<f32>, core_math::ModelError>,
+    mut motion_at: impl FnMut(usize, f32) -> Result<ImageMotion<f32>, core_math::ModelError>,
 ) -> Result<Extremes, Fault> {
     let Some((first, samples)) = seg.samples.split_first() else {
         return Err(Fault::InvalidScene);
     };
-    let centre = motion_at(first.p2_m)?;
+    let centre = motion_at(0, first.p2_m)?;
     // Comparisons, not f32::min/max: those are software calls on this core
     // (fminf/fmaxf, NaN handling). `motion_at` refuses a NaN v1.
     let mut e = Extremes {
@@ -432,8 +545,8 @@ fn sweep(
         drift_v2: centre.v2_mps.abs(),
         drift_v1: centre.v1_mps.abs(),
     };
-    for sample in samples {
-        let m = motion_at(sample.p2_m)?;
+    for (j, sample) in samples.iter().enumerate() {
+        let m = motion_at(j + 1, sample.p2_m)?;
         if m.v1_mps < e.lo {
             e.lo = m.v1_mps;
         }

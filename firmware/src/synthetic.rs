@@ -74,7 +74,7 @@ pub fn controller_with_nav(
 }
 
 /// The synthetic orbit's state at its epoch (ECI of date, or the ITRF frozen then).
-fn orbit() -> StateVector {
+pub fn orbit() -> StateVector {
     let r_m = controller::EARTH.a_m + ALTITUDE_M;
     let (i0, u) = (INCLINATION_DEG.to_radians(), ARG_LATITUDE_RAD);
     let speed = libm::sqrt(core_math::GM_M3_S2 / r_m);

@@ -247,11 +247,120 @@ fn scene_kinds() -> Result<(), FirmwareError> {
         BUS_EPOCH_US + 80_000,
         BUS_EPOCH_US + 100_000,
     )?;
+    dem_update_regions(all, agile)?;
     let mut c = controller_with_nav(all, false, agile)?;
     first_update_region(
         "scene roll and pitch up to 25 deg, the first update after NAV, all segments: planned",
         &mut c,
     )?;
+    Ok(())
+}
+
+/// Nodes along each side of the update bench's DEM tile (128 x 128 int16, the
+/// protocol's smallest: 32 KiB of RAM).
+const TILE_SIDE: usize = 128;
+/// Its spacing (deg): 4.3 km cells, the tile 4.95 deg wide, as wide as the DEM route
+/// takes (`controller::dem_ground::MAX_TILE_HALF_DEG`).
+const TILE_STEP_DEG: f64 = 0.039;
+static mut TILE_HEIGHTS: [i16; TILE_SIDE * TILE_SIDE] = [0; TILE_SIDE * TILE_SIDE];
+
+/// The bus-frame update at the agile instant with a DEM tile in force, centred under
+/// the boresight (mountains of 5 200 m range, slopes to about 0.35; the swath's outer
+/// segments reach past it): the steady update (two updates before it), and the first
+/// after the tile came into force (each sample's search starts from its TERRAIN height).
+fn dem_update_regions(
+    scene: controller::Scene,
+    attitude: controller::nav::Attitude<f32>,
+) -> Result<(), FirmwareError> {
+    use core_math::earth::dem::{DemGrid, DemTile};
+    use core_math::earth::frames::geodetic_from_itrf;
+    use core_math::earth::reference::EarthRefPixel;
+
+    let g = EarthGeometry {
+        state: firmware::synthetic::orbit(),
+        attitude: attitude.to_f64(),
+        ground_h_m: 2_500.0,
+        ellipsoid: controller::EARTH,
+        earth_rate_rad_s: core_math::EARTH_RATE_RAD_S,
+    }
+    .to_inertial()?;
+    let px = EarthRefPixel {
+        p1_m: 0.0,
+        p2_m: 0.0,
+        focal_m: scene.camera.focal_m,
+    };
+    let chain = EarthReference::chain(&g, &px)?;
+    let (lat, lon, _) = geodetic_from_itrf(chain.ground_m, &g.ellipsoid)?;
+    let half = 0.5 * (TILE_SIDE - 1) as f64 * TILE_STEP_DEG;
+    let grid = DemGrid {
+        lat0_deg: lat.to_degrees() - half,
+        lon0_deg: lon.to_degrees() - half,
+        dlat_deg: TILE_STEP_DEG,
+        dlon_deg: TILE_STEP_DEG,
+        nrows: TILE_SIDE,
+        ncols: TILE_SIDE,
+    };
+    let tau = core::f64::consts::TAU;
+    // SAFETY: the bench is single-threaded and takes no interrupt that reads it; the
+    // table is written once here, before any reference to it is taken.
+    let heights: &'static [i16] = unsafe {
+        let table = &mut *core::ptr::addr_of_mut!(TILE_HEIGHTS);
+        for (k, h) in table.iter_mut().enumerate() {
+            let (i, j) = ((k / TILE_SIDE) as f64, (k % TILE_SIDE) as f64);
+            *h = libm::round(
+                2_500.0
+                    + 2_000.0 * libm::sin(tau * i / 17.0) * libm::cos(tau * j / 23.0)
+                    + 600.0 * libm::sin(tau * (i + j) / 11.0),
+            ) as i16;
+        }
+        &*core::ptr::addr_of!(TILE_HEIGHTS)
+    };
+    let tile = DemTile::new(grid, heights)?;
+    let mut c = controller_with_bus(scene, attitude)?;
+    c.set_dem_tile(Some(tile))
+        .map_err(|_| FirmwareError::Layout)?;
+    for t in [BUS_EPOCH_US + 60_000, BUS_EPOCH_US + 80_000] {
+        if !c.advance(t, &mut NoRegisters) {
+            return Err(FirmwareError::Telemetry);
+        }
+    }
+    let before = c.dem_stats().unwrap_or_default();
+    update_region(
+        "bus frames and a 128 x 128 DEM tile, scene roll and pitch up to 25 deg, all segments: planned",
+        &mut c,
+        BUS_EPOCH_US + 100_000,
+    )?;
+    let after = c.dem_stats().unwrap_or_default();
+    defmt::info!(
+        "DEM update: {=u32} samples searched in {=u32} evaluations, {=u32} traced, {=u32} unresolved, {=u32} off the tile, {=u32} settled at its edge",
+        after.searched - before.searched,
+        after.evaluations - before.evaluations,
+        after.traced - before.traced,
+        after.unresolved - before.unresolved,
+        after.outside - before.outside,
+        after.edges - before.edges
+    );
+    let mut c = controller_with_bus(scene, attitude)?;
+    if !c.advance(BUS_EPOCH_US + 80_000, &mut NoRegisters) {
+        return Err(FirmwareError::Telemetry);
+    }
+    c.set_dem_tile(Some(tile))
+        .map_err(|_| FirmwareError::Layout)?;
+    update_region(
+        "bus frames and a 128 x 128 DEM tile, the first update over it: planned",
+        &mut c,
+        BUS_EPOCH_US + 100_000,
+    )?;
+    let first = c.dem_stats().unwrap_or_default();
+    defmt::info!(
+        "DEM first update: {=u32} samples searched in {=u32} evaluations, {=u32} traced, {=u32} unresolved, {=u32} off the tile, {=u32} settled at its edge",
+        first.searched,
+        first.evaluations,
+        first.traced,
+        first.unresolved,
+        first.outside,
+        first.edges
+    );
     Ok(())
 }
 

@@ -130,7 +130,7 @@ impl<'a, H: DemHeight> DemTile<'a, H> {
     /// The tile's steepest slope (m/m), bounded as the march bounds it: the largest
     /// height step per radian of latitude over the smallest meridian radius, plus the
     /// same along longitude over the smallest parallel radius in the tile.
-    fn slope_metric(&self, e: &Ellipsoid) -> f64 {
+    pub(super) fn slope_metric(&self, e: &Ellipsoid) -> f64 {
         let f = e.flattening;
         let e2 = f * (2.0 - f);
         let g = &self.grid;

@@ -249,6 +249,19 @@ impl<'a, H: DemHeight> DemTile<'a, H> {
         (self.min_m, self.max_m)
     }
 
+    /// The node heights (m), row-major, row 0 the southernmost: for a caller that
+    /// evaluates the bilinear surface by grid coordinates of its own.
+    pub fn heights_m(&self) -> &'a [H] {
+        self.heights_m
+    }
+
+    /// The tile's steepest slope on ellipsoid `e` (m/m), bounded as the march and the
+    /// height search bound it (largest height step between neighbouring nodes over the
+    /// smallest radius in the tile).
+    pub fn steepest_slope(&self, e: &Ellipsoid) -> f64 {
+        self.slope_metric(e)
+    }
+
     /// The bilinear height (m) at a geodetic latitude and longitude (rad) in the closed
     /// box of the tile, `None` outside it.
     pub fn height_at<T: Real>(&self, lat_rad: T, lon_rad: T) -> Option<T> {
