@@ -12,6 +12,7 @@
 
 mod doc;
 mod general;
+mod general_fixed;
 mod grid;
 mod maps;
 mod point;
@@ -59,8 +60,12 @@ pub fn run(args: &Args) -> Result<()> {
     let t1 = Instant::now();
     let gmaps = grid::sweep_all(&general::GMAPS, div, None);
     let gsecs = t1.elapsed().as_secs_f64();
+    let t2 = Instant::now();
+    let xmaps = grid::sweep_all::<general_fixed::FCell>(&general::GMAPS, div, None);
+    let xsecs = t2.elapsed().as_secs_f64();
     let mut values = figures(&maps, secs);
     values.extend(general::figures(&gmaps, gsecs));
+    values.extend(general_fixed::figures(&xmaps, xsecs));
     println!("{}", values["summary_table"]);
     println!("{}", values["bound_line"]);
     println!("sweep: {} samples in {secs:.1} s", values["samples_total"]);
@@ -69,6 +74,12 @@ pub fn run(args: &Args) -> Result<()> {
     println!(
         "general model: {} cases in {gsecs:.1} s",
         values["G.samples"]
+    );
+    println!("{}", values["X.table"]);
+    println!("{}", values["X.bound_line"]);
+    println!(
+        "general model, EARTH_FIXED: {} cases in {xsecs:.1} s",
+        values["X.samples"]
     );
     if !quick {
         let root = crate::qemu::workspace_root();
@@ -80,12 +91,16 @@ pub fn run(args: &Args) -> Result<()> {
         for m in &gmaps {
             general::write_pngs(m, &dir)?;
         }
+        for m in &xmaps {
+            general_fixed::write_pngs(m, &dir)?;
+        }
         let text = doc::fill(TEMPLATE, &values)?;
         std::fs::write(root.join(DOC), text).with_context(|| format!("writing {DOC}"))?;
         eprintln!("stability: wrote {DOC} and the maps under {PNG_DIR}/");
     }
     let mut bad = grid::broken(&maps);
     bad.extend(grid::broken(&gmaps));
+    bad.extend(grid::broken(&xmaps));
     if !bad.is_empty() {
         bail!("stability bound broken:\n{}", bad.join("\n"));
     }
@@ -437,6 +452,28 @@ mod tests {
         // The rate maps reach the cancellation: kappa there dwarfs the angle maps'.
         let rates = maps.iter().find(|m| m.spec.letter == "F'").unwrap();
         assert!(rates.aggregate(|_, _| true).kappa.max > 1e3);
+    }
+
+    /// EARTH_FIXED over the same five maps, every dimension / 4: within the issue's
+    /// targets (2e-5 from 0.01 deg, 2e-6 from 1 deg where kappa <= 30), no refusal and no
+    /// non-finite result; not vacuous: the maps reach 0.02 deg of the limb, the errors are
+    /// real (the backend's Q25-Q33 roundings, not the reference against itself), and the
+    /// far-field check is exercised at kappa <= 30.
+    #[test]
+    fn general_fixed_coarse_maps_meet_the_targets() {
+        let maps: Vec<general_fixed::FMap> = grid::sweep_all(&general::GMAPS, 4, None);
+        let bad = grid::broken(&maps);
+        assert!(bad.is_empty(), "{}", bad.join("\n"));
+        let mut a = general_fixed::FCell::empty();
+        for m in &maps {
+            a.merge(&m.aggregate(|_, _| true));
+        }
+        assert!(a.n > 5_000, "{} cases", a.n);
+        assert_eq!((a.refused, a.non_finite), (0, 0));
+        assert!(a.min_margin_rad.to_degrees() < 0.02, "{}", a.min_margin_rad);
+        assert!(a.err.max > 1e-8, "fixed err {}", a.err.max);
+        assert!(a.near.at.is_some() && a.far_tame.at.is_some());
+        assert!(a.far_tame.max > 1e-9, "far err {}", a.far_tame.max);
     }
 
     /// |v_P| = f x (angular rate) x a function of h = H/R and the angles: scaling H and R
