@@ -82,7 +82,9 @@ pub fn sinc<T: Real>(x: T) -> T {
 #[inline(never)]
 fn sinc_beyond_pi<T: Real>(x: T) -> T {
     // |sinc x| <= 1/|x|: the limit at infinity is 0 (an overflowed argument, never NaN).
-    if !x.is_finite() {
+    // So is it from where the sine gives NaN on (`trig_f64`, no huge-argument
+    // reduction): there |sinc x| is below 1/1 647 099 = 6.1e-7, and 0 is that close.
+    if !x.is_finite() || x.abs() >= T::from_f64(crate::trig_f64::SIN_COS_LIMIT_RAD) {
         return T::ZERO;
     }
     x.sin() / x

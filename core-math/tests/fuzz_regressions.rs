@@ -16,6 +16,31 @@ fn f1_mtf_of_an_overflowing_argument_is_zero_not_nan() {
     );
 }
 
+/// F7: from 1 647 099 rad on the sine (no huge-argument reduction) is NaN, and so was
+/// sinc there; |sinc x| <= 1/|x| bounds the answer, which must be finite.
+#[test]
+fn f7_mtf_beyond_the_sines_domain_is_within_its_bound() {
+    let fuzzed = 0.1f32 - f32::EPSILON / 16.0; // 0.1 less one ulp (the fuzzer's case)
+    let cases: [(u32, f64); 5] = [
+        (u32::MAX, f64::from(fuzzed)),
+        (1_048_576, 1.0),          // x = 1 647 099.3, just past the limit
+        (1_048_575, 1.0),          // x = 1 647 097.8, just inside: the sine is computed
+        (256, 5_000.0),            // x = 2.0e6
+        (2_000_000_000, -0.002_5), // x = -7.9e6
+    ];
+    for (stages, rel) in cases {
+        let x = std::f64::consts::FRAC_PI_2 * f64::from(stages) * rel.abs();
+        let f64_mtf = mtf_mismatch::<f64>(stages, rel).unwrap();
+        let f32_mtf = mtf_mismatch::<f32>(stages, rel as f32).unwrap();
+        for m in [f64_mtf, f64::from(f32_mtf)] {
+            assert!(
+                m.is_finite() && (0.0..=1.0 / x).contains(&m),
+                "{stages} {rel}: {m}"
+            );
+        }
+    }
+}
+
 /// F2: an infinite speed, or an underflowing quotient, gave a zero period.
 #[test]
 fn f2_no_zero_line_period() {
