@@ -364,6 +364,14 @@ pub type GMap = grid::Map<GCell>;
 
 /// Where a case is.
 pub fn describe(c: &EarthCase, o: &GOutcome) -> String {
+    let mut s = case_place(c, o.margin_rad, o.v);
+    s.push_str(&format!(", v1 {} m/s", e2(o.v1)));
+    s
+}
+
+/// Where a case is, and its limb margin and image speed: the words every general map's
+/// `describe` starts with.
+pub fn case_place(c: &EarthCase, margin_rad: f64, v_mps: f64) -> String {
     let a = &c.geometry.attitude;
     let r = c.geometry.state.position_m;
     let h_km = (norm(r) - c.geometry.ellipsoid.a_m) / 1e3;
@@ -381,11 +389,10 @@ pub fn describe(c: &EarthCase, o: &GOutcome) -> String {
         ));
     }
     s.push_str(&format!(
-        ", n_px {:.0}; limb margin {} deg, |v| {} m/s, v1 {} m/s",
+        ", n_px {:.0}; limb margin {} deg, |v| {} m/s",
         c.n_px,
-        sig(o.margin_rad.to_degrees()),
-        e2(o.v),
-        e2(o.v1)
+        sig(margin_rad.to_degrees()),
+        e2(v_mps)
     ));
     s
 }

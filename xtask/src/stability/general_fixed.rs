@@ -228,29 +228,8 @@ pub type FMap = grid::Map<FCell>;
 
 /// Where a case is.
 pub fn describe(c: &EarthCase, o: &FOutcome) -> String {
-    let a = &c.geometry.attitude;
-    let r = c.geometry.state.position_m;
-    let h_km = (core_math::vector::norm(r) - c.geometry.ellipsoid.a_m) / 1e3;
-    let mut s = format!(
-        "H {h_km:.0} km, roll {:.2} deg, pitch {:.2} deg, yaw {:.0} deg",
-        a.roll_rad.to_degrees(),
-        a.pitch_rad.to_degrees(),
-        a.yaw_rad.to_degrees(),
-    );
-    if a.roll_rate_rad_s != 0.0 || a.pitch_rate_rad_s != 0.0 {
-        s.push_str(&format!(
-            ", roll rate {:.3} deg/s, pitch rate {:.3} deg/s",
-            a.roll_rate_rad_s.to_degrees(),
-            a.pitch_rate_rad_s.to_degrees()
-        ));
-    }
-    s.push_str(&format!(
-        ", n_px {:.0}; limb margin {} deg, |v| {} m/s, kappa {}",
-        c.n_px,
-        sig(o.margin_rad.to_degrees()),
-        e2(o.v),
-        sig(o.kappa)
-    ));
+    let mut s = super::general::case_place(c, o.margin_rad, o.v);
+    s.push_str(&format!(", kappa {}", sig(o.kappa)));
     s
 }
 
