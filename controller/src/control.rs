@@ -156,6 +156,9 @@ pub struct Controller {
     /// The DEM tile in force and the per-sample state of its route
     /// ([`crate::dem_ground`]); None: the TERRAIN heights are the ground.
     pub(crate) dem_ground: Option<crate::dem_ground::DemGround>,
+    /// A tile given by [`Controller::set_dem_tile`] (tests, the bench): it wins over
+    /// the uploaded one.
+    pub(crate) dem_given: Option<core_math::earth::dem::DemTile<'static, i16>>,
 }
 
 impl Controller {
@@ -211,6 +214,7 @@ impl Controller {
             boot: None,
             dem: Dem::default(),
             dem_ground: None,
+            dem_given: None,
         }
     }
 

@@ -108,7 +108,6 @@ struct TileFrame {
 /// The DEM tile in force and what the route keeps between updates.
 #[derive(Clone, Debug)]
 pub struct DemGround {
-    tile: DemTile<'static, i16>,
     frame: TileFrame,
     /// Each plan segment's samples' heights at the last update (NaN: none) and their
     /// change over it (m).
@@ -126,7 +125,7 @@ pub enum TileRefusal {
 
 impl DemGround {
     /// The route's constants for `tile` (f64 trigonometry, once per tile).
-    pub fn new(tile: DemTile<'static, i16>) -> Result<DemGround, TileRefusal> {
+    pub fn new(tile: &DemTile<'_, i16>) -> Result<DemGround, TileRefusal> {
         let g: DemGrid = *tile.grid();
         let (rows, cols) = ((g.nrows - 1) as f64, (g.ncols - 1) as f64);
         if 0.5 * rows * g.dlat_deg > MAX_TILE_HALF_DEG
@@ -178,16 +177,11 @@ impl DemGround {
                 as f32,
         };
         Ok(DemGround {
-            tile,
             frame,
             last_h_m: [[f32::NAN; MAX_SAMPLES]; MAX_SEGMENTS],
             step_h_m: [[0.0; MAX_SAMPLES]; MAX_SEGMENTS],
             stats: DemStats::default(),
         })
-    }
-
-    pub fn tile(&self) -> &DemTile<'static, i16> {
-        &self.tile
     }
 }
 
@@ -221,7 +215,10 @@ impl Footprint {
 
 /// One segment's rays at one update: d = d0 + p2 dy (the camera's row p1 turned into
 /// the ITRF), with what every evaluation reads.
-pub(crate) struct SegmentRays {
+pub(crate) struct SegmentRays<'h> {
+    /// The heights of the tile the route was made for (its grid's, row-major): lent
+    /// per update by whoever holds the tile.
+    heights_m: &'h [i16],
     r: [f32; 3],
     d0: [f32; 3],
     dy: [f32; 3],
@@ -238,15 +235,16 @@ pub(crate) struct SegmentRays {
     r2_minus_a2_m2: f32,
 }
 
-impl SegmentRays {
+impl<'h> SegmentRays<'h> {
     pub(crate) fn new(
         ground: &DemGround,
+        heights_m: &'h [i16],
         frame: &ItrfFrame,
         p1_m: f32,
         focal_m: f32,
         uu0_m2: f32,
         r2_minus_a2_m2: f32,
-    ) -> SegmentRays {
+    ) -> SegmentRays<'h> {
         let b = &frame.camera_to_itrf;
         let r = frame.position_m;
         // B (p1, 0, -f) and B (0, 1, 0).
@@ -255,6 +253,7 @@ impl SegmentRays {
         let dot = |x: [f32; 3], y: [f32; 3]| x[0] * y[0] + x[1] * y[1] + x[2] * y[2];
         let t = &ground.frame;
         SegmentRays {
+            heights_m,
             r,
             d0,
             dy,
@@ -476,7 +475,7 @@ impl DemGround {
                     }
                 }
             }
-            let (height, _, _) = self.bilinear(row, col);
+            let (height, _, _) = self.bilinear(rays.heights_m, row, col);
             let g = height - h;
             if g >= -TRACE_TOLERANCE_M {
                 if above {
@@ -653,7 +652,7 @@ impl DemGround {
         }
         let row = clamp(at.row, 0.0, t.last_row);
         let col = clamp(at.col, 0.0, t.last_col);
-        let (height, _, _) = self.bilinear(row, col);
+        let (height, _, _) = self.bilinear(rays.heights_m, row, col);
         Some(height - h)
     }
 
@@ -779,7 +778,7 @@ impl DemGround {
         if !(q2 < MAX_CONTRACTION * MAX_CONTRACTION) {
             return Evaluation::March;
         }
-        let (height, per_row, per_col) = self.bilinear(row, col);
+        let (height, per_row, per_col) = self.bilinear(rays.heights_m, row, col);
         Evaluation::At {
             at,
             g: height - h,
@@ -813,12 +812,11 @@ impl DemGround {
     /// The bilinear height at grid coordinates in the tile, and its derivatives per row
     /// and per column.
     #[inline(always)]
-    fn bilinear(&self, row: f32, col: f32) -> (f32, f32, f32) {
+    fn bilinear(&self, heights: &[i16], row: f32, col: f32) -> (f32, f32, f32) {
         let t = &self.frame;
         let i = (row as u32).min(t.last_row_cell);
         let j = (col as u32).min(t.last_col_cell);
         let (u, v) = (row - i as f32, col - j as f32);
-        let heights = self.tile.heights_m();
         let base = i as usize * t.ncols + j as usize;
         // In range by the tile's construction (nrows x ncols heights); 0 is never read.
         let at = |n: usize| f32::from(heights.get(n).copied().unwrap_or(0));
@@ -971,7 +969,7 @@ mod tests {
             })
             .collect();
         let tile = DemTile::new(grid, Box::leak(heights.into_boxed_slice())).unwrap();
-        let mut ground = DemGround::new(tile).unwrap();
+        let mut ground = DemGround::new(&tile).unwrap();
         let focal = 0.555f64;
         let (mut checked, mut walls, mut worst_m) = (0, 0, 0f64);
         // (edge point, direction into the tile) for the west, east, south, north edges.
@@ -1006,6 +1004,7 @@ mod tests {
                 let r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
                 let rays = SegmentRays::new(
                     &ground,
+                    tile.heights_m(),
                     &frame,
                     0.0,
                     focal as f32,

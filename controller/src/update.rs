@@ -445,8 +445,10 @@ fn sweep_checked(row: &GeneralRowMotion<f32>, seg: &SegmentPlan) -> Result<Extre
 /// is made for): [`DemGround::sample`] per sample, then the row form at that range.
 /// Out of line: the flat route's registers stay as they were.
 #[inline(never)]
+#[allow(clippy::too_many_arguments)]
 fn dem_extremes(
     dem: &mut DemGround,
+    heights_m: &[i16],
     k: usize,
     frame: &ItrfFrame,
     update: &GeneralUpdate<f32>,
@@ -455,7 +457,15 @@ fn dem_extremes(
     terrain_h_m: f32,
 ) -> Result<Extremes, Fault> {
     let r = &seg.row;
-    let rays = SegmentRays::new(dem, frame, r.p1_m, r.focal_m, r.uu0_m2, r2_minus_a2_m2);
+    let rays = SegmentRays::new(
+        dem,
+        heights_m,
+        frame,
+        r.p1_m,
+        r.focal_m,
+        r.uu0_m2,
+        r2_minus_a2_m2,
+    );
     let footprint = match (seg.samples.get(1), seg.samples.last()) {
         (Some(a), Some(b)) => dem.footprint(&rays, a.p2_m, b.p2_m),
         _ => None,
@@ -484,11 +494,18 @@ impl Controller {
         instant: &GeneralInstant<f32>,
         terrain_h_m: f32,
     ) -> Result<Extremes, Fault> {
+        // The route's tile's heights: the one given (tests, bench) or the upload's in
+        // force; the route was made for that tile (`refresh_dem_ground`).
+        let heights_m = match &self.dem_given {
+            Some(t) => t.heights_m(),
+            None => self.dem.heights_in_force().unwrap_or(&[]),
+        };
         let (Some(dem), Some(seg)) = (self.dem_ground.as_mut(), self.plan.segments.get(k)) else {
             return Err(Fault::InvalidScene);
         };
         dem_extremes(
             dem,
+            heights_m,
             k,
             frame,
             float(update),
@@ -498,25 +515,42 @@ impl Controller {
         )
     }
 
-    /// Puts `tile` in force as the ground of every plan sample it covers, or (None)
-    /// takes the tile out of force; the TERRAIN heights hold where no tile covers a
-    /// sample, and while the state comes from NAV frames. The seam for the tile's
-    /// upload (protocol 4), which checks it; the route's constants are made here, once.
+    /// Puts `tile` in force as the ground of every plan sample it covers, in place of
+    /// any uploaded tile (tests and the bench, which have no uplink), or (None) goes
+    /// back to the uploaded tile in force, if any; the TERRAIN heights hold where no
+    /// tile covers a sample, and while the state comes from NAV frames. The route's
+    /// constants are made here, once.
     #[doc(hidden)]
     pub fn set_dem_tile(
         &mut self,
         tile: Option<core_math::earth::dem::DemTile<'static, i16>>,
     ) -> Result<(), TileRefusal> {
-        self.dem_ground = match tile {
+        let ground = match &tile {
             Some(t) => Some(DemGround::new(t)?),
             None => None,
         };
+        self.dem_given = tile;
+        self.dem_ground = ground;
+        if self.dem_given.is_none() {
+            self.refresh_dem_ground();
+        }
         Ok(())
     }
 
-    /// The DEM tile in force, if any.
-    pub fn dem_tile_in_force(&self) -> Option<&core_math::earth::dem::DemTile<'static, i16>> {
-        self.dem_ground.as_ref().map(|d| d.tile())
+    /// The route on the tile in force (the given one, else the uploaded one), made
+    /// again whenever that tile changes: a commit, a restore, the store lent or taken
+    /// back. None when no tile is in force, or when the route refuses it (wider than
+    /// it handles): then the TERRAIN heights are the ground.
+    pub(crate) fn refresh_dem_ground(&mut self) {
+        let tile = self.dem_given.or_else(|| self.dem.tile());
+        self.dem_ground = tile.and_then(|t| DemGround::new(&t).ok());
+    }
+
+    /// The DEM tile the update's ground comes from, if any: None also when the route
+    /// refused the tile in force.
+    pub fn dem_tile_in_force(&self) -> Option<core_math::earth::dem::DemTile<'_, i16>> {
+        self.dem_ground.as_ref()?;
+        self.dem_given.or_else(|| self.dem.tile())
     }
 
     /// How the DEM route found the samples' ground since the tile was set.

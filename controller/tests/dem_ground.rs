@@ -10,6 +10,7 @@ mod common;
 
 use common::{feed, frame, Registers, H, I0};
 use controller::bus::{encode_time_scales, Gnss, StarAttitude};
+use controller::dem::{encode_begin, encode_chunk, heights_crc32, DemStore};
 use controller::frame::kind;
 use controller::{golden, Config, Controller, Scene};
 use core_math::earth::dem::{DemGrid, DemTile};
@@ -233,6 +234,15 @@ fn scene() -> Scene {
     s
 }
 
+/// How the flight's tile becomes the controller's ground.
+#[derive(Clone, Copy)]
+enum Ground {
+    /// `Controller::set_dem_tile`.
+    Given,
+    /// Uploaded through DEM_BEGIN and DEM_CHUNK frames into the controller's store.
+    Uploaded,
+}
+
 /// What one flight over a tile measured.
 #[derive(Debug, Default)]
 struct Flight {
@@ -246,7 +256,7 @@ struct Flight {
 
 /// 2 s of bus data over `tile`: GNSS at 1 Hz, attitude at 10 Hz, updates every 20 ms,
 /// every update checked against the DEM reference.
-fn fly(bus: &Bus, tile: DemTile<'static, i16>) -> Flight {
+fn fly(bus: &Bus, tile: DemTile<'static, i16>, ground: Ground) -> Flight {
     // Two controllers fed the same frames (a controller is not `Clone`: it may hold
     // the DEM upload's tile memory).
     let start = || {
@@ -263,7 +273,25 @@ fn fly(bus: &Bus, tile: DemTile<'static, i16>) -> Flight {
     };
     let (mut with, mut without) = (start(), start());
     let mut p = [0u8; 512];
-    with.set_dem_tile(Some(tile)).unwrap();
+    match ground {
+        Ground::Given => with.set_dem_tile(Some(tile)).unwrap(),
+        Ground::Uploaded => {
+            // Through the uplink, as the ground sends it: DEM_BEGIN, then every chunk.
+            with.attach_dem(Box::leak(Box::new(DemStore::new())));
+            let (g, h) = (*tile.grid(), tile.heights_m());
+            let begin = encode_begin(7, &g, heights_crc32(h));
+            let mut t = T0_US - 300_000;
+            feed(&mut with, &frame(kind::DEM_BEGIN, 3, t, &begin));
+            for index in 0u16.. {
+                let Some(n) = encode_chunk(7, index, h, &mut p) else {
+                    break;
+                };
+                t += 1_000;
+                feed(&mut with, &frame(kind::DEM_CHUNK, 4 + index, t, &p[..n]));
+            }
+            assert_eq!(with.dem_status().in_force_id, 7, "{:?}", with.last_fault);
+        }
+    }
     let (mut r1, mut r2) = (Registers::default(), Registers::default());
     let mut flight = Flight::default();
     let (mut gnss, mut att): (Option<Gnss>, Option<StarAttitude>) = (None, None);
@@ -309,7 +337,7 @@ fn fly(bus: &Bus, tile: DemTile<'static, i16>) -> Flight {
             &a,
             &SCALES,
             t,
-            with.dem_tile_in_force().unwrap(),
+            &with.dem_tile_in_force().unwrap(),
         )
         .unwrap();
         assert_eq!(r1.writes.len(), 10, "t {t}: {:?}", with.last_fault);
@@ -360,7 +388,7 @@ fn report(name: &str, f: &Flight) {
 fn roll_slew_over_mountains_matches_the_dem_reference() {
     let bus = Bus::new(15.0, 0.0, [0.012, -0.002, 0.001]);
     let tile = tile_at(bus.boresight_ground_deg(), 250, 0.02, smooth);
-    let f = fly(&bus, tile);
+    let f = fly(&bus, tile, Ground::Given);
     report("roll slew, smooth tile", &f);
     let s = f.stats.unwrap();
     assert!(f.updates >= 90);
@@ -375,7 +403,7 @@ fn roll_slew_over_mountains_matches_the_dem_reference() {
 fn stereo_pitch_over_mountains_matches_the_dem_reference() {
     let bus = Bus::new(5.0, -20.0, [0.002, 0.007, 0.0]);
     let tile = tile_at(bus.boresight_ground_deg(), 250, 0.02, smooth);
-    let f = fly(&bus, tile);
+    let f = fly(&bus, tile, Ground::Given);
     report("stereo pitch, smooth tile", &f);
     let s = f.stats.unwrap();
     assert!(s.searched >= 500 && s.outside > 100, "{s:?}");
@@ -390,8 +418,24 @@ fn ridges_and_cliffs_go_to_the_march_in_height_and_match_the_dem_reference() {
     let tile = tile_at(bus.boresight_ground_deg(), 250, 0.02, rugged);
     let (lo, hi) = tile.height_range_m();
     assert!(hi - lo >= 4_500.0, "{lo} {hi}");
-    let f = fly(&bus, tile);
+    let f = fly(&bus, tile, Ground::Given);
     report("roll slew, ridges and cliffs", &f);
     let s = f.stats.unwrap();
     assert!(s.traced > 100 && s.outside > 100, "{s:?}");
+}
+
+/// The same roll slew with a tile of the uploadable size (120 x 120 nodes at 0.02 deg)
+/// sent through the uplink: the update takes its ground from the uploaded tile in force
+/// and meets the same budget against the DEM reference.
+#[test]
+fn an_uploaded_tile_is_the_ground_of_the_update() {
+    let bus = Bus::new(15.0, 0.0, [0.012, -0.002, 0.001]);
+    let tile = tile_at(bus.boresight_ground_deg(), 120, 0.02, smooth);
+    let f = fly(&bus, tile, Ground::Uploaded);
+    report("roll slew, uploaded tile", &f);
+    let s = f.stats.unwrap();
+    assert!(f.updates >= 90);
+    assert!(s.searched >= 500, "{s:?}");
+    // Without the uploaded tile in force the periods would be far off the reference.
+    assert!(f.worst_terrain > 10.0 * BUDGET, "{f:?}");
 }

@@ -200,6 +200,14 @@ impl Dem {
         DemTile::with_bounds(f.grid, heights, f.bounds).ok()
     }
 
+    /// The heights of the tile in force (its grid's nodes, row-major): what the
+    /// update's route reads, without [`Dem::tile`]'s check of the grid.
+    pub(crate) fn heights_in_force(&self) -> Option<&[i16]> {
+        let f = self.in_force.as_ref()?;
+        let slot = self.store.as_deref()?.slots.get(f.slot)?;
+        slot.get(..f.grid.nrows * f.grid.ncols)
+    }
+
     pub fn status(&self) -> DemStatus {
         DemStatus {
             in_force_id: self.in_force.map_or(0, |f| f.id),
@@ -392,6 +400,7 @@ impl Controller {
         let old = self.dem.store.replace(store);
         self.dem.in_force = None;
         self.dem.upload = None;
+        self.refresh_dem_ground();
         old
     }
 
@@ -400,6 +409,7 @@ impl Controller {
     pub fn detach_dem(&mut self) -> Option<&'static mut DemStore> {
         self.dem.in_force = None;
         self.dem.upload = None;
+        self.refresh_dem_ground();
         self.dem.store.take()
     }
 
@@ -407,7 +417,9 @@ impl Controller {
     /// and its CRC-32 check out (a pass over the whole tile: call it after the kept
     /// periods are written). Returns its upload id; on a refusal nothing changes.
     pub fn restore_dem(&mut self) -> Result<u32, Fault> {
-        self.dem.restore()
+        let restored = self.dem.restore();
+        self.refresh_dem_ground();
+        restored
     }
 
     /// The DEM tile in force, for the per-sample ground of the update; `None` when no
@@ -438,6 +450,11 @@ impl Controller {
     /// DEM_CHUNK: staged; the last one puts the tile in force.
     pub(crate) fn accept_dem_chunk(&mut self, payload: &[u8]) -> Result<(), Fault> {
         let ok = self.dem.check_chunk(payload)?;
-        self.dem.apply_chunk(payload, ok)
+        let commit = ok.commit;
+        self.dem.apply_chunk(payload, ok)?;
+        if commit {
+            self.refresh_dem_ground();
+        }
+        Ok(())
     }
 }
