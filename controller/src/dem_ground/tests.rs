@@ -1,0 +1,163 @@
+//! The route against the march, across the tile's edges.
+
+extern crate std;
+use std::boxed::Box;
+use std::vec::Vec;
+
+use super::{DemGround, SampleGround, SegmentRays};
+use crate::config::EARTH;
+use crate::track::ItrfFrame;
+use core_math::earth::dem::{DemGrid, DemTile};
+use core_math::ModelError;
+
+/// ITRF point of geodetic (lat, lon, h) on WGS 84 (deg, deg, m).
+fn itrf(lat_deg: f64, lon_deg: f64, h_m: f64) -> [f64; 3] {
+    let (lat, lon) = (lat_deg.to_radians(), lon_deg.to_radians());
+    let e2 = EARTH.flattening * (2.0 - EARTH.flattening);
+    let n = EARTH.a_m / (1.0 - e2 * lat.sin() * lat.sin()).sqrt();
+    [
+        (n + h_m) * lat.cos() * lon.cos(),
+        (n + h_m) * lat.cos() * lon.sin(),
+        (n * (1.0 - e2) + h_m) * lat.sin(),
+    ]
+}
+
+fn unit(x: [f64; 3]) -> [f64; 3] {
+    let n = (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
+    x.map(|v| v / n)
+}
+
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+/// Rays swept across each edge of a tile whose relief rises to 5 000 m along its
+/// edges, from a satellite 700 km up looking 40 deg from the vertical into the
+/// tile (entering it through the edge) and out of it (leaving through the edge):
+/// each sample's range against `DemTile::first_crossing` in f64 (the march, the
+/// reference's ground), the ray's side of the tile included.
+#[test]
+fn rays_across_the_edges_match_the_march() {
+    // A rim rising to 5 000 m over 6 cells (slopes to 0.6 with the ripple: the march
+    // in height), and to 3 500 m over 12 cells (0.35: the search in height).
+    let searched = edges_against_the_march(4_000.0, 6.0);
+    assert_eq!(searched, 0);
+    let searched = edges_against_the_march(2_500.0, 12.0);
+    assert!(searched > 1_000, "{searched}");
+}
+
+/// [`rays_across_the_edges_match_the_march`] over a rim of `rim_m` falling off over
+/// `width` cells; the samples the search in height took.
+fn edges_against_the_march(rim_m: f64, width: f64) -> u32 {
+    let (lat_c, lon_c, side, step) = (45.0, 10.0, 61usize, 0.01);
+    let half = 0.5 * (side - 1) as f64 * step;
+    let grid = DemGrid {
+        lat0_deg: lat_c - half,
+        lon0_deg: lon_c - half,
+        dlat_deg: step,
+        dlon_deg: step,
+        nrows: side,
+        ncols: side,
+    };
+    let last = (side - 1) as f64;
+    let heights: Vec<i16> = (0..side * side)
+        .map(|k| {
+            let (i, j) = ((k / side) as f64, (k % side) as f64);
+            let d = i.min(j).min(last - i).min(last - j);
+            (1_000.0 + rim_m * (-d / width).exp() + 300.0 * (0.3 * i + 0.2 * j).sin()) as i16
+        })
+        .collect();
+    let tile = DemTile::new(grid, Box::leak(heights.into_boxed_slice())).unwrap();
+    let mut ground = DemGround::new(&tile).unwrap();
+    let focal = 0.555f64;
+    let (mut checked, mut walls, mut worst_m) = (0, 0, 0f64);
+    // (edge point, direction into the tile) for the west, east, south, north edges.
+    let edges = [
+        ((lat_c, lon_c - half), (0.0, 1.0)),
+        ((lat_c, lon_c + half), (0.0, -1.0)),
+        ((lat_c - half, lon_c), (1.0, 0.0)),
+        ((lat_c + half, lon_c), (-1.0, 0.0)),
+    ];
+    for ((lat, lon), (north_in, east_in)) in edges {
+        for inward in [1.0, -1.0] {
+            let t = itrf(lat, lon, 3_000.0);
+            let up = unit(t);
+            let east = unit([-t[1], t[0], 0.0]);
+            let north = cross(up, east);
+            let across: [f64; 3] =
+                core::array::from_fn(|i| inward * (north_in * north[i] + east_in * east[i]));
+            // The satellite 700 km along the ray back from the edge point.
+            let (c, s) = (40f64.to_radians().cos(), 40f64.to_radians().sin());
+            let look = unit(core::array::from_fn(|i| -c * up[i] + s * across[i]));
+            let r: [f64; 3] = core::array::from_fn(|i| t[i] - 700e3 / c * look[i]);
+            // Camera axes: z = -look, y across the edge's normal plane (so the row
+            // sweeps across the edge), x = y cross z.
+            let z = look.map(|v| -v);
+            let y = unit(cross(z, cross(across, z)));
+            let x = cross(y, z);
+            let b: [[f64; 3]; 3] = core::array::from_fn(|i| [x[i], y[i], z[i]]);
+            let frame = ItrfFrame {
+                position_m: r.map(|v| v as f32),
+                camera_to_itrf: b.map(|row| row.map(|v| v as f32)),
+            };
+            let r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+            let rays = SegmentRays::new(
+                &ground,
+                tile.heights_m(),
+                &frame,
+                0.0,
+                focal as f32,
+                (focal * focal) as f32,
+                (r2 - EARTH.a_m * EARTH.a_m) as f32,
+            );
+            for n in -400..=400 {
+                // p2 over +-8 mm: +-10 km across the edge at 700 km.
+                let p2 = n as f64 * 2e-5;
+                let d: [f64; 3] = core::array::from_fn(|i| b[i][1] * p2 - b[i][2] * focal);
+                let want = tile.first_crossing::<f64>(&EARTH, r, d);
+                let got = ground.sample(0, 0, &rays, p2 as f32, 0.0).unwrap();
+                let len = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+                match (got, want) {
+                    (SampleGround::Range(s), Ok(s_ref)) => {
+                        let off_m = (f64::from(s) - s_ref).abs() * len;
+                        worst_m = worst_m.max(off_m);
+                        assert!(off_m <= 10.0, "p2 {p2}: {s} vs {s_ref} ({off_m} m)");
+                    }
+                    (SampleGround::Outside, Err(ModelError::OutsideDem)) => {}
+                    (g, w) => {
+                        // Either outcome only where the march's answer is a hair
+                        // from the edge (the contract's rule at the tile's edge).
+                        let g = match g {
+                            SampleGround::Range(s) => Some(s),
+                            SampleGround::Outside => None,
+                        };
+                        let geo = w.ok().map(|s| {
+                            let x: [f64; 3] = core::array::from_fn(|i| r[i] + s * d[i]);
+                            core_math::earth::frames::geodetic_from_itrf(x, &EARTH)
+                                .map(|(la, lo, h)| (la.to_degrees(), lo.to_degrees(), h))
+                        });
+                        panic!(
+                            "edge ({lat}, {lon}) inward {inward} p2 {p2}: route {g:?}, \
+                             march {w:?} at {geo:?}; {:?}",
+                            ground.stats
+                        );
+                    }
+                }
+                checked += 1;
+            }
+            walls += ground.stats.edges;
+            ground.stats.edges = 0;
+        }
+    }
+    std::eprintln!(
+        "edges (rim {rim_m} m over {width} cells): {checked} rays, worst range \
+         {worst_m:.2} m from the march's, {walls} settled at the edge; {:?}",
+        ground.stats
+    );
+    assert!(walls > 0, "no ray's stretch met the tile's edge");
+    ground.stats.searched
+}
