@@ -1,0 +1,124 @@
+//! The update's DEM route: a segment's samples each on their own ground on the tile in
+//! force (`crate::dem_ground`), and the controller's hold of that route.
+
+use super::sweep::{sweep, Extremes};
+use super::*;
+
+/// The segment's [`Extremes`] with every sample's ground on the DEM tile (or, where the
+/// tile does not cover it, at the segment's TERRAIN height `terrain_h_m`, which `update`
+/// is made for): [`DemGround::sample`] per sample, then the row form at that range.
+/// Out of line: the flat route's registers stay as they were.
+#[inline(never)]
+#[allow(clippy::too_many_arguments)]
+pub(super) fn dem_extremes(
+    dem: &mut DemGround,
+    heights_m: &[i16],
+    k: usize,
+    frame: &ItrfFrame,
+    update: &GeneralUpdate<f32>,
+    seg: &SegmentPlan,
+    r2_minus_a2_m2: f32,
+    terrain_h_m: f32,
+) -> Result<Extremes, Fault> {
+    let r = &seg.row;
+    let rays = SegmentRays::new(
+        dem,
+        heights_m,
+        frame,
+        r.p1_m,
+        r.focal_m,
+        r.uu0_m2,
+        r2_minus_a2_m2,
+    );
+    let footprint = match (seg.samples.get(1), seg.samples.last()) {
+        (Some(a), Some(b)) => dem.footprint(&rays, a.p2_m, b.p2_m),
+        _ => None,
+    };
+    let row = GENERAL_F32.row_motion(update, &seg.row);
+    sweep(seg, |j, p2| {
+        if footprint.is_some_and(|f| f.off_tile(p2)) {
+            dem.off_tile(k, j);
+            return row.motion_at(p2);
+        }
+        match dem.sample(k, j, &rays, p2, terrain_h_m)? {
+            SampleGround::Range(s) => motion_at_range(&row, update.c_m2, p2, s),
+            SampleGround::Outside => row.motion_at(p2),
+        }
+    })
+}
+
+impl Controller {
+    /// [`dem_extremes`] of plan segment `k`, whose TERRAIN height `update` is made for.
+    #[inline(never)]
+    pub(super) fn dem_segment(
+        &mut self,
+        k: usize,
+        frame: &ItrfFrame,
+        update: &Ground,
+        instant: &GeneralInstant<f32>,
+        terrain_h_m: f32,
+    ) -> Result<Extremes, Fault> {
+        // The route's tile's heights: the one given (tests, bench) or the upload's in
+        // force; the route was made for that tile (`refresh_dem_ground`).
+        let heights_m = match &self.dem_given {
+            Some(t) => t.heights_m(),
+            None => self.dem.heights_in_force().unwrap_or(&[]),
+        };
+        let (Some(dem), Some(seg)) = (self.dem_ground.as_mut(), self.plan.segments.get(k)) else {
+            return Err(Fault::InvalidScene);
+        };
+        dem_extremes(
+            dem,
+            heights_m,
+            k,
+            frame,
+            float(update),
+            seg,
+            instant.r2_minus_a2_m2,
+            terrain_h_m,
+        )
+    }
+
+    /// Puts `tile` in force as the ground of every plan sample it covers, in place of
+    /// any uploaded tile (tests and the bench, which have no uplink), or (None) goes
+    /// back to the uploaded tile in force, if any; the TERRAIN heights hold where no
+    /// tile covers a sample, and while the state comes from NAV frames. The route's
+    /// constants are made here, once.
+    #[doc(hidden)]
+    pub fn set_dem_tile(
+        &mut self,
+        tile: Option<core_math::earth::dem::DemTile<'static, i16>>,
+    ) -> Result<(), TileRefusal> {
+        let ground = match &tile {
+            Some(t) => Some(DemGround::new(t)?),
+            None => None,
+        };
+        self.dem_given = tile;
+        self.dem_ground = ground;
+        if self.dem_given.is_none() {
+            self.refresh_dem_ground();
+        }
+        Ok(())
+    }
+
+    /// The route on the tile in force (the given one, else the uploaded one), made
+    /// again whenever that tile changes: a commit, a restore, the store lent or taken
+    /// back. None when no tile is in force, or when the route refuses it (wider than
+    /// it handles): then the TERRAIN heights are the ground.
+    pub(crate) fn refresh_dem_ground(&mut self) {
+        let tile = self.dem_given.or_else(|| self.dem.tile());
+        self.dem_ground = tile.and_then(|t| DemGround::new(&t).ok());
+    }
+
+    /// The DEM tile the update's ground comes from, if any: None also when the route
+    /// refused the tile in force.
+    pub fn dem_tile_in_force(&self) -> Option<core_math::earth::dem::DemTile<'_, i16>> {
+        self.dem_ground.as_ref()?;
+        self.dem_given.or_else(|| self.dem.tile())
+    }
+
+    /// How the DEM route found the samples' ground since the tile was set.
+    pub fn dem_stats(&self) -> Option<DemStats> {
+        self.dem_ground.as_ref().map(|d| d.stats)
+    }
+}

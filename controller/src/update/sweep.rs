@@ -1,0 +1,171 @@
+//! A segment's samples swept: v1's extremes and the largest drift over them, by the f32
+//! row form or the fixed-point pixels, and the drift angles from their tangents.
+
+use super::*;
+
+/// What a segment's samples show: v1's signed extremes, and the (|v2|, |v1|) of the
+/// largest |v2/v1| over the samples and the centre.
+#[derive(Clone, Copy)]
+pub(super) struct Extremes {
+    pub(super) centre: ImageMotion<f32>,
+    pub(super) lo: f32,
+    pub(super) hi: f32,
+    pub(super) drift_v2: f32,
+    pub(super) drift_v1: f32,
+}
+
+/// The segment's row at this update, its centre, and the samples' [`Extremes`] (the
+/// centre's drift included).
+///
+/// Its own function, never inlined: the loop's square root is a call
+/// (`core_math::sqrt`), which clobbers s0-s15; inlined into `segment`, whose values
+/// then live across it, every sample reloaded many of them. Here the row's constants
+/// and the running extremes nearly fit the callee-saved s16-s31. The row is formed here
+/// from the update in memory: formed by the caller and passed by reference, its
+/// constants went through the stack. The steered centre stays out of here: computed in
+/// here too, it made the update's values reload across the calls. (The counts:
+/// docs/controller.md, "What it costs".)
+#[inline(never)]
+pub(super) fn extremes(update: &GeneralUpdate<f32>, seg: &SegmentPlan) -> Result<Extremes, Fault> {
+    let row = GENERAL_F32.row_motion(update, &seg.row);
+    // The samples run from the segment's first pixel to its last, the centre between:
+    // when both ends face the ground, every pixel does, and each one costs one check
+    // instead of three (`GeneralRowMotion::motion_at_facing`: the same results and
+    // errors). Otherwise some pixel misses, and the checked route finds which first.
+    let ends = (seg.samples.get(1), seg.samples.last());
+    match ends {
+        (Some(a), Some(b)) if row.faces_ground_over(a.p2_m, b.p2_m) => {
+            sweep(seg, |_, p2| row.motion_at_facing(p2))
+        }
+        _ => sweep_checked(&row, seg),
+    }
+}
+
+#[cold]
+#[inline(never)]
+pub(super) fn sweep_checked(
+    row: &GeneralRowMotion<f32>,
+    seg: &SegmentPlan,
+) -> Result<Extremes, Fault> {
+    sweep(seg, |_, p2| row.motion_at(p2))
+}
+
+/// The centre's motion, then the extremes over the centre and the samples, by
+/// `motion_at` (`SegmentPlan::samples`: the centre first).
+#[inline(always)]
+pub(super) fn sweep(
+    seg: &SegmentPlan,
+    mut motion_at: impl FnMut(usize, f32) -> Result<ImageMotion<f32>, core_math::ModelError>,
+) -> Result<Extremes, Fault> {
+    let Some((first, samples)) = seg.samples.split_first() else {
+        return Err(Fault::InvalidScene);
+    };
+    let centre = motion_at(0, first.p2_m)?;
+    // Comparisons, not f32::min/max: those are software calls on this core
+    // (fminf/fmaxf, NaN handling). `motion_at` refuses a NaN v1.
+    let mut e = Extremes {
+        centre,
+        lo: centre.v1_mps,
+        hi: centre.v1_mps,
+        drift_v2: centre.v2_mps.abs(),
+        drift_v1: centre.v1_mps.abs(),
+    };
+    for (j, sample) in samples.iter().enumerate() {
+        let m = motion_at(j + 1, sample.p2_m)?;
+        if m.v1_mps < e.lo {
+            e.lo = m.v1_mps;
+        }
+        if m.v1_mps > e.hi {
+            e.hi = m.v1_mps;
+        }
+        let (v1, v2) = (m.v1_mps.abs(), m.v2_mps.abs());
+        if v2 * e.drift_v1 > e.drift_v2 * v1 {
+            (e.drift_v2, e.drift_v1) = (v2, v1);
+        }
+    }
+    Ok(e)
+}
+
+/// The [`Extremes`] of the centre and the samples by the fixed-point backend
+/// (`SegmentPlan::fixed`: the centre first), integer only per pixel: v1's extremes
+/// compared as I24F40 bits, the largest |v2/v1| by cross-multiplying the bits' magnitudes
+/// (exact in u128). Widened to f32 once, at the end: the per-segment work after it is
+/// the f32 path's.
+#[cfg(feature = "earth-fixed")]
+#[inline(never)]
+pub(super) fn extremes_fixed(g: &Ground, seg: &SegmentPlan) -> Result<Extremes, Fault> {
+    use core_math::EARTH_FIXED;
+    let Some(up) = &g.fixed else {
+        return Err(Fault::InvalidScene);
+    };
+    let Some((first, pixels)) = seg.fixed.split_first() else {
+        return Err(Fault::InvalidScene);
+    };
+    let centre = EARTH_FIXED.motion(up, first)?;
+    let (c1, c2) = (centre.v1_mps.to_bits(), centre.v2_mps.to_bits());
+    let (mut lo, mut hi) = (c1, c1);
+    let (mut d2, mut d1) = (c2.unsigned_abs(), c1.unsigned_abs());
+    for px in pixels {
+        let m = EARTH_FIXED.motion(up, px)?;
+        let (v1, v2) = (m.v1_mps.to_bits(), m.v2_mps.to_bits());
+        lo = lo.min(v1);
+        hi = hi.max(v1);
+        let (a1, a2) = (v1.unsigned_abs(), v2.unsigned_abs());
+        if u128::from(a2) * u128::from(d1) > u128::from(d2) * u128::from(a1) {
+            (d2, d1) = (a2, a1);
+        }
+    }
+    // I24F40 bits to m/s: exact to f32's rounding (|v| < 2^23 m/s).
+    const LSB_MPS: f32 = 1.0 / (1u64 << 40) as f32;
+    let mps = |bits: i64| bits as f32 * LSB_MPS;
+    Ok(Extremes {
+        centre: ImageMotion {
+            v1_mps: mps(c1),
+            v2_mps: mps(c2),
+        },
+        lo: mps(lo),
+        hi: mps(hi),
+        drift_v2: d2 as f32 * LSB_MPS,
+        drift_v1: d1 as f32 * LSB_MPS,
+    })
+}
+
+/// The segment's centre pixel seen by the camera turned by the yaw request
+/// (`General::motion_yawed`).
+#[inline(always)]
+pub(super) fn steered_centre(
+    update: &GeneralUpdate<f32>,
+    seg: &SegmentPlan,
+    sin: f32,
+    cos: f32,
+) -> Result<ImageMotion<f32>, core_math::ModelError> {
+    GENERAL_F32.motion_yawed(update, &seg.centre, sin, cos)
+}
+
+/// A segment's drift angles from their tangents: at the centre, the worst (`tan_max`
+/// >= |`tan_centre`|), and the steered centre's.
+///
+/// The worst is the centre's magnitude plus atan of the tangent of their difference,
+/// (tan_max - |t|) / (1 + tan_max |t|): a small tangent, which `atan_f32` takes without
+/// reduction, where the worst drift itself (0.8 rad in a roll slew) needs one; and the
+/// sum is never below the centre's.
+#[inline(always)]
+pub(super) fn drift_angles_rad(tan_centre: f32, tan_max: f32, tan_residual: f32) -> [f32; 3] {
+    let centre_rad = drift_angle_rad(tan_centre);
+    let t = tan_centre.abs();
+    let beyond_rad = drift_angle_rad((tan_max - t) / (1.0 + tan_max * t));
+    [
+        centre_rad,
+        centre_rad.abs() + beyond_rad,
+        drift_angle_rad(tan_residual),
+    ]
+}
+
+/// The drift angle atan(t) (rad) of a drift tangent t = v2/v1: `core_math::trig::atan_f32`
+/// (accurate to a few ulp, and cheaper than libm's `atanf`: docs/controller.md), which
+/// the drift smear of keystoned outer segments (|t| up to 0.3 at 20 deg of pitch) needs
+/// beyond any short series.
+#[inline(always)]
+pub fn drift_angle_rad(t: f32) -> f32 {
+    core_math::trig::atan_f32(t)
+}
