@@ -8,77 +8,20 @@
 
 mod common;
 
+use common::bus::{Bus, SCALES, T0_US};
 use common::{feed, frame, periods, Registers, H, I0};
 use controller::bus::{encode_time_scales, Gnss, StarAttitude};
 use controller::frame::kind;
 use controller::{golden, Config, Controller, Fault, Mode, Scene};
-use core_math::earth::frames::{self, Mat3, TimeScales};
-use core_math::earth::kepler::Kepler;
+use core_math::earth::frames::Mat3;
 use core_math::earth::{Attitude, EarthGeometry};
-use core_math::{StateVector, EARTH_RATE_RAD_S, GM_M3_S2};
+use core_math::{StateVector, EARTH_RATE_RAD_S};
 
-/// 2026-12 in GPS time (us since 1980-01-06).
-const T0_US: u64 = 1_480_000_000_000_000;
-const SCALES: TimeScales = TimeScales {
-    gps_utc_s: 18.0,
-    dut1_s: 0.125,
-};
 const WGS84: core_math::Ellipsoid = core_math::Ellipsoid::WGS84;
-
-fn secs(us: u64) -> f64 {
-    us as f64 * 1e-6
-}
 
 /// The orbit in I at T0 (the ITRF frozen then).
 fn orbit_t0() -> StateVector {
     common::state(I0.to_radians(), 0.9, H + 7_000.0)
-}
-
-/// A rotation matrix's quaternion (scalar first; Shepperd's choice of the largest
-/// component).
-fn quaternion_of(m: &Mat3) -> [f64; 4] {
-    let tr = m[0][0] + m[1][1] + m[2][2];
-    if tr > 0.0 {
-        let s = 2.0 * (1.0 + tr).sqrt();
-        [
-            0.25 * s,
-            (m[2][1] - m[1][2]) / s,
-            (m[0][2] - m[2][0]) / s,
-            (m[1][0] - m[0][1]) / s,
-        ]
-    } else if m[0][0] > m[1][1] && m[0][0] > m[2][2] {
-        let s = 2.0 * (1.0 + m[0][0] - m[1][1] - m[2][2]).sqrt();
-        [
-            (m[2][1] - m[1][2]) / s,
-            0.25 * s,
-            (m[0][1] + m[1][0]) / s,
-            (m[0][2] + m[2][0]) / s,
-        ]
-    } else if m[1][1] > m[2][2] {
-        let s = 2.0 * (1.0 + m[1][1] - m[0][0] - m[2][2]).sqrt();
-        [
-            (m[0][2] - m[2][0]) / s,
-            (m[0][1] + m[1][0]) / s,
-            0.25 * s,
-            (m[1][2] + m[2][1]) / s,
-        ]
-    } else {
-        let s = 2.0 * (1.0 + m[2][2] - m[0][0] - m[1][1]).sqrt();
-        [
-            (m[1][0] - m[0][1]) / s,
-            (m[0][2] + m[2][0]) / s,
-            (m[1][2] + m[2][1]) / s,
-            0.25 * s,
-        ]
-    }
-}
-
-fn mul(a: &Mat3, b: &Mat3) -> Mat3 {
-    core::array::from_fn(|i| core::array::from_fn(|j| (0..3).map(|k| a[i][k] * b[k][j]).sum()))
-}
-
-fn transpose(a: &Mat3) -> Mat3 {
-    core::array::from_fn(|i| core::array::from_fn(|j| a[j][i]))
 }
 
 fn rotation_of(q: [f64; 4]) -> Mat3 {
@@ -105,95 +48,25 @@ fn scene() -> Scene {
 /// What the bus sends: the truth is a Kepler orbit in I at T0 and a camera rolled 12
 /// deg, pitched 5 deg, yawed 3 deg relative to the orbital frame at T0, then turning at
 /// constant body rates (a roll and pitch slew over the orbit rate).
-struct Bus {
-    kepler: Kepler,
-    q0: [f64; 4],
-    valid0_us: u64,
-    body_rate_rad_s: [f64; 3],
-}
-
-impl Bus {
-    fn new() -> Bus {
-        let s = orbit_t0();
-        let valid0_us = T0_US + 70_000;
-        let kepler = Kepler::new(s.position_m, s.velocity_mps, GM_M3_S2).unwrap();
-        // The camera's axes in I at T0 (Part I's attitude) and its angular velocity.
-        let g = EarthGeometry {
-            state: s,
-            attitude: Attitude {
-                roll_rad: 12f64.to_radians(),
-                pitch_rad: 5f64.to_radians(),
-                yaw_rad: 3f64.to_radians(),
-                roll_rate_rad_s: 0.0,
-                pitch_rate_rad_s: 0.0,
-                yaw_rate_rad_s: 0.0,
-            },
-            ground_h_m: 0.0,
-            ellipsoid: WGS84,
-            earth_rate_rad_s: EARTH_RATE_RAD_S,
-        }
-        .to_inertial()
-        .unwrap();
-        let cam = rotation_of(mounting());
-        // I at T0 to the GCRF: C2T(T0)^T; body = GCRF-from-camera R(cam)^T.
-        let c2t = frames::c2t(secs(T0_US), &SCALES).unwrap();
-        let body = mul(
-            &mul(&transpose(&c2t), &g.attitude.camera_to_inertial),
-            &transpose(&cam),
-        );
-        let omega = g.attitude.omega_rad_s;
-        let omega = [omega[0] + 0.012, omega[1] - 0.006, omega[2] + 0.002];
-        let w: [f64; 3] = core::array::from_fn(|i| (0..3).map(|k| cam[i][k] * omega[k]).sum());
-        Bus {
-            kepler,
-            q0: quaternion_of(&body),
-            valid0_us,
-            body_rate_rad_s: w,
-        }
+fn bus() -> Bus {
+    let g = EarthGeometry {
+        state: orbit_t0(),
+        attitude: Attitude {
+            roll_rad: 12f64.to_radians(),
+            pitch_rad: 5f64.to_radians(),
+            yaw_rad: 3f64.to_radians(),
+            roll_rate_rad_s: 0.0,
+            pitch_rate_rad_s: 0.0,
+            yaw_rate_rad_s: 0.0,
+        },
+        ground_h_m: 0.0,
+        ellipsoid: WGS84,
+        earth_rate_rad_s: EARTH_RATE_RAD_S,
     }
-
-    /// The GNSS fix at `fix_us`: the Kepler state turned into the ITRF of that instant
-    /// (the Earth's turn since T0 about z; precession over seconds is below 1e-11).
-    fn gnss(&self, fix_us: u64) -> Gnss {
-        let dt = secs(fix_us) - secs(T0_US);
-        let s = self.kepler.state_at(dt);
-        let (r, v) = (s.position_m, s.velocity_mps);
-        let a = EARTH_RATE_RAD_S * dt;
-        let (s, c) = (a.sin(), a.cos());
-        let rot = |x: [f64; 3]| [c * x[0] + s * x[1], c * x[1] - s * x[0], x[2]];
-        let (r, v) = (rot(r), rot(v));
-        let w = EARTH_RATE_RAD_S;
-        Gnss {
-            fix_us,
-            position_m: r,
-            velocity_mps: [v[0] + w * r[1], v[1] - w * r[0], v[2]],
-        }
-    }
-
-    /// The attitude at `valid_us`: q0 turned at the body rates since its validity.
-    fn attitude(&self, valid_us: u64) -> StarAttitude {
-        let w = self.body_rate_rad_s;
-        let rate = (w.iter().map(|x| x * x).sum::<f64>()).sqrt();
-        let half = 0.5 * rate * (secs(valid_us) - secs(self.valid0_us));
-        let e = [
-            half.cos(),
-            half.sin() * w[0] / rate,
-            half.sin() * w[1] / rate,
-            half.sin() * w[2] / rate,
-        ];
-        let q = self.q0;
-        let p = [
-            q[0] * e[0] - q[1] * e[1] - q[2] * e[2] - q[3] * e[3],
-            q[0] * e[1] + q[1] * e[0] + q[2] * e[3] - q[3] * e[2],
-            q[0] * e[2] - q[1] * e[3] + q[2] * e[0] + q[3] * e[1],
-            q[0] * e[3] + q[1] * e[2] - q[2] * e[1] + q[3] * e[0],
-        ];
-        StarAttitude {
-            valid_us,
-            q: p.map(|x| x as f32),
-            body_rate_rad_s: w.map(|x| x as f32),
-        }
-    }
+    .to_inertial()
+    .unwrap();
+    let cam = rotation_of(mounting());
+    Bus::new(g, &cam, [0.012, -0.006, 0.002], T0_US + 70_000)
 }
 
 fn gnss_frame(seq: u16, tag_us: u64, g: &Gnss) -> Vec<u8> {
@@ -281,7 +154,7 @@ fn clean_stream(bus: &Bus) -> Vec<Step> {
 
 #[test]
 fn bus_periods_match_the_reference_of_the_same_itrf_state_quaternion_and_time() {
-    let bus = Bus::new();
+    let bus = bus();
     let mut c = Controller::new(Config::default(), Scene::paper_default()).unwrap();
     let mut regs = Registers::default();
     let (mut gnss, mut att) = (None, None);
@@ -352,7 +225,7 @@ fn bus_periods_match_the_reference_of_the_same_itrf_state_quaternion_and_time() 
 /// run's (every PERIODS frame and every register write).
 #[test]
 fn every_bus_fault_changes_no_output() {
-    let bus = Bus::new();
+    let bus = bus();
     let mut clean = Controller::new(Config::default(), Scene::paper_default()).unwrap();
     let mut faulty = Controller::new(Config::default(), Scene::paper_default()).unwrap();
     let (mut clean_regs, mut faulty_regs) = (Registers::default(), Registers::default());
@@ -503,7 +376,7 @@ fn bad_frame(bus: &Bus, k: usize, tag_us: u64, last_valid_us: u64) -> (Vec<u8>, 
 /// frame then replaces the bus's data, and a GNSS frame the NAV state.
 #[test]
 fn bus_data_go_stale_by_their_own_limits_and_one_source_replaces_the_other() {
-    let bus = Bus::new();
+    let bus = bus();
     let mut c = Controller::new(Config::default(), Scene::paper_default()).unwrap();
     let mut regs = Registers::default();
     let mut last_valid_us = 0;

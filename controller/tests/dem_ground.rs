@@ -8,175 +8,57 @@
 
 mod common;
 
+use common::bus::{Bus, SCALES, T0_US};
 use common::{feed, frame, Registers, H, I0};
 use controller::bus::{encode_time_scales, Gnss, StarAttitude};
 use controller::dem::{encode_begin, encode_chunk, heights_crc32, DemStore};
 use controller::frame::kind;
 use controller::{golden, Config, Controller, Scene};
 use core_math::earth::dem::{DemGrid, DemTile};
-use core_math::earth::frames::{self, geodetic_from_itrf, Mat3, TimeScales};
-use core_math::earth::kepler::Kepler;
+use core_math::earth::frames::geodetic_from_itrf;
 use core_math::earth::reference::EarthRefPixel;
 use core_math::earth::{Attitude, EarthGeometry};
-use core_math::{EarthReference, StateVector, EARTH_RATE_RAD_S, GM_M3_S2};
+use core_math::{EarthReference, EARTH_RATE_RAD_S};
 
-/// 2026-12 in GPS time (us since 1980-01-06).
-const T0_US: u64 = 1_480_000_000_000_000;
-const SCALES: TimeScales = TimeScales {
-    gps_utc_s: 18.0,
-    dut1_s: 0.125,
-};
 const WGS84: core_math::Ellipsoid = core_math::Ellipsoid::WGS84;
 /// The budget on the periods against the DEM truth (relative).
 const BUDGET: f64 = 1e-4;
 
-fn secs(us: u64) -> f64 {
-    us as f64 * 1e-6
-}
-
-fn mul(a: &Mat3, b: &Mat3) -> Mat3 {
-    core::array::from_fn(|i| core::array::from_fn(|j| (0..3).map(|k| a[i][k] * b[k][j]).sum()))
-}
-
-fn transpose(a: &Mat3) -> Mat3 {
-    core::array::from_fn(|i| core::array::from_fn(|j| a[j][i]))
-}
-
-/// A rotation matrix's quaternion (scalar first; Shepperd's choice).
-fn quaternion_of(m: &Mat3) -> [f64; 4] {
-    let tr = m[0][0] + m[1][1] + m[2][2];
-    if tr > 0.0 {
-        let s = 2.0 * (1.0 + tr).sqrt();
-        [
-            0.25 * s,
-            (m[2][1] - m[1][2]) / s,
-            (m[0][2] - m[2][0]) / s,
-            (m[1][0] - m[0][1]) / s,
-        ]
-    } else if m[0][0] > m[1][1] && m[0][0] > m[2][2] {
-        let s = 2.0 * (1.0 + m[0][0] - m[1][1] - m[2][2]).sqrt();
-        [
-            (m[2][1] - m[1][2]) / s,
-            0.25 * s,
-            (m[0][1] + m[1][0]) / s,
-            (m[0][2] + m[2][0]) / s,
-        ]
-    } else if m[1][1] > m[2][2] {
-        let s = 2.0 * (1.0 + m[1][1] - m[0][0] - m[2][2]).sqrt();
-        [
-            (m[0][2] - m[2][0]) / s,
-            (m[0][1] + m[1][0]) / s,
-            0.25 * s,
-            (m[1][2] + m[2][1]) / s,
-        ]
-    } else {
-        let s = 2.0 * (1.0 + m[2][2] - m[0][0] - m[1][1]).sqrt();
-        [
-            (m[1][0] - m[0][1]) / s,
-            (m[0][2] + m[2][0]) / s,
-            (m[1][2] + m[2][1]) / s,
-            0.25 * s,
-        ]
-    }
-}
-
 /// What the bus sends: a Kepler orbit in I at T0, the camera at `roll`, `pitch` (deg)
-/// relative to the orbital frame at T0, then turning at the orbit's rate plus
-/// `slew_rad_s` (camera axes): a slew.
-struct Bus {
-    kepler: Kepler,
-    q0: [f64; 4],
-    valid0_us: u64,
-    body_rate_rad_s: [f64; 3],
-    /// The camera's axes in I at T0 and the state, for the tile's placement.
-    geometry: core_math::earth::InertialGeometry<f64>,
+/// relative to the orbital frame at T0 and mounted as the body, then turning at the
+/// orbit's rate plus `slew_rad_s` (camera axes): a slew.
+fn bus(roll_deg: f64, pitch_deg: f64, slew_rad_s: [f64; 3]) -> Bus {
+    let g = EarthGeometry {
+        state: common::state(I0.to_radians(), 0.9, H + 7_000.0),
+        attitude: Attitude {
+            roll_rad: roll_deg.to_radians(),
+            pitch_rad: pitch_deg.to_radians(),
+            yaw_rad: 2f64.to_radians(),
+            ..Attitude::default()
+        },
+        ground_h_m: 0.0,
+        ellipsoid: WGS84,
+        earth_rate_rad_s: EARTH_RATE_RAD_S,
+    }
+    .to_inertial()
+    .unwrap();
+    let identity = core::array::from_fn(|i| core::array::from_fn(|j| f64::from(u8::from(i == j))));
+    Bus::new(g, &identity, slew_rad_s, T0_US + 70_000)
 }
 
-impl Bus {
-    fn new(roll_deg: f64, pitch_deg: f64, slew_rad_s: [f64; 3]) -> Bus {
-        let s: StateVector = common::state(I0.to_radians(), 0.9, H + 7_000.0);
-        let kepler = Kepler::new(s.position_m, s.velocity_mps, GM_M3_S2).unwrap();
-        let g = EarthGeometry {
-            state: s,
-            attitude: Attitude {
-                roll_rad: roll_deg.to_radians(),
-                pitch_rad: pitch_deg.to_radians(),
-                yaw_rad: 2f64.to_radians(),
-                ..Attitude::default()
-            },
-            ground_h_m: 0.0,
-            ellipsoid: WGS84,
-            earth_rate_rad_s: EARTH_RATE_RAD_S,
-        }
-        .to_inertial()
-        .unwrap();
-        let c2t = frames::c2t(secs(T0_US), &SCALES).unwrap();
-        // Identity mounting: the body is the camera.
-        let body = mul(&transpose(&c2t), &g.attitude.camera_to_inertial);
-        let o = g.attitude.omega_rad_s;
-        Bus {
-            kepler,
-            q0: quaternion_of(&body),
-            valid0_us: T0_US + 70_000,
-            body_rate_rad_s: core::array::from_fn(|i| o[i] + slew_rad_s[i]),
-            geometry: g,
-        }
-    }
-
-    fn gnss(&self, fix_us: u64) -> Gnss {
-        let dt = secs(fix_us) - secs(T0_US);
-        let s = self.kepler.state_at(dt);
-        let (r, v) = (s.position_m, s.velocity_mps);
-        let a = EARTH_RATE_RAD_S * dt;
-        let (s, c) = (a.sin(), a.cos());
-        let rot = |x: [f64; 3]| [c * x[0] + s * x[1], c * x[1] - s * x[0], x[2]];
-        let (r, v) = (rot(r), rot(v));
-        let w = EARTH_RATE_RAD_S;
-        Gnss {
-            fix_us,
-            position_m: r,
-            velocity_mps: [v[0] + w * r[1], v[1] - w * r[0], v[2]],
-        }
-    }
-
-    fn attitude(&self, valid_us: u64) -> StarAttitude {
-        let w = self.body_rate_rad_s;
-        let rate = (w.iter().map(|x| x * x).sum::<f64>()).sqrt();
-        let half = 0.5 * rate * (secs(valid_us) - secs(self.valid0_us));
-        let e = [
-            half.cos(),
-            half.sin() * w[0] / rate,
-            half.sin() * w[1] / rate,
-            half.sin() * w[2] / rate,
-        ];
-        let q = self.q0;
-        let p = [
-            q[0] * e[0] - q[1] * e[1] - q[2] * e[2] - q[3] * e[3],
-            q[0] * e[1] + q[1] * e[0] + q[2] * e[3] - q[3] * e[2],
-            q[0] * e[2] - q[1] * e[3] + q[2] * e[0] + q[3] * e[1],
-            q[0] * e[3] + q[1] * e[2] - q[2] * e[1] + q[3] * e[0],
-        ];
-        StarAttitude {
-            valid_us,
-            q: p.map(|x| x as f32),
-            body_rate_rad_s: w.map(|x| x as f32),
-        }
-    }
-
-    /// Geodetic latitude and longitude (deg) of the boresight's ground at T0, on the
-    /// ellipsoid raised by 2 000 m.
-    fn boresight_ground_deg(&self) -> (f64, f64) {
-        let mut g = self.geometry;
-        g.ground_h_m = 2_000.0;
-        let px = EarthRefPixel {
-            p1_m: 0.0,
-            p2_m: 0.0,
-            focal_m: Scene::paper_default().camera.focal_m,
-        };
-        let chain = EarthReference::chain(&g, &px).unwrap();
-        let (lat, lon, _) = geodetic_from_itrf(chain.ground_m, &g.ellipsoid).unwrap();
-        (lat.to_degrees(), lon.to_degrees())
-    }
+/// Geodetic latitude and longitude (deg) of the boresight's ground at T0, on the
+/// ellipsoid raised by 2 000 m.
+fn boresight_ground_deg(bus: &Bus) -> (f64, f64) {
+    let mut g = bus.geometry;
+    g.ground_h_m = 2_000.0;
+    let px = EarthRefPixel {
+        p1_m: 0.0,
+        p2_m: 0.0,
+        focal_m: Scene::paper_default().camera.focal_m,
+    };
+    let chain = EarthReference::chain(&g, &px).unwrap();
+    let (lat, lon, _) = geodetic_from_itrf(chain.ground_m, &g.ellipsoid).unwrap();
+    (lat.to_degrees(), lon.to_degrees())
 }
 
 /// A tile of `side` x `side` nodes at `step_deg` centred on (lat, lon), heights from
@@ -386,8 +268,8 @@ fn report(name: &str, f: &Flight) {
 /// the tile 5 deg wide under the boresight: the outer segments partly off it.
 #[test]
 fn roll_slew_over_mountains_matches_the_dem_reference() {
-    let bus = Bus::new(15.0, 0.0, [0.012, -0.002, 0.001]);
-    let tile = tile_at(bus.boresight_ground_deg(), 250, 0.02, smooth);
+    let bus = bus(15.0, 0.0, [0.012, -0.002, 0.001]);
+    let tile = tile_at(boresight_ground_deg(&bus), 250, 0.02, smooth);
     let f = fly(&bus, tile, Ground::Given);
     report("roll slew, smooth tile", &f);
     let s = f.stats.unwrap();
@@ -401,8 +283,8 @@ fn roll_slew_over_mountains_matches_the_dem_reference() {
 /// mountains.
 #[test]
 fn stereo_pitch_over_mountains_matches_the_dem_reference() {
-    let bus = Bus::new(5.0, -20.0, [0.002, 0.007, 0.0]);
-    let tile = tile_at(bus.boresight_ground_deg(), 250, 0.02, smooth);
+    let bus = bus(5.0, -20.0, [0.002, 0.007, 0.0]);
+    let tile = tile_at(boresight_ground_deg(&bus), 250, 0.02, smooth);
     let f = fly(&bus, tile, Ground::Given);
     report("stereo pitch, smooth tile", &f);
     let s = f.stats.unwrap();
@@ -414,8 +296,8 @@ fn stereo_pitch_over_mountains_matches_the_dem_reference() {
 /// crossing, and the march in height decides) on a tile 5 deg wide, in the roll slew.
 #[test]
 fn ridges_and_cliffs_go_to_the_march_in_height_and_match_the_dem_reference() {
-    let bus = Bus::new(10.0, -5.0, [0.010, 0.003, 0.0]);
-    let tile = tile_at(bus.boresight_ground_deg(), 250, 0.02, rugged);
+    let bus = bus(10.0, -5.0, [0.010, 0.003, 0.0]);
+    let tile = tile_at(boresight_ground_deg(&bus), 250, 0.02, rugged);
     let (lo, hi) = tile.height_range_m();
     assert!(hi - lo >= 4_500.0, "{lo} {hi}");
     let f = fly(&bus, tile, Ground::Given);
@@ -429,8 +311,8 @@ fn ridges_and_cliffs_go_to_the_march_in_height_and_match_the_dem_reference() {
 /// and meets the same budget against the DEM reference.
 #[test]
 fn an_uploaded_tile_is_the_ground_of_the_update() {
-    let bus = Bus::new(15.0, 0.0, [0.012, -0.002, 0.001]);
-    let tile = tile_at(bus.boresight_ground_deg(), 120, 0.02, smooth);
+    let bus = bus(15.0, 0.0, [0.012, -0.002, 0.001]);
+    let tile = tile_at(boresight_ground_deg(&bus), 120, 0.02, smooth);
     let f = fly(&bus, tile, Ground::Uploaded);
     report("roll slew, uploaded tile", &f);
     let s = f.stats.unwrap();

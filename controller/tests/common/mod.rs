@@ -3,6 +3,8 @@
 
 use std::convert::Infallible;
 
+pub mod bus;
+
 use controller::frame::{encode, kind, Decoder, Event, MAX_FRAME};
 use controller::nav::{Attitude, Nav};
 use controller::report::{encode_periods, Periods};

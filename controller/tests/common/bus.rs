@@ -1,0 +1,151 @@
+//! What a satellite bus sends, for the tests of the bus frames: a Kepler orbit in I (the
+//! ITRF frozen at T0) seen as GNSS fixes in the ITRF of each instant, and a camera whose
+//! axes turn at constant body rates, seen as GCRF star-tracker quaternions.
+
+use controller::bus::{Gnss, StarAttitude};
+use core_math::earth::frames::{self, Mat3, TimeScales};
+use core_math::earth::kepler::Kepler;
+use core_math::earth::InertialGeometry;
+use core_math::{EARTH_RATE_RAD_S, GM_M3_S2};
+
+/// 2026-12 in GPS time (us since 1980-01-06).
+pub const T0_US: u64 = 1_480_000_000_000_000;
+pub const SCALES: TimeScales = TimeScales {
+    gps_utc_s: 18.0,
+    dut1_s: 0.125,
+};
+
+pub fn secs(us: u64) -> f64 {
+    us as f64 * 1e-6
+}
+
+pub fn mul(a: &Mat3, b: &Mat3) -> Mat3 {
+    core::array::from_fn(|i| core::array::from_fn(|j| (0..3).map(|k| a[i][k] * b[k][j]).sum()))
+}
+
+pub fn transpose(a: &Mat3) -> Mat3 {
+    core::array::from_fn(|i| core::array::from_fn(|j| a[j][i]))
+}
+
+/// A rotation matrix's quaternion (scalar first; Shepperd's choice of the largest
+/// component, so that no division is by a small number).
+pub fn quaternion_of(m: &Mat3) -> [f64; 4] {
+    let tr = m[0][0] + m[1][1] + m[2][2];
+    if tr > 0.0 {
+        let s = 2.0 * (1.0 + tr).sqrt();
+        [
+            0.25 * s,
+            (m[2][1] - m[1][2]) / s,
+            (m[0][2] - m[2][0]) / s,
+            (m[1][0] - m[0][1]) / s,
+        ]
+    } else if m[0][0] > m[1][1] && m[0][0] > m[2][2] {
+        let s = 2.0 * (1.0 + m[0][0] - m[1][1] - m[2][2]).sqrt();
+        [
+            (m[2][1] - m[1][2]) / s,
+            0.25 * s,
+            (m[0][1] + m[1][0]) / s,
+            (m[0][2] + m[2][0]) / s,
+        ]
+    } else if m[1][1] > m[2][2] {
+        let s = 2.0 * (1.0 + m[1][1] - m[0][0] - m[2][2]).sqrt();
+        [
+            (m[0][2] - m[2][0]) / s,
+            (m[0][1] + m[1][0]) / s,
+            0.25 * s,
+            (m[1][2] + m[2][1]) / s,
+        ]
+    } else {
+        let s = 2.0 * (1.0 + m[2][2] - m[0][0] - m[1][1]).sqrt();
+        [
+            (m[1][0] - m[0][1]) / s,
+            (m[0][2] + m[2][0]) / s,
+            (m[1][2] + m[2][1]) / s,
+            0.25 * s,
+        ]
+    }
+}
+
+pub struct Bus {
+    kepler: Kepler,
+    q0: [f64; 4],
+    /// When the first attitude is valid.
+    pub valid0_us: u64,
+    body_rate_rad_s: [f64; 3],
+    /// The state and the camera's axes in I at T0 (Part I's geometry).
+    pub geometry: InertialGeometry<f64>,
+}
+
+impl Bus {
+    /// The orbit and camera of `geometry` at T0; the body carries the camera turned by
+    /// `mounting` (camera axes in body axes); the camera turns at `geometry`'s angular
+    /// velocity plus `slew_rad_s` (camera axes), as constant body rates.
+    pub fn new(
+        geometry: InertialGeometry<f64>,
+        mounting: &Mat3,
+        slew_rad_s: [f64; 3],
+        valid0_us: u64,
+    ) -> Bus {
+        let s = geometry.state;
+        let kepler = Kepler::new(s.position_m, s.velocity_mps, GM_M3_S2).unwrap();
+        // I at T0 to the GCRF: C2T(T0)^T; body = GCRF-from-camera R(mounting)^T.
+        let c2t = frames::c2t(secs(T0_US), &SCALES).unwrap();
+        let body = mul(
+            &mul(&transpose(&c2t), &geometry.attitude.camera_to_inertial),
+            &transpose(mounting),
+        );
+        let o = geometry.attitude.omega_rad_s;
+        let omega: [f64; 3] = core::array::from_fn(|i| o[i] + slew_rad_s[i]);
+        let w = core::array::from_fn(|i| (0..3).map(|k| mounting[i][k] * omega[k]).sum());
+        Bus {
+            kepler,
+            q0: quaternion_of(&body),
+            valid0_us,
+            body_rate_rad_s: w,
+            geometry,
+        }
+    }
+
+    /// The GNSS fix at `fix_us`: the Kepler state turned into the ITRF of that instant
+    /// (the Earth's turn since T0 about z; precession over seconds is below 1e-11).
+    pub fn gnss(&self, fix_us: u64) -> Gnss {
+        let dt = secs(fix_us) - secs(T0_US);
+        let s = self.kepler.state_at(dt);
+        let (r, v) = (s.position_m, s.velocity_mps);
+        let a = EARTH_RATE_RAD_S * dt;
+        let (s, c) = (a.sin(), a.cos());
+        let rot = |x: [f64; 3]| [c * x[0] + s * x[1], c * x[1] - s * x[0], x[2]];
+        let (r, v) = (rot(r), rot(v));
+        let w = EARTH_RATE_RAD_S;
+        Gnss {
+            fix_us,
+            position_m: r,
+            velocity_mps: [v[0] + w * r[1], v[1] - w * r[0], v[2]],
+        }
+    }
+
+    /// The attitude at `valid_us`: q0 turned at the body rates since its validity.
+    pub fn attitude(&self, valid_us: u64) -> StarAttitude {
+        let w = self.body_rate_rad_s;
+        let rate = (w.iter().map(|x| x * x).sum::<f64>()).sqrt();
+        let half = 0.5 * rate * (secs(valid_us) - secs(self.valid0_us));
+        let e = [
+            half.cos(),
+            half.sin() * w[0] / rate,
+            half.sin() * w[1] / rate,
+            half.sin() * w[2] / rate,
+        ];
+        let q = self.q0;
+        let p = [
+            q[0] * e[0] - q[1] * e[1] - q[2] * e[2] - q[3] * e[3],
+            q[0] * e[1] + q[1] * e[0] + q[2] * e[3] - q[3] * e[2],
+            q[0] * e[2] - q[1] * e[3] + q[2] * e[0] + q[3] * e[1],
+            q[0] * e[3] + q[1] * e[2] - q[2] * e[1] + q[3] * e[0],
+        ];
+        StarAttitude {
+            valid_us,
+            q: p.map(|x| x as f32),
+            body_rate_rad_s: w.map(|x| x as f32),
+        }
+    }
+}
