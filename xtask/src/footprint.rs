@@ -13,26 +13,20 @@ use object::{Object, ObjectSection, SectionFlags};
 
 use crate::qemu::{board::Board, build_firmware};
 
-/// Loadable bytes of the footprint binary built for `variant`.
-fn image_bytes(variant: &str) -> Result<u64> {
+/// Loadable bytes of the footprint binary built for `variant` on `board`.
+fn image_bytes(board: Board, variant: &str) -> Result<u64> {
     let cfg = format!("footprint=\"{variant}\"");
-    let elf = build_firmware(
-        Board::DEFAULT,
-        "footprint",
-        true,
-        &["bench"],
-        &["--cfg", &cfg],
-    )?;
+    let elf = build_firmware(board, "footprint", true, &["bench"], &["--cfg", &cfg])?;
     flash_bytes(&elf)
 }
 
-/// Flash bytes of each of `variants` beyond the empty ("none") build.
-pub fn variant_bytes(variants: &[&str]) -> Result<Vec<u64>> {
-    let base = image_bytes("none")?;
+/// Flash bytes of each of `variants` beyond the empty ("none") build, on `board`.
+pub fn variant_bytes(board: Board, variants: &[&str]) -> Result<Vec<u64>> {
+    let base = image_bytes(board, "none")?;
     variants
         .iter()
         .map(|v| {
-            let with = image_bytes(v)?;
+            let with = image_bytes(board, v)?;
             with.checked_sub(base).ok_or_else(|| {
                 anyhow!("footprint: `{v}` ({with} B) is smaller than none ({base} B)")
             })

@@ -10,28 +10,35 @@
 //! to 2^-40, in the fixed backend's I24F40). `max_rel_err` and `p99_rel_err` are over the
 //! cases at least 1 deg from the limb, `max_rel_err_near_limb` over those within 1 deg.
 //!
-//! Run time: guest instructions on the Cortex-M4 under QEMU from `cargo xtask bench`
-//! (the same build, the same plugin, [`crate::qemu::bench_counts`]): per pixel, the
+//! Run time: guest instructions under QEMU from `cargo xtask bench` (the same build, the
+//! same plugin, [`crate::qemu::bench_counts`]), on the Cortex-M4F (mps2-an386) and on the
+//! Cortex-M3 without FPU (mps2-an385, where f32 and f64 are software): per pixel, the
 //! count of `motion` over 32 pixels across the swath in a loop, divided by 32 (the
 //! marginal cost inside the loop the controller runs, without a one-pixel region's call
 //! and return); per update, `update` then `motion` at each of the default scene's
 //! planned sample points. Instructions, not cycles.
 //!
-//! `flash_bytes`: [`crate::footprint`], one link per backend.
+//! `flash_bytes`: [`crate::footprint`], one link per backend and board.
 
 use anyhow::{anyhow, Context, Result};
 use core_math::accuracy::{earth_kappa, EARTH_F32_KAPPA_LIMIT};
 use core_math::earth;
+use core_math::earth::fixed::{
+    geometry_from_f64 as earth_fixed_geometry, motion_to_f64 as earth_fixed_motion,
+};
 use core_math::sample::SplitMix64 as Rng;
 use core_math::sphere::accuracy::limb_margin_rad;
 use core_math::sphere::fixed_point::{geometry_from_f64, motion_to_f64};
 use core_math::sphere::{
     Geometry, MicroF32, NaiveF32, Reference, CLOSED_F32, CLOSED_F64, CLOSED_MICROMATH, FIXED,
 };
-use core_math::{Backend, Camera, EarthReference, ImageMotion, GENERAL_F32, GENERAL_F64};
+use core_math::{
+    Backend, Camera, EarthReference, ImageMotion, EARTH_FIXED, GENERAL_F32, GENERAL_F64,
+};
 
 use crate::accuracy::{percentile, U_F32};
 use crate::markdown;
+use crate::qemu::board::Board;
 use crate::qemu::{bench_counts, BenchCounts};
 
 const DEFAULT_CASES: usize = 200_000;
@@ -65,7 +72,7 @@ impl Variant {
 /// The round-Earth variants first (`SPHERE_VARIANTS` of them, errors over the round-Earth
 /// sample), then the real-Earth ones (errors over the real-Earth sample).
 const SPHERE_VARIANTS: usize = 6;
-const VARIANTS: [Variant; 9] = [
+const VARIANTS: [Variant; 10] = [
     Variant("naive-f32", "NaiveF32"),
     Variant("reference", "Reference"),
     Variant("f64", "CLOSED_F64"),
@@ -75,7 +82,10 @@ const VARIANTS: [Variant; 9] = [
     Variant("earth-reference", "EarthReference"),
     Variant("earth-f64", "GENERAL_F64"),
     Variant("earth-f32", "GENERAL_F32"),
+    Variant("earth-fixed", "EARTH_FIXED"),
 ];
+/// The boards whose counts and flash fill the table: the M4F, then the M3 (no FPU).
+const BOARDS: [Board; 2] = [Board::Mps2An386, Board::Mps2An385];
 
 #[derive(Default)]
 struct Errors {
@@ -141,16 +151,17 @@ pub fn run(args: &Args) -> Result<()> {
     let (csv, bench, cases) = (args.csv, !args.no_bench, args.cases);
     let seed = args.seed.unwrap_or(DEFAULT_SEED);
     let sample = sweep(seed, cases);
-    let (counts, flash) = if bench {
-        let names: Vec<&str> = VARIANTS.iter().map(|v| v.0).collect();
-        (
-            Some(bench_counts(true)?),
-            Some(crate::footprint::variant_bytes(&names)?),
-        )
-    } else {
-        (None, None)
-    };
-    let rows = print_table(&sample, counts.as_ref(), flash.as_deref(), csv, seed)?;
+    let names: Vec<&str> = VARIANTS.iter().map(|v| v.0).collect();
+    let mut runs = Vec::new();
+    if bench {
+        for board in BOARDS {
+            runs.push((
+                bench_counts(board, true)?,
+                crate::footprint::variant_bytes(board, &names)?,
+            ));
+        }
+    }
+    let rows = print_table(&sample, &runs, csv, seed)?;
     // The model's own error, for scale: the round Earth against WGS 84 (docs/earth-model.md).
     let earth = format!(
         "Model error for scale: {}.",
@@ -162,7 +173,7 @@ pub fn run(args: &Args) -> Result<()> {
         println!("\n{earth}");
     }
     // The default (full sample, bench run, markdown) regenerates the doc's table and plot.
-    if !csv && counts.is_some() && cases == DEFAULT_CASES && seed == DEFAULT_SEED {
+    if !csv && !runs.is_empty() && cases == DEFAULT_CASES && seed == DEFAULT_SEED {
         write_artefacts(&rows, &earth)?;
     }
     Ok(())
@@ -175,7 +186,7 @@ const END: &str = "<!-- report:end -->";
 
 /// `doc` with the markdown table of `rows`, then the paragraph `trailer`, between its
 /// markers.
-fn replace_table(doc: &str, rows: &[[String; 7]], trailer: &str) -> Option<String> {
+fn replace_table(doc: &str, rows: &[Row], trailer: &str) -> Option<String> {
     let mut block = format!("{BEGIN}\n\n{}\n", markdown::table(&HEADER, rows));
     if !trailer.is_empty() {
         block.push_str(trailer);
@@ -187,9 +198,10 @@ fn replace_table(doc: &str, rows: &[[String; 7]], trailer: &str) -> Option<Strin
 
 /// Replaces the table between the doc's markers and draws the plot: each variant's
 /// worst error at least 1 deg from the limb (a cross) and within 1 deg (a slash, dashed)
-/// against log10 of its instructions per pixel. The reference is the golden source
-/// (error 0 by definition) and has no point on a log axis.
-fn write_artefacts(rows: &[[String; 7]], trailer: &str) -> Result<()> {
+/// against log10 of its instructions per pixel on the M4F, and the far error again at
+/// the M3's count (a thin cross). The reference is the golden source (error 0 by
+/// definition) and has no point on a log axis.
+fn write_artefacts(rows: &[Row], trailer: &str) -> Result<()> {
     let root = crate::qemu::workspace_root();
     let doc_path = root.join(DOC);
     let doc = std::fs::read_to_string(&doc_path).with_context(|| format!("reading {DOC}"))?;
@@ -197,7 +209,7 @@ fn write_artefacts(rows: &[[String; 7]], trailer: &str) -> Result<()> {
         .with_context(|| format!("{DOC} lacks the report markers"))?;
     std::fs::write(&doc_path, new_doc).with_context(|| format!("writing {DOC}"))?;
     let mut plot = crate::plot::Plot::new(
-        "Error against run time, per backend (Cortex-M4 under QEMU)",
+        "Error against run time, per backend (Cortex-M4F; thin: Cortex-M3)",
         "log10 instructions per pixel",
         "max relative error of |v_P|",
     )
@@ -224,6 +236,20 @@ fn write_artefacts(rows: &[[String; 7]], trailer: &str) -> Result<()> {
                     .width(3.0)
                     .dashed(),
             );
+        if let Some(m3) = parse(7) {
+            let x = m3.log10();
+            plot = plot
+                .series(
+                    crate::plot::Series::line("", vec![(x - 0.04, far), (x + 0.04, far)])
+                        .palette(i)
+                        .width(1.5),
+                )
+                .series(
+                    crate::plot::Series::line("", vec![(x, far / 1.4), (x, far * 1.4)])
+                        .palette(i)
+                        .width(1.5),
+                );
+        }
     }
     plot.save(&root.join(PNG))?;
     eprintln!("report: wrote {DOC} (table) and {PNG}");
@@ -331,6 +357,10 @@ fn earth_sweep(seed: u64, cases: usize, errors: &mut [Errors]) -> (usize, EarthF
             v1_mps: f64::from(m.v1_mps),
             v2_mps: f64::from(m.v2_mps),
         };
+        let fixed = earth_fixed_geometry(&c.geometry)
+            .and_then(|g| EARTH_FIXED.evaluate(&c.camera, &g, c.n_px))
+            .ok()
+            .map(|m| earth_fixed_motion(&m));
         let motions = [
             Some(r),
             GENERAL_F64.evaluate(&c.camera, &c.geometry, c.n_px).ok(),
@@ -338,6 +368,7 @@ fn earth_sweep(seed: u64, cases: usize, errors: &mut [Errors]) -> (usize, EarthF
                 .evaluate(&c.camera, &c.geometry.to::<f32>(), c.n_px)
                 .ok()
                 .map(widen),
+            fixed,
         ];
         let sp = r.speed_mps();
         let rel = |m: ImageMotion<f64>| (m.v1_mps - r.v1_mps).hypot(m.v2_mps - r.v2_mps) / sp;
@@ -364,7 +395,7 @@ fn earth_sweep(seed: u64, cases: usize, errors: &mut [Errors]) -> (usize, EarthF
     (near, split)
 }
 
-const HEADER: [&str; 7] = [
+const HEADER: [&str; 10] = [
     "variant",
     "max_rel_err",
     "p99_rel_err",
@@ -372,21 +403,25 @@ const HEADER: [&str; 7] = [
     "instr_per_pixel",
     "instr_per_update",
     "flash_bytes",
+    "m3_instr_per_pixel",
+    "m3_instr_per_update",
+    "m3_flash_bytes",
 ];
+type Row = [String; 10];
 
 fn print_table(
     sample: &Sample,
-    counts: Option<&BenchCounts>,
-    flash: Option<&[u64]>,
+    runs: &[(BenchCounts, Vec<u64>)],
     csv: bool,
     seed: u64,
-) -> Result<Vec<[String; 7]>> {
+) -> Result<Vec<Row>> {
     let notes = format!(
         "{} cases (seed {seed:#x}), {} within {NEAR_LIMB_DEG} deg of the limb; errors of |v_P| \
          relative to the f64 reference chain (reference: 0 by definition); earth rows: {} \
          cases of the real-Earth envelope, {} within {NEAR_LIMB_DEG} deg of the limb, error \
          |dv|/|v| against EarthReference; instructions: \
-         Cortex-M4 under QEMU {}, release, per pixel = motion over {LOOP_PX} pixels in a \
+         Cortex-M4F (mps2-an386) and, m3_ columns, Cortex-M3 without FPU (mps2-an385) under \
+         QEMU {}, release, per pixel = motion over {LOOP_PX} pixels in a \
          loop / {LOOP_PX}, per update = update + motion at the default scene's planned \
          sample points, instructions not cycles; flash_bytes = loadable bytes the backend's \
          pixel + update + motion add to an empty binary (xtask/src/footprint.rs)",
@@ -394,7 +429,8 @@ fn print_table(
         sample.near,
         sample.cases,
         sample.earth_near,
-        counts.map_or("(not run: --no-bench)", |c| c.qemu_version.as_str()),
+        runs.first()
+            .map_or("(not run: --no-bench)", |(c, _)| c.qemu_version.as_str()),
     );
     let mut rows = Vec::new();
     for (i, (v, e)) in VARIANTS.iter().zip(&sample.errors).enumerate() {
@@ -402,30 +438,22 @@ fn print_table(
         let mut far = e.far.clone();
         let p99 = percentile(&mut far, 0.99);
         let max = far.last().copied().unwrap_or(0.0);
-        let count = |label: &str| -> Result<Option<u64>> {
-            match counts {
-                None => Ok(None),
-                Some(c) => c
+        let mut row: Row = Default::default();
+        row[0] = name.to_string();
+        row[1] = format!("{max:.2e}");
+        row[2] = format!("{p99:.2e}");
+        row[3] = format!("{:.2e}", e.max_near);
+        for ((counts, flash), cells) in runs.iter().zip(row[4..].chunks_mut(3)) {
+            let count = |label: &str| -> Result<u64> {
+                counts
                     .net(label)
-                    .map(Some)
-                    .with_context(|| format!("report: no bench region `{label}`")),
-            }
-        };
-        let per_pixel = count(&v.loop_label())?.map_or(String::new(), |n| {
-            format!("{:.1}", n as f64 / LOOP_PX as f64)
-        });
-        let per_update = count(&v.full_update_label())?.map_or(String::new(), |n| n.to_string());
-        rows.push([
-            name.to_string(),
-            format!("{max:.2e}"),
-            format!("{p99:.2e}"),
-            format!("{:.2e}", e.max_near),
-            per_pixel,
-            per_update,
-            flash
-                .and_then(|f| f.get(i))
-                .map_or(String::new(), |b| b.to_string()),
-        ]);
+                    .with_context(|| format!("report: no bench region `{label}`"))
+            };
+            cells[0] = format!("{:.1}", count(&v.loop_label())? as f64 / LOOP_PX as f64);
+            cells[1] = count(&v.full_update_label())?.to_string();
+            cells[2] = flash.get(i).map_or(String::new(), |b| b.to_string());
+        }
+        rows.push(row);
         if e.refused > 0 {
             eprintln!(
                 "report: {name} refused {} case(s) the reference accepts (not in its errors)",
@@ -462,12 +490,12 @@ mod tests {
     #[test]
     fn the_table_between_the_markers_is_replaced_and_the_rest_kept() {
         let doc = format!("intro\n{BEGIN}\nold table\n{END}\nreading\n");
-        let row = ["f32", "1e-7", "1e-7", "1e-7", "87", "5264", ""].map(String::from);
+        let row = ["f32", "1e-7", "1e-7", "1e-7", "87", "5264", "", "", "", ""].map(String::from);
         let new = replace_table(&doc, &[row], "model error").unwrap();
         assert!(new.starts_with("intro\n"));
         assert!(new.ends_with(&format!("{END}\nreading\n")));
         assert!(!new.contains("old table"));
-        assert!(new.contains("| f32 | 1e-7 | 1e-7 | 1e-7 | 87 | 5264 |  |"));
+        assert!(new.contains("| f32 | 1e-7 | 1e-7 | 1e-7 | 87 | 5264 |  |  |  |  |"));
         assert!(new.contains("|  |\n\nmodel error\n\n<!-- report:end"));
         assert!(replace_table("no markers", &[], "").is_none());
     }

@@ -48,7 +48,7 @@ fn exercise<B: Backend<Sphere>>(backend: &B, g: &Geometry<B::Real>) {
 #[allow(dead_code)]
 fn exercise_earth<B: Backend<Earth>>(
     backend: &B,
-    to: impl Fn(EarthGeometry<f64>) -> EarthGeometry<B::Real>,
+    to: impl Fn(EarthGeometry<f64>) -> Option<EarthGeometry<B::Real>>,
 ) {
     let g = black_box(EarthGeometry {
         state: circular_state(7_023_137.0, 1.710_073_105_064_591, 0.5),
@@ -70,7 +70,8 @@ fn exercise_earth<B: Backend<Earth>>(
         p1_m: 0.0,
     });
     let n_px = black_box(12_345.0);
-    if let (Ok(p), Ok(u)) = (backend.pixel(&camera, n_px), backend.update(&to(g))) {
+    let Some(g) = to(g) else { return };
+    if let (Ok(p), Ok(u)) = (backend.pixel(&camera, n_px), backend.update(&g)) {
         let _kept = black_box(backend.motion(&u, &p));
     }
 }
@@ -94,10 +95,14 @@ fn main() -> ! {
         exercise(&core_math::sphere::FIXED, &gq);
     }
     #[cfg(footprint = "earth-reference")]
-    exercise_earth(&core_math::EarthReference, |g| g);
+    exercise_earth(&core_math::EarthReference, Some);
     #[cfg(footprint = "earth-f64")]
-    exercise_earth(&core_math::GENERAL_F64, |g| g);
+    exercise_earth(&core_math::GENERAL_F64, Some);
     #[cfg(footprint = "earth-f32")]
-    exercise_earth(&core_math::GENERAL_F32, |g| g.to());
+    exercise_earth(&core_math::GENERAL_F32, |g| Some(g.to()));
+    #[cfg(footprint = "earth-fixed")]
+    exercise_earth(&core_math::EARTH_FIXED, |g| {
+        core_math::earth::fixed::geometry_from_f64(&g).ok()
+    });
     platform::exit(0)
 }

@@ -92,8 +92,8 @@ pub fn bench(args: &BenchArgs) -> Result<()> {
 /// Builds the bench firmware and the plugin, runs the firmware under QEMU and returns
 /// the parsed counts. The decoded defmt log is echoed as the firmware runs, to stdout or,
 /// with `log_to_stderr`, to stderr.
-pub fn measure(log_to_stderr: bool) -> Result<BenchCounts> {
-    measure_on(Board::DEFAULT, log_to_stderr, None)
+pub fn measure(board: Board, log_to_stderr: bool) -> Result<BenchCounts> {
+    measure_on(board, log_to_stderr, None)
 }
 
 /// [`measure`] on `board`; with `profile`, the per-address counts of that region (its
