@@ -393,6 +393,46 @@ fn state_vectors_with_no_orbit_plane_are_refused() {
     takes_earth(&GENERAL_F32);
 }
 
+/// Finding F9 (docs/fuzzing.md): a satellite nearly at rest. Its orbital frame is still
+/// defined (r x v != 0) and constant, so the image moves by the attitude rates and the
+/// Earth's turn alone. With the Earth still and a pitch rate q at the nadir pixel the
+/// image of the ground point moves along P1 at f q (exactly, to the velocity's 1e-92);
+/// with the Earth turning, the reference agrees with the general form, an independent
+/// closed form. Before the fix the reference's frame turned at ~1e77 rad/s here (the
+/// rounding of r x a divided by |r x v|) and gave |v| ~ 1e78 m/s.
+#[test]
+fn a_satellite_nearly_at_rest_moves_the_image_by_the_attitude_and_the_earth_alone() {
+    let (cam, mut g) = default_case();
+    g.attitude = Attitude {
+        pitch_rate_rad_s: -4.5e-4,
+        ..Attitude::default()
+    };
+    for speed_mps in [1e-92, 1e-40, 1e-12, 1e-3] {
+        // A direction whose two-body acceleration has a rounding across r (the axes'
+        // directions would give r x a = 0 exactly).
+        g.state = StateVector {
+            position_m: [4.1e6, -3.7e6, 4.6e6],
+            velocity_mps: [0.3 * speed_mps, 0.8 * speed_mps, 0.1 * speed_mps],
+        };
+        g.earth_rate_rad_s = 0.0;
+        let r = EarthReference.evaluate(&cam, &g, 0.0).unwrap();
+        // The satellite's own motion adds about f |v| / range: 4e-22 m/s at 1e-12 m/s.
+        let want = cam.focal_m * 4.5e-4;
+        let tol = 1e-12 * want + cam.focal_m * speed_mps / 600e3;
+        assert!(
+            (r.v1_mps.abs() - want).abs() <= tol && r.v2_mps.abs() <= tol,
+            "{speed_mps:e} m/s, Earth still: {r:?}, |v1| should be {want:e}"
+        );
+        g.earth_rate_rad_s = core_math::EARTH_RATE_RAD_S;
+        let r = EarthReference.evaluate(&cam, &g, 0.0).unwrap();
+        let m = GENERAL_F64.evaluate(&cam, &g, 0.0).unwrap();
+        assert!(
+            rel(&m, &r) <= EARTH_F64_REL_TOLERANCE,
+            "{speed_mps:e} m/s, Earth turning: reference {r:?}, general {m:?}"
+        );
+    }
+}
+
 /// One general case against 50-digit values of the literal construction computed with
 /// mpmath by `tools/derivation/general.py` (an independent route: no Rust, dual numbers
 /// in 60-digit arithmetic, the textbook root), its inputs the binary64 roundings of:

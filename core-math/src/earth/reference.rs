@@ -1,9 +1,9 @@
 //! The independent f64 reference of the real-Earth model: the construction of
 //! `EARTH-MODEL.md` evaluated literally, with time as a dual number.
 //!
-//! r(t) = r + v t and v(t) = v + a t with the two-body acceleration a = -GM r/|r|^3 (only
-//! first order in t matters at t = 0); the local orbital frame L(t) from r(t), v(t) by
-//! normalisation and cross products; A(t) = Rx Ry Rz of the angles at their rates; the
+//! r(t) = r + v t (only first order in t matters at t = 0; the two-body acceleration
+//! enters the frame only through r x v, which it leaves constant); the local orbital
+//! frame L(t) from r(t) and r x v by normalisation and cross products; A(t) = Rx Ry Rz of the angles at their rates; the
 //! pixel's line of sight M(0) (p1, p2, -f), M = [x_L y_L z_L] A; its first intersection
 //! with the ground ellipsoid from the textbook quadratic (polished by one Newton step);
 //! that Earth-fixed point carried by Rz(omega t); its camera coordinates
@@ -19,7 +19,7 @@ use crate::earth::{
     InertialGeometry,
 };
 use crate::error::ModelError;
-use crate::model::{Backend, ImageMotion, GM_M3_S2};
+use crate::model::{Backend, ImageMotion};
 use crate::orbit::StateVector;
 use crate::vector::{cross, unit};
 
@@ -132,17 +132,19 @@ impl ReferenceGeometry for InertialGeometry<f64> {
 }
 
 impl ReferenceAttitude for Attitude<f64> {
-    /// M(t) = [x_L y_L z_L] A(t): the columns are B's axes in I, with r(t) = r + v t,
-    /// v(t) = v + a t (two-body a) and the angles moving at their rates.
+    /// M(t) = [x_L y_L z_L] A(t): the columns are B's axes in I, with r(t) = r + v t and
+    /// the angles moving at their rates. The orbit normal y_L is r x v, constant on a
+    /// two-body orbit (the contract says so), so it is taken at t = 0 and carries no
+    /// derivative: formed from r(t) x v(t) with v(t) = v - GM r/|r|^3 t, its derivative
+    /// r x a is zero only up to the rounding of a, ~1e-16 |r| |a|, and divided by |r x v|
+    /// that turned the frame at 1e77 rad/s for a velocity of 1e-92 m/s (finding F9,
+    /// docs/fuzzing.md).
     fn axes(&self, state: &StateVector, t: Dual) -> M3 {
         let (r0, v0) = (state.position_m, state.velocity_mps);
-        let r0n = libm::sqrt(r0[0] * r0[0] + r0[1] * r0[1] + r0[2] * r0[2]);
-        let acc = r0.map(|x| -GM_M3_S2 * x / (r0n * r0n * r0n));
         let r: V3 = core::array::from_fn(|i| c(r0[i]) + c(v0[i]) * t);
-        let v: V3 = core::array::from_fn(|i| c(v0[i]) + c(acc[i]) * t);
         // Local orbital frame; E's columns are x_L, y_L, z_L in I.
         let z_l = unit(r);
-        let y_l = unit(cross(r, v));
+        let y_l = unit(cross(r0, v0)).map(c);
         let x_l = cross(y_l, z_l);
         let e: M3 = core::array::from_fn(|i| [x_l[i], y_l[i], z_l[i]]);
         let at = self;
