@@ -168,9 +168,9 @@ fn earth_fixed_within_target(
     if std::env::var_os("FUZZ_DEBUG").is_some() {
         eprintln!("EARTH_FIXED compared: err {err:e}, margin {margin_deg} deg");
     }
-    // F8 (docs/fuzzing.md, open): the backend's roundings are absolute (2^-34 rad/s on
-    // W and V / sigma), so below an image rate |v| / f of about 5e-5 rad/s they exceed
-    // the relative targets even where kappa is small; skipped below 1e-4 rad/s.
+    // F8 (docs/fuzzing.md): the roundings are absolute (2^-34 rad/s on W and V / sigma),
+    // so the targets are stated for image rates |v| / f of at least 1e-4 rad/s
+    // (docs/fixed-point.md) besides kappa <= 30.
     let f8 = v / c.focal_m < 1e-4;
     if err > target + REFERENCE_SLACK && !f8 {
         let kappa = core_math::accuracy::earth_kappa(c, g, n_px);
