@@ -183,6 +183,7 @@ impl Controller {
     /// [`Controller::set_scene`]: the firmware places one in static memory this way and
     /// then plans its scene in place, so that no 10 KB controller passes through its
     /// stack.
+    #[inline(always)]
     pub fn blank(config: Config) -> Controller {
         Controller {
             config,

@@ -220,6 +220,7 @@ impl Plan {
     /// The plan of no scene: no segment, nothing to evaluate. A placeholder that
     /// [`Plan::build_into`] overwrites (a controller keeps two plans and builds a new
     /// scene's into the spare one, in place).
+    #[inline(always)]
     pub fn blank() -> Plan {
         Plan {
             segments: Vec::new(),

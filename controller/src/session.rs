@@ -61,6 +61,7 @@ pub struct Session {
 }
 
 impl Session {
+    #[inline(always)]
     pub fn new(controller: Controller) -> Session {
         Session {
             decoder: Decoder::new(),
