@@ -16,7 +16,7 @@ use std::time::Instant;
 
 use object::{Object, ObjectSection, ObjectSymbol, SectionKind, SymbolKind};
 
-use crate::qemu::{cargo_command as cargo, executable, TARGET};
+use crate::qemu::{cargo_command as cargo, executable, NO_FPU_TARGET, TARGET};
 
 /// The undefined function the check build's panic handlers call (firmware/src/platform.rs).
 const SYMBOL: &str = "NO_PANIC_CHECK__a_panic_path_is_reachable__see_docs_no_panic_md";
@@ -24,6 +24,7 @@ const SYMBOL: &str = "NO_PANIC_CHECK__a_panic_path_is_reachable__see_docs_no_pan
 /// build (with `no-panic-check`), and extra rustc arguments.
 struct Build {
     what: &'static str,
+    target: &'static str,
     bin: &'static str,
     features: &'static str,
     rustc_args: &'static [&'static str],
@@ -32,24 +33,34 @@ struct Build {
 /// The flight binary on each board, and the real-Earth general form in f32 (its
 /// `pixel`, `update` and `motion`, linked by the footprint binary) until the controller
 /// flies it. The features name the board: the builds use no default features.
-const BUILDS: [Build; 3] = [
+const BUILDS: [Build; 4] = [
     Build {
         what: "the release flight binary (mps2-an386)",
+        target: TARGET,
         bin: "firmware",
         features: "mps2-an386,no-panic-check",
         rustc_args: &[],
     },
     Build {
         what: "the release flight binary (stm32f405, with stm32f4xx-hal)",
+        target: TARGET,
         bin: "firmware",
         features: "stm32f405,no-panic-check",
         rustc_args: &[],
     },
     Build {
         what: "GENERAL_F32 (the real-Earth f32 form: pixel, update, motion)",
+        target: TARGET,
         bin: "footprint",
         features: "mps2-an386,bench,no-panic-check",
         rustc_args: &["--cfg", "footprint=\"earth-f32\""],
+    },
+    Build {
+        what: "the release flight binary (mps2-an385: Cortex-M3, fixed-point pixels)",
+        target: NO_FPU_TARGET,
+        bin: "firmware",
+        features: "mps2-an385,no-panic-check",
+        rustc_args: &[],
     },
 ];
 
@@ -61,7 +72,7 @@ impl Build {
             "--bin",
             self.bin,
             "--target",
-            TARGET,
+            self.target,
             "--release",
             "--no-default-features",
             "--features",
@@ -98,7 +109,7 @@ fn check_one(build: &Build) -> Result<()> {
         .context("cannot start cargo")?;
     let stderr = String::from_utf8_lossy(&out.stderr);
     if out.status.success() {
-        restore_flight_binary();
+        restore_flight_binary(build);
         eprintln!(
             "xtask: no-panic proof passed: {} links with no path to a panic handler ({:.1} s)",
             build.what,
@@ -142,18 +153,24 @@ fn diagnose(build: &Build) -> Result<String> {
             .and_then(|bytes| report(&bytes)),
         _ => Err(anyhow!("the diagnostic link failed ({})", out.status)),
     };
-    restore_flight_binary();
+    restore_flight_binary(build);
     report
 }
 
 /// Cargo copies the last ELF it linked for a binary to `<target>/<triple>/release/
-/// firmware`: after the check builds, put the normal flight binary back there (cargo
-/// finds it up to date, so this only copies).
-fn restore_flight_binary() {
-    let restored = cargo()
+/// firmware`: after a check build, put that target's normal flight binary back there
+/// (cargo finds it up to date, so this only copies): the default board's on the FPU
+/// target, the check build's own board on the other.
+fn restore_flight_binary(build: &Build) {
+    let mut restore = cargo();
+    restore
         .args(["build", "--package", "firmware", "--bin", "firmware"])
-        .args(["--target", TARGET, "--release", "--quiet"])
-        .status();
+        .args(["--target", build.target, "--release", "--quiet"]);
+    if build.target != TARGET {
+        let board = build.features.split(',').next().unwrap_or_default();
+        restore.args(["--no-default-features", "--features", board]);
+    }
+    let restored = restore.status();
     if !restored.is_ok_and(|s| s.success()) {
         eprintln!("xtask: warning: could not rebuild the normal release flight binary");
     }
