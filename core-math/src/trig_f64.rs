@@ -56,6 +56,8 @@ fn k_sin(x: f64, y: f64, iy: i32) -> f64 {
 }
 
 /// cos x on [-pi/4, pi/4], x + y the argument.
+// Out of line: sin, cos and sin_cos share one copy (docs/target.md, flash).
+#[inline(never)]
 fn k_cos(x: f64, y: f64) -> f64 {
     const C1: f64 = f64::from_bits(0x3FA5_5555_5555_554C);
     const C2: f64 = f64::from_bits(0xBF56_C16C_16C1_5177);
