@@ -173,7 +173,7 @@ impl DemGround {
             slope2: (slope * slope) as f32,
             rows_per_m: north.map(|x| (x * rows_per_rad / meridian_m) as f32),
             cols_per_m: east.map(|x| (x * cols_per_rad / parallel_m) as f32),
-            bow_share: (0.02 + 0.02 * libm::tan(libm::fabs(lat_c) + MAX_TILE_HALF_DEG.to_radians()))
+            bow_share: (0.02 + 0.02 * tan_small(libm::fabs(lat_c) + MAX_TILE_HALF_DEG.to_radians()))
                 as f32,
         };
         Ok(DemGround {
@@ -183,6 +183,14 @@ impl DemGround {
             stats: DemStats::default(),
         })
     }
+}
+
+/// tan(x) for |x| below pi/2, from the sine and cosine the flight binary links anyway:
+/// `libm::tan` brings its own argument reduction for huge arguments (6 KB of flash,
+/// docs/target.md) that a latitude never needs.
+fn tan_small(x: f64) -> f64 {
+    let (s, c) = core_math::trig_f64::sin_cos(x);
+    s / c
 }
 
 /// A segment's row's view of the tile ([`DemGround::footprint`]).
