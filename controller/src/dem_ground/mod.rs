@@ -219,6 +219,28 @@ impl Footprint {
             || col + self.col_margin < 0.0
             || col - self.col_margin > self.last_col
     }
+
+    /// Whether every sample from p2 `a_m` to `b_m` sees ground off the tile beyond one
+    /// and the same edge: the coordinates are affine in p2, so both ends beyond it
+    /// put every pixel between them there.
+    #[inline(always)]
+    pub(crate) fn off_tile_over(&self, a_m: f32, b_m: f32) -> bool {
+        let (da, db) = (a_m - self.a_m, b_m - self.a_m);
+        let (ra, rb) = (
+            self.row + self.row_per_m * da,
+            self.row + self.row_per_m * db,
+        );
+        let (ca, cb) = (
+            self.col + self.col_per_m * da,
+            self.col + self.col_per_m * db,
+        );
+        let (r_lo, r_hi) = if ra < rb { (ra, rb) } else { (rb, ra) };
+        let (c_lo, c_hi) = if ca < cb { (ca, cb) } else { (cb, ca) };
+        r_hi + self.row_margin < 0.0
+            || r_lo - self.row_margin > self.last_row
+            || c_hi + self.col_margin < 0.0
+            || c_lo - self.col_margin > self.last_col
+    }
 }
 
 /// One segment's rays at one update: d = d0 + p2 dy (the camera's row p1 turned into
