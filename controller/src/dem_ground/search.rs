@@ -196,6 +196,17 @@ impl DemGround {
         }
     }
 
+    /// Whether the first `n` samples of plan segment `k` all found their ground on the
+    /// tile at the last update: the footprint, which only spares evaluations of
+    /// samples off the tile, is then not worth its two evaluations ([`DemGround::sample`]
+    /// places a sample that has since left the tile by itself).
+    pub(crate) fn all_on_tile(&self, k: usize, n: usize) -> bool {
+        self.last_h_m
+            .get(k)
+            .and_then(|last| last.get(..n))
+            .is_some_and(|last| last.iter().all(|h| h.is_finite()))
+    }
+
     pub(super) fn slot(&self, k: usize, j: usize, last: bool) -> f32 {
         let table = if last { &self.last_h_m } else { &self.step_h_m };
         table

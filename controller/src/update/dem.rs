@@ -31,7 +31,9 @@ pub(super) fn dem_extremes(
         r2_minus_a2_m2,
     );
     let footprint = match (seg.samples.get(1), seg.samples.last()) {
-        (Some(a), Some(b)) => dem.footprint(&rays, a.p2_m, b.p2_m),
+        (Some(a), Some(b)) if !dem.all_on_tile(k, seg.samples.len()) => {
+            dem.footprint(&rays, a.p2_m, b.p2_m)
+        }
         _ => None,
     };
     // A segment wholly off the tile is the flat route's, at its TERRAIN height.
