@@ -198,12 +198,15 @@ impl Scene {
             || usize::from(self.count) > MAX_SEGMENTS
             || self.max_stages == 0
             || self.max_stages > MAX_TDI_STAGES
-            || self.active().next().is_none()
+            || !self.table().iter().any(|s| s.active)
         {
             return Err(Fault::InvalidScene);
         }
-        // The smallest limb angle: the polar radius seen from the highest orbit.
-        let limb_rad = libm::asin(ellipsoid.b_m() / (ellipsoid.a_m + altitude_max_m));
+        // The smallest limb angle: the polar radius seen from the highest orbit, as its
+        // tangent b / sqrt(S^2 - b^2), S = a + h, that the off-axis angles' tangents are
+        // compared with (no arc sine or arctangent: docs/target.md, flash).
+        let (b, big_s) = (ellipsoid.b_m(), ellipsoid.a_m + altitude_max_m);
+        let tan_limb = b / libm::sqrt((big_s - b) * (big_s + b));
         let f = self.camera.focal_m;
         // Segments are chips of one array: in order along it, none overlapping another.
         let mut previous_last: Option<i32> = None;
@@ -224,8 +227,8 @@ impl Scene {
                 let (p1, p2) = camera
                     .focal_plane_m(f64::from(n))
                     .map_err(|_| Fault::InvalidScene)?;
-                let off_axis_rad = libm::atan(libm::sqrt(p1 * p1 + p2 * p2) / f);
-                if !(off_axis_rad < limb_rad) {
+                let tan_off_axis = libm::sqrt(p1 * p1 + p2 * p2) / f;
+                if !(tan_off_axis < tan_limb) {
                     return Err(Fault::InvalidScene);
                 }
             }
