@@ -191,7 +191,7 @@ impl Scene {
         if !(libm::fabs(norm - 1.0) <= core_math::earth::bus::MAX_QUATERNION_NORM_ERROR) {
             return Err(Fault::BadQuaternion);
         }
-        if !clock_ok || !envelope_ok || StageRule::<f32>::new(f64::from(self.mtf_floor)).is_err() {
+        if !clock_ok || !envelope_ok || self.stage_rule().is_err() {
             return Err(Fault::InvalidScene);
         }
         if self.count == 0
@@ -234,6 +234,13 @@ impl Scene {
             }
         }
         Ok(())
+    }
+
+    /// The stage rule of the scene's MTF floor.
+    // Not inlined: the checks and the plan share one copy.
+    #[inline(never)]
+    pub fn stage_rule(&self) -> Result<StageRule<f32>, Fault> {
+        StageRule::<f32>::new(f64::from(self.mtf_floor)).map_err(|_| Fault::InvalidScene)
     }
 
     /// Parses a SCENE payload; the physical checks are [`Scene::validate`]'s.
