@@ -265,8 +265,7 @@ impl Plan {
         exhaustive: bool,
     ) -> Result<(), Fault> {
         scene.validate(&EARTH, config.altitude_range_m.1)?;
-        let stage_rule =
-            StageRule::<f32>::new(f64::from(scene.mtf_floor)).map_err(|_| Fault::InvalidScene)?;
+        let stage_rule = scene.stage_rule()?;
         // Every planned segment's curvature, the probe grid walked once for all.
         let mut curvatures: [Option<Curvature>; MAX_SEGMENTS] = [None; MAX_SEGMENTS];
         for (slot, spec) in curvatures.iter_mut().zip(scene.table()) {

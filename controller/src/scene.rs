@@ -191,19 +191,22 @@ impl Scene {
         if !(libm::fabs(norm - 1.0) <= core_math::earth::bus::MAX_QUATERNION_NORM_ERROR) {
             return Err(Fault::BadQuaternion);
         }
-        if !clock_ok || !envelope_ok || StageRule::<f32>::new(f64::from(self.mtf_floor)).is_err() {
+        if !clock_ok || !envelope_ok || self.stage_rule().is_err() {
             return Err(Fault::InvalidScene);
         }
         if self.count == 0
             || usize::from(self.count) > MAX_SEGMENTS
             || self.max_stages == 0
             || self.max_stages > MAX_TDI_STAGES
-            || self.active().next().is_none()
+            || !self.table().iter().any(|s| s.active)
         {
             return Err(Fault::InvalidScene);
         }
-        // The smallest limb angle: the polar radius seen from the highest orbit.
-        let limb_rad = libm::asin(ellipsoid.b_m() / (ellipsoid.a_m + altitude_max_m));
+        // The smallest limb angle: the polar radius seen from the highest orbit, as its
+        // tangent b / sqrt(S^2 - b^2), S = a + h, that the off-axis angles' tangents are
+        // compared with (no arc sine or arctangent: docs/target.md, flash).
+        let (b, big_s) = (ellipsoid.b_m(), ellipsoid.a_m + altitude_max_m);
+        let tan_limb = b / libm::sqrt((big_s - b) * (big_s + b));
         let f = self.camera.focal_m;
         // Segments are chips of one array: in order along it, none overlapping another.
         let mut previous_last: Option<i32> = None;
@@ -224,13 +227,20 @@ impl Scene {
                 let (p1, p2) = camera
                     .focal_plane_m(f64::from(n))
                     .map_err(|_| Fault::InvalidScene)?;
-                let off_axis_rad = libm::atan(libm::sqrt(p1 * p1 + p2 * p2) / f);
-                if !(off_axis_rad < limb_rad) {
+                let tan_off_axis = libm::sqrt(p1 * p1 + p2 * p2) / f;
+                if !(tan_off_axis < tan_limb) {
                     return Err(Fault::InvalidScene);
                 }
             }
         }
         Ok(())
+    }
+
+    /// The stage rule of the scene's MTF floor.
+    // Not inlined: the checks and the plan share one copy.
+    #[inline(never)]
+    pub fn stage_rule(&self) -> Result<StageRule<f32>, Fault> {
+        StageRule::<f32>::new(f64::from(self.mtf_floor)).map_err(|_| Fault::InvalidScene)
     }
 
     /// Parses a SCENE payload; the physical checks are [`Scene::validate`]'s.

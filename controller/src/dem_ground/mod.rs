@@ -173,7 +173,7 @@ impl DemGround {
             slope2: (slope * slope) as f32,
             rows_per_m: north.map(|x| (x * rows_per_rad / meridian_m) as f32),
             cols_per_m: east.map(|x| (x * cols_per_rad / parallel_m) as f32),
-            bow_share: (0.02 + 0.02 * libm::tan(libm::fabs(lat_c) + MAX_TILE_HALF_DEG.to_radians()))
+            bow_share: (0.02 + 0.02 * tan_small(libm::fabs(lat_c) + MAX_TILE_HALF_DEG.to_radians()))
                 as f32,
         };
         Ok(DemGround {
@@ -183,6 +183,14 @@ impl DemGround {
             stats: DemStats::default(),
         })
     }
+}
+
+/// tan(x) for |x| below pi/2, from the sine and cosine the flight binary links anyway:
+/// `libm::tan` brings its own argument reduction for huge arguments (6 KB of flash,
+/// docs/target.md) that a latitude never needs.
+fn tan_small(x: f64) -> f64 {
+    let (s, c) = core_math::trig_f64::sin_cos(x);
+    s / c
 }
 
 /// A segment's row's view of the tile ([`DemGround::footprint`]).
@@ -210,6 +218,28 @@ impl Footprint {
             || row - self.row_margin > self.last_row
             || col + self.col_margin < 0.0
             || col - self.col_margin > self.last_col
+    }
+
+    /// Whether every sample from p2 `a_m` to `b_m` sees ground off the tile beyond one
+    /// and the same edge: the coordinates are affine in p2, so both ends beyond it
+    /// put every pixel between them there.
+    #[inline(always)]
+    pub(crate) fn off_tile_over(&self, a_m: f32, b_m: f32) -> bool {
+        let (da, db) = (a_m - self.a_m, b_m - self.a_m);
+        let (ra, rb) = (
+            self.row + self.row_per_m * da,
+            self.row + self.row_per_m * db,
+        );
+        let (ca, cb) = (
+            self.col + self.col_per_m * da,
+            self.col + self.col_per_m * db,
+        );
+        let (r_lo, r_hi) = if ra < rb { (ra, rb) } else { (rb, ra) };
+        let (c_lo, c_hi) = if ca < cb { (ca, cb) } else { (cb, ca) };
+        r_hi + self.row_margin < 0.0
+            || r_lo - self.row_margin > self.last_row
+            || c_hi + self.col_margin < 0.0
+            || c_lo - self.col_margin > self.last_col
     }
 }
 

@@ -185,6 +185,28 @@ impl DemGround {
         self.remember(k, j, f32::NAN);
     }
 
+    /// Notes the first `n` samples of plan segment `k` as off the tile by its
+    /// segment's footprint, all at once ([`DemGround::off_tile`] each).
+    pub(crate) fn segment_off_tile(&mut self, k: usize, n: usize) {
+        if let (Some(last), Some(step)) = (self.last_h_m.get_mut(k), self.step_h_m.get_mut(k)) {
+            let n = n.min(MAX_SAMPLES);
+            last[..n].fill(f32::NAN);
+            step[..n].fill(0.0);
+            self.stats.outside += n as u32;
+        }
+    }
+
+    /// Whether the first `n` samples of plan segment `k` all found their ground on the
+    /// tile at the last update: the footprint, which only spares evaluations of
+    /// samples off the tile, is then not worth its two evaluations ([`DemGround::sample`]
+    /// places a sample that has since left the tile by itself).
+    pub(crate) fn all_on_tile(&self, k: usize, n: usize) -> bool {
+        self.last_h_m
+            .get(k)
+            .and_then(|last| last.get(..n))
+            .is_some_and(|last| last.iter().all(|h| h.is_finite()))
+    }
+
     pub(super) fn slot(&self, k: usize, j: usize, last: bool) -> f32 {
         let table = if last { &self.last_h_m } else { &self.step_h_m };
         table

@@ -1,7 +1,7 @@
 //! The update's DEM route: a segment's samples each on their own ground on the tile in
 //! force (`crate::dem_ground`), and the controller's hold of that route.
 
-use super::sweep::{sweep, Extremes};
+use super::sweep::{extremes, sweep, Extremes};
 use super::*;
 
 /// The segment's [`Extremes`] with every sample's ground on the DEM tile (or, where the
@@ -31,9 +31,18 @@ pub(super) fn dem_extremes(
         r2_minus_a2_m2,
     );
     let footprint = match (seg.samples.get(1), seg.samples.last()) {
-        (Some(a), Some(b)) => dem.footprint(&rays, a.p2_m, b.p2_m),
+        (Some(a), Some(b)) if !dem.all_on_tile(k, seg.samples.len()) => {
+            dem.footprint(&rays, a.p2_m, b.p2_m)
+        }
         _ => None,
     };
+    // A segment wholly off the tile is the flat route's, at its TERRAIN height.
+    if let (Some(f), Some(a), Some(b)) = (&footprint, seg.samples.get(1), seg.samples.last()) {
+        if f.off_tile_over(a.p2_m, b.p2_m) {
+            dem.segment_off_tile(k, seg.samples.len());
+            return extremes(update, seg);
+        }
+    }
     let row = GENERAL_F32.row_motion(update, &seg.row);
     sweep(seg, |j, p2| {
         if footprint.is_some_and(|f| f.off_tile(p2)) {

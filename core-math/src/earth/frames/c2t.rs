@@ -14,7 +14,7 @@ use super::cio::s06;
 use super::era::{era00, sp00};
 use super::fw::{fw2m, pfw06};
 use super::nutation::nut06b;
-use super::rot::{ry, rz, Mat3, IDENTITY};
+use super::rot::{rz, Mat3};
 use super::time::{tt_from_gps_s, ut1_from_gps_s, JulianDays, TimeScales};
 use crate::error::ModelError;
 
@@ -27,14 +27,20 @@ pub const C2T_TOLERANCE_RAD: f64 = 1.0e-8;
 
 /// The celestial-to-intermediate matrix from the CIP's X, Y and the CIO locator s (SOFA
 /// `iauC2ixys`): R3(-(E + s)) R2(d) R3(E), E = atan2(Y, X), d = atan(sqrt(r2 / (1 - r2))),
-/// r2 = X^2 + Y^2.
+/// r2 = X^2 + Y^2. Formed, as IERS Conventions (2010) Eq. 5.10 writes it, without the
+/// angles: R3(-E) R2(d) R3(E) has rows (1 - a X^2, -a X Y, -X), (-a X Y, 1 - a Y^2, -Y),
+/// (X, Y, Z) with Z = cos d = sqrt(1 - r2) and a = 1 / (1 + Z). The same matrix to
+/// rounding, and no arctangent in the flight binary for it (docs/target.md, flash).
 pub fn c2ixys(x: f64, y: f64, s: f64) -> Mat3 {
-    let r2 = x * x + y * y;
-    let e = if r2 > 0.0 { libm::atan2(y, x) } else { 0.0 };
-    let d = libm::atan(libm::sqrt(r2 / (1.0 - r2)));
-    let r = rz(e, &IDENTITY);
-    let r = ry(d, &r);
-    rz(-(e + s), &r)
+    let z = libm::sqrt(1.0 - (x * x + y * y));
+    let a = 1.0 / (1.0 + z);
+    let (ax, ay) = (a * x, a * y);
+    let m = [
+        [1.0 - ax * x, -ax * y, -x],
+        [-ax * y, 1.0 - ay * y, -y],
+        [x, y, z],
+    ];
+    rz(-s, &m)
 }
 
 /// C2T at the given TT and UT1 (days since J2000.0 in each scale), polar motion zero,

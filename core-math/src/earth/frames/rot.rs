@@ -25,13 +25,6 @@ pub(crate) fn rx(phi: f64, m: &Mat3) -> Mat3 {
     mul(&r, m)
 }
 
-/// R2(theta) m: the frame turned by theta about y (`iauRy`).
-pub(crate) fn ry(theta: f64, m: &Mat3) -> Mat3 {
-    let (s, c) = crate::trig_f64::sin_cos(theta);
-    let r = [[c, 0.0, -s], [0.0, 1.0, 0.0], [s, 0.0, c]];
-    mul(&r, m)
-}
-
 /// R3(psi) m: the frame turned by psi about z (`iauRz`).
 pub(crate) fn rz(psi: f64, m: &Mat3) -> Mat3 {
     let (s, c) = crate::trig_f64::sin_cos(psi);
