@@ -17,6 +17,7 @@
 //! Protocol and file format: docs/telemetry.md.
 
 mod check;
+mod geotiff;
 mod plots;
 mod reset;
 mod scenario;
@@ -76,6 +77,12 @@ pub struct RunArgs {
     /// The table's segments: indices, or all [default: 0,5,9]
     #[arg(long, value_name = "0,5,9|all", value_parser = parse_segments)]
     segments: Option<Segments>,
+    /// The built-in pass's DEM tile from this GeoTIFF [default: xtask/data/pass-dem.tif]
+    #[arg(long, value_name = "FILE.tif")]
+    dem: Option<PathBuf>,
+    /// Only write the built-in passes' synthetic DEM tile as a GeoTIFF
+    #[arg(long, value_name = "FILE.tif", hide = true)]
+    write_dem: Option<PathBuf>,
     /// Only write the default pass's NAV samples as telemetry CSV
     #[arg(long, value_name = "FILE.csv")]
     export_telemetry: Option<PathBuf>,
@@ -114,8 +121,15 @@ fn parse_segments(v: &str) -> Result<Segments> {
 /// default pass's telemetry.
 pub fn run(args: &RunArgs) -> Result<()> {
     let (board, release) = (args.board.board, !args.debug);
+    if let Some(path) = &args.write_dem {
+        return geotiff::write(path);
+    }
+    let dem = || {
+        let default = workspace_root().join(geotiff::PASS_DEM_PATH);
+        geotiff::read(args.dem.as_ref().unwrap_or(&default))
+    };
     if let Some(path) = &args.export_telemetry {
-        return export(path);
+        return export(path, dem()?);
     }
     if args.demo {
         ensure_target_tools()?;
@@ -127,8 +141,8 @@ pub fn run(args: &RunArgs) -> Result<()> {
     let tick_us = Config::default().update_period_us;
     let pass = match &args.telemetry {
         Some(path) => scenario::from_csv(path, tick_us)?,
-        None if args.short => scenario::short_pass(tick_us)?,
-        None => scenario::default_pass(tick_us)?,
+        None if args.short => scenario::short_pass(dem()?, tick_us)?,
+        None => scenario::default_pass(dem()?, tick_us)?,
     };
     let reset = match args.reset_at {
         Some(at_s) => Some(reset::Plan::new(at_s, args.reset_loses, pass.end_us)?),
@@ -157,8 +171,8 @@ pub fn run(args: &RunArgs) -> Result<()> {
 }
 
 /// `cargo xtask run --export-telemetry FILE`: the default pass's NAV samples as CSV.
-pub fn export(path: &Path) -> Result<()> {
-    let pass = scenario::default_pass(Config::default().update_period_us)?;
+pub fn export(path: &Path, dem: (core_math::earth::dem::DemGrid, Vec<i16>)) -> Result<()> {
+    let pass = scenario::default_pass(dem, Config::default().update_period_us)?;
     scenario::to_csv(&pass, path)?;
     println!(
         "wrote {} NAV samples of the {} to {} (faults are not part of the file)",
@@ -182,7 +196,8 @@ const RESET_TEST_LOSES_S: f64 = 1.0;
 /// reference, every fault counted, no output changed by a fault.
 pub fn e2e_test(board: Board) -> Result<()> {
     let started = Instant::now();
-    let pass = scenario::short_pass(Config::default().update_period_us)?;
+    let dem = geotiff::read(&workspace_root().join(geotiff::PASS_DEM_PATH))?;
+    let pass = scenario::short_pass(dem, Config::default().update_period_us)?;
     let elf = build_firmware(board, "firmware", true, &[], &[])?;
     let result = play(&elf, &pass, None)?;
     result.finish()?;
@@ -430,11 +445,11 @@ fn play(elf: &Path, pass: &Pass, plan: Option<reset::Plan>) -> Result<Played> {
                 ));
             }
             // The built-in passes upload a DEM tile at their start (stream.rs).
-            if pass.truth.agile().is_some() {
+            if let Some((g, _)) = &pass.dem {
                 let d = fw.dem;
                 println!(
-                    "DEM upload: tile {} in force, {} committed, upload in progress {} (128 x 128 nodes in 74 chunks, away from the ground track)",
-                    d.in_force_id, d.tiles_committed, d.upload_id
+                    "DEM upload: tile {} in force, {} committed, upload in progress {} ({} x {} nodes from the GeoTIFF)",
+                    d.in_force_id, d.tiles_committed, d.upload_id, g.nrows, g.ncols
                 );
                 if d.in_force_id != scenario::PASS_DEM_ID || d.tiles_committed != 1 {
                     count_failures.push(format!(

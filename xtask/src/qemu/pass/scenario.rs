@@ -8,6 +8,7 @@ use anyhow::{anyhow, bail, Context, Result};
 use controller::frame::kind;
 use controller::nav::{Attitude, Nav};
 use controller::{Fault, EARTH};
+use core_math::earth::dem::DemGrid;
 use core_math::earth::kepler::Kepler;
 use core_math::vector::{add, dot, scale};
 use core_math::{StateVector, GM_M3_S2};
@@ -34,6 +35,8 @@ const ORBIT_STEP_S: f64 = 1.0;
 #[derive(Clone, Debug)]
 pub struct J2Orbit {
     grid: Vec<StateVector>,
+    /// Orbit time of the pass's t = 0 (s).
+    start_s: f64,
 }
 
 fn accel(r: [f64; 3]) -> [f64; 3] {
@@ -107,12 +110,13 @@ impl J2Orbit {
             let next = rk4(&grid[k - 1], ORBIT_STEP_S);
             grid.push(next);
         }
-        J2Orbit { grid }
+        J2Orbit { grid, start_s: 0.0 }
     }
 
-    /// The ECI state at `t_s` (0 <= t within the duration): one Runge-Kutta step from
-    /// the grid point before it.
+    /// The ECI state at pass time `t_s` (0 <= t within the duration): one Runge-Kutta
+    /// step from the grid point before it.
     pub fn state(&self, t_s: f64) -> StateVector {
+        let t_s = t_s + self.start_s;
         let k = ((t_s / ORBIT_STEP_S).floor().max(0.0) as usize).min(self.grid.len() - 1);
         rk4(&self.grid[k], t_s - k as f64 * ORBIT_STEP_S)
     }
@@ -286,26 +290,8 @@ pub enum DemProbe {
     SameId,
 }
 
-/// The tile the built-in passes upload at their start: 128 x 128 nodes at 3 arc-seconds
-/// in the South Pacific, far from their ground track, so that it exercises the upload
-/// (74 chunks through the UART, the commit, STATUS) and leaves the ground of every
-/// segment to TERRAIN.
+/// The id of the tile the built-in passes upload at their start.
 pub const PASS_DEM_ID: u32 = 23;
-
-pub fn pass_dem() -> (core_math::earth::dem::DemGrid, Vec<i16>) {
-    let grid = core_math::earth::dem::DemGrid {
-        lat0_deg: -45.0,
-        lon0_deg: -150.0,
-        dlat_deg: 1.0 / 1200.0,
-        dlon_deg: 1.0 / 1200.0,
-        nrows: 128,
-        ncols: 128,
-    };
-    let heights = (0..128 * 128)
-        .map(|k: i32| ((k * 37 + (k / 128) * 11) % 4_500 - 300) as i16)
-        .collect();
-    (grid, heights)
-}
 
 impl DemProbe {
     pub fn label(&self) -> &'static str {
@@ -317,12 +303,11 @@ impl DemProbe {
     }
 
     /// The payload's kind, the payload, and the fault it must be refused with.
-    pub fn frame(&self) -> (u8, Vec<u8>, Fault) {
-        let (grid, heights) = pass_dem();
-        let crc = controller::dem::heights_crc32(&heights);
+    pub fn frame(&self, (grid, heights): &(DemGrid, Vec<i16>)) -> (u8, Vec<u8>, Fault) {
+        let (grid, crc) = (*grid, controller::dem::heights_crc32(heights));
         match self {
             DemProbe::Pole => {
-                let g = core_math::earth::dem::DemGrid {
+                let g = DemGrid {
                     lat0_deg: 87.99,
                     ..grid
                 };
@@ -331,7 +316,7 @@ impl DemProbe {
             }
             DemProbe::StrayChunk => {
                 let mut out = [0u8; controller::frame::MAX_PAYLOAD];
-                let n = controller::dem::encode_chunk(PASS_DEM_ID + 2, 0, &heights, &mut out)
+                let n = controller::dem::encode_chunk(PASS_DEM_ID + 2, 0, heights, &mut out)
                     .unwrap_or(0);
                 (kind::DEM_CHUNK, out[..n].to_vec(), Fault::DemSequence)
             }
@@ -456,6 +441,8 @@ pub struct Pass {
     pub end_us: u64,
     pub truth: Truth,
     pub faults: Vec<FaultSpec>,
+    /// The DEM tile uploaded before imaging (the built-in passes'), grid and heights.
+    pub dem: Option<(DemGrid, Vec<i16>)>,
 }
 
 pub fn us(t_s: f64) -> u64 {
@@ -477,18 +464,27 @@ const MAX_YAW_RATE_RAD_S: f64 = 2e-3;
 const MAX_YAW_RATE_STEP_RAD_S: f64 = 1e-4;
 
 /// The truth orbit of the built-in passes: sun-synchronous, 645 km, e = 0.001 (perigee
-/// 638 km, apogee 652 km), i = 97.98 deg, J2 included.
-pub fn sun_synchronous(duration_s: f64) -> J2Orbit {
-    J2Orbit::new(
+/// 638 km, apogee 652 km), i = 97.98 deg, J2 included; the pass's t = 0 at orbit time
+/// `start_s`.
+pub fn sun_synchronous(start_s: f64, duration_s: f64) -> J2Orbit {
+    let orbit = J2Orbit::new(
         EARTH.a_m + 645e3,
         0.001,
         97.98f64.to_radians(),
         0.4,
         1.2,
         -1.6,
-        duration_s,
-    )
+        start_s + duration_s,
+    );
+    J2Orbit { start_s, ..orbit }
 }
+
+/// GPS time of the orbit's t = 0 (us since 1980-01-06, late November 2026): the
+/// orbit's inertial frame is the ITRF frozen then (Part I's I).
+pub const EPOCH_GPS_US: u64 = 1_480_000_000_000_000;
+/// Orbit time at which the short pass starts: its roll slew then looks at the ground
+/// the default pass's forward stereo look sees, where the DEM tile lies.
+pub const SHORT_START_S: f64 = 280.0;
 
 /// What one kind of frame goes where in a pass's time line.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -533,6 +529,8 @@ pub fn schedule(
 /// A built-in pass: its attitude manoeuvres, terrain and faults.
 pub struct Manoeuvres {
     pub name: &'static str,
+    /// Orbit time of the pass's t = 0 (s).
+    pub start_s: f64,
     pub duration_s: f64,
     pub roll: Profile,
     pub pitch: Profile,
@@ -546,7 +544,7 @@ pub struct Manoeuvres {
 /// NAV frame reports the yaw and rate it flies. The host run sees exactly the clean
 /// stream the firmware will see (the injected faults change no output, which the pass
 /// checks), so its requests are the firmware's.
-pub fn build(m: Manoeuvres, tick_us: u64) -> Result<Pass> {
+pub fn build(m: Manoeuvres, dem: (DemGrid, Vec<i16>), tick_us: u64) -> Result<Pass> {
     use controller::frame::kind;
     let end_us = us(m.duration_s);
     let in_gap = |t_us: u64| {
@@ -564,7 +562,7 @@ pub fn build(m: Manoeuvres, tick_us: u64) -> Result<Pass> {
         .collect();
     let scene = controller::Scene::paper_default();
     let mut truth = AgileTruth {
-        orbit: sun_synchronous(m.duration_s + 2.0),
+        orbit: sun_synchronous(m.start_s, m.duration_s + 2.0),
         roll: m.roll,
         pitch: m.pitch,
         yaw: Vec::new(),
@@ -637,6 +635,7 @@ pub fn build(m: Manoeuvres, tick_us: u64) -> Result<Pass> {
         end_us,
         truth: Truth::Agile(Box::new(truth)),
         faults: m.faults,
+        dem: Some(dem),
     })
 }
 
@@ -689,7 +688,12 @@ fn deg(corners: &[(f64, f64)]) -> Profile {
 /// reverse it.) Faults spread over it, none at a corner of a profile (a lost frame there
 /// would leave the controller extrapolating the old rate, which is the telemetry's loss,
 /// not an error).
-pub fn default_pass(tick_us: u64) -> Result<Pass> {
+pub fn default_pass(dem: (DemGrid, Vec<i16>), tick_us: u64) -> Result<Pass> {
+    build(default_manoeuvres(), dem, tick_us)
+}
+
+/// The default pass's manoeuvres, terrain and faults.
+pub fn default_manoeuvres() -> Manoeuvres {
     let mut faults = vec![
         FaultSpec::BitFlip { t_s: 30.0 },
         FaultSpec::BitFlip { t_s: 70.5 },
@@ -719,25 +723,28 @@ pub fn default_pass(tick_us: u64) -> Result<Pass> {
         },
     ];
     faults.extend(link_probes(160.0));
-    build(
-        Manoeuvres {
-            name: "default pass (600 s)",
-            duration_s: 600.0,
-            roll: deg(&[(40.0, 0.0), (60.0, 20.0), (140.0, 20.0), (160.0, 0.0)]),
-            pitch: deg(&[(180.0, 0.0), (280.0, 20.0), (310.0, 20.0), (510.0, -20.0)]),
-            terrain: TerrainProfile {
-                ridge_s: 300.0,
-                half_width_s: 90.0,
-            },
-            faults,
+    Manoeuvres {
+        name: "default pass (600 s)",
+        start_s: 0.0,
+        duration_s: 600.0,
+        roll: deg(&[(40.0, 0.0), (60.0, 20.0), (140.0, 20.0), (160.0, 0.0)]),
+        pitch: deg(&[(180.0, 0.0), (280.0, 20.0), (310.0, 20.0), (510.0, -20.0)]),
+        terrain: TerrainProfile {
+            ridge_s: 300.0,
+            half_width_s: 90.0,
         },
-        tick_us,
-    )
+        faults,
+    }
 }
 
 /// The end-to-end test's pass: one minute, roll 0 -> 20 deg at 1.25 deg/s, then pitch
 /// 0 -> 5 deg at 0.2 deg/s, a ridge at 40 s, every kind of fault.
-pub fn short_pass(tick_us: u64) -> Result<Pass> {
+pub fn short_pass(dem: (DemGrid, Vec<i16>), tick_us: u64) -> Result<Pass> {
+    build(short_manoeuvres(), dem, tick_us)
+}
+
+/// The short pass's manoeuvres, terrain and faults.
+pub fn short_manoeuvres() -> Manoeuvres {
     let mut faults = vec![
         FaultSpec::BitFlip { t_s: 5.0 },
         FaultSpec::Truncate { t_s: 8.0 },
@@ -778,20 +785,18 @@ pub fn short_pass(tick_us: u64) -> Result<Pass> {
         },
     ];
     faults.extend(link_probes(28.0));
-    build(
-        Manoeuvres {
-            name: "short pass (60 s)",
-            duration_s: 60.0,
-            roll: deg(&[(8.5, 0.0), (24.5, 20.0)]),
-            pitch: deg(&[(30.0, 0.0), (55.0, 5.0)]),
-            terrain: TerrainProfile {
-                ridge_s: 40.0,
-                half_width_s: 15.0,
-            },
-            faults,
+    Manoeuvres {
+        name: "short pass (60 s)",
+        start_s: SHORT_START_S,
+        duration_s: 60.0,
+        roll: deg(&[(8.5, 0.0), (24.5, 20.0)]),
+        pitch: deg(&[(30.0, 0.0), (55.0, 5.0)]),
+        terrain: TerrainProfile {
+            ridge_s: 40.0,
+            half_width_s: 15.0,
         },
-        tick_us,
-    )
+        faults,
+    }
 }
 
 /// The CSV columns of a telemetry file, in this order when written.
@@ -874,6 +879,7 @@ pub fn from_csv(path: &std::path::Path, tick_us: u64) -> Result<Pass> {
         terrain: Vec::new(),
         truth: Truth::Telemetry,
         faults: Vec::new(),
+        dem: None,
     })
 }
 

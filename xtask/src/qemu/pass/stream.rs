@@ -184,7 +184,8 @@ pub fn build(pass: &Pass) -> Result<Stream> {
                 (Some((t_s, bytes)), Some(Fault::OutOfRange))
             }
             FaultSpec::Dem { t_s, probe } => {
-                let (k, payload, fault) = probe.frame();
+                let (k, payload, fault) =
+                    probe.frame(pass.dem.as_ref().context("DEM faults need a tile")?);
                 (Some((t_s, frames.frame(k, us(t_s), &payload))), Some(fault))
             }
             FaultSpec::Envelope { t_s } => {
@@ -214,13 +215,11 @@ pub fn build(pass: &Pass) -> Result<Stream> {
             let bytes = frames.frame(kind::SCENE, t0 + 1, &p[..n]);
             extra.push((1, Item { bytes, fault: None }));
         }
-        // Then a DEM tile, its DEM_BEGIN and 74 chunks 1 us apart, before the next
-        // tick: away from the ground track ([`super::scenario::pass_dem`]).
-        if pass.truth.agile().is_some() && t1 > t0 + 100 {
-            let (grid, heights) = super::scenario::pass_dem();
+        // Then the DEM tile, its DEM_BEGIN and chunks 1 us apart, before the next tick.
+        if let (Some((grid, heights)), true) = (&pass.dem, t1 > t0 + 100) {
             let id = super::scenario::PASS_DEM_ID;
-            let crc = controller::dem::heights_crc32(&heights);
-            let begin = controller::dem::encode_begin(id, &grid, crc);
+            let crc = controller::dem::heights_crc32(heights);
+            let begin = controller::dem::encode_begin(id, grid, crc);
             extra.push((
                 1,
                 Item {
@@ -230,7 +229,7 @@ pub fn build(pass: &Pass) -> Result<Stream> {
             ));
             let mut out = [0u8; controller::frame::MAX_PAYLOAD];
             let mut k = 0u16;
-            while let Some(n) = controller::dem::encode_chunk(id, k, &heights, &mut out) {
+            while let Some(n) = controller::dem::encode_chunk(id, k, heights, &mut out) {
                 let bytes = frames.frame(kind::DEM_CHUNK, t0 + 3 + u64::from(k), &out[..n]);
                 extra.push((1, Item { bytes, fault: None }));
                 k += 1;
