@@ -16,6 +16,7 @@
 //!
 //! Protocol and file format: docs/telemetry.md.
 
+mod bus;
 mod check;
 mod geotiff;
 mod plots;
@@ -34,6 +35,7 @@ use std::time::{Duration, Instant};
 
 use controller::report::{mode_from_u8, Periods, Status};
 use controller::{Config, Fault, Mode};
+use core_math::earth::dem::{DemGrid, DemTile};
 
 use crate::plot::Plot;
 use check::{Downlink, EARTH_FIXED_REL_TOLERANCE, F32_REL_TOLERANCE};
@@ -327,10 +329,11 @@ impl Played {
 /// resets the firmware at its pass time and checks the recovery instead of the fault
 /// counters (which start afresh at the reset).
 fn play(elf: &Path, pass: &Pass, plan: Option<reset::Plan>) -> Result<Played> {
+    check::set_epoch(pass.epoch_us);
     let stream = stream::build(pass)?;
     let uplink = stream.faulty();
     println!(
-        "{}: {} NAV samples, {} bytes up ({} injected faults), firmware {}",
+        "{}: {} telemetry frames, {} bytes up ({} injected faults), firmware {}",
         pass.name,
         pass.samples.len(),
         uplink.len(),
@@ -396,7 +399,11 @@ fn play(elf: &Path, pass: &Pass, plan: Option<reset::Plan>) -> Result<Played> {
         None => compare_with_twin(&firmware, &twin),
         Some(r) => r.changed_by_faults.clone(),
     };
-    let controller = check::new_controller(config)?;
+    // The scene of the checks: the one the pass uploads at its start.
+    let mut controller = check::new_controller(config)?;
+    controller
+        .set_scene(scenario::pass_scene(pass.truth.agile().is_some()))
+        .map_err(|f| anyhow!("the pass's scene was refused: {}", f.name()))?;
     let t_check = Instant::now();
     let (rel_tolerance, tolerance_note) = if config.fixed_point_pixels {
         (
@@ -406,10 +413,22 @@ fn play(elf: &Path, pass: &Pass, plan: Option<reset::Plan>) -> Result<Played> {
     } else {
         (F32_REL_TOLERANCE, "the f32 closed form")
     };
-    let (max_rel, max_ticks, compared, reference_failures) =
-        reference_check(&firmware, &navs, &controller, rel_tolerance)?;
+    let (max_rel, max_ticks, compared, reference_failures) = reference_check(
+        &firmware,
+        &navs,
+        &controller,
+        rel_tolerance,
+        pass.dem.as_ref(),
+    )?;
     let truth = match pass.truth.agile() {
-        Some(a) => Some(truth::check(a, &firmware, &controller)?),
+        Some(a) => Some(truth::check(
+            a,
+            &firmware,
+            &controller,
+            pass.dem.as_ref(),
+            &pass.terrain,
+            &navs,
+        )?),
         None => None,
     };
     println!(
@@ -534,7 +553,15 @@ fn reference_check(
     inputs: &BTreeMap<u64, check::InForce>,
     controller: &controller::Controller,
     rel_tolerance: f64,
+    dem: Option<&(DemGrid, Vec<i16>)>,
 ) -> Result<(f64, f64, usize, Vec<String>)> {
+    use controller::golden::{bus_update, bus_update_on_dem};
+    let dem = match dem {
+        Some((g, h)) => {
+            Some(DemTile::new(*g, h).map_err(|e| anyhow!("the pass's DEM: {}", e.name()))?)
+        }
+        None => None,
+    };
     let mut max_rel = 0.0f64;
     let mut max_ticks = 0.0f64;
     let mut compared = 0;
@@ -550,13 +577,19 @@ fn reference_check(
             ));
             continue;
         };
-        let golden = controller::golden::update(
-            controller.scene(),
-            controller.plan(),
-            &input.heights_m,
-            &input.nav,
-            t_us,
-        )
+        let (scene, plan, h) = (controller.scene(), controller.plan(), &input.heights_m[..]);
+        let t_gps = t_us + check::epoch_us();
+        let tile = match (&dem, input.dem) {
+            (Some(t), true) => Some(t),
+            _ => None,
+        };
+        let golden = match (&input.source, tile) {
+            (check::Source::Nav(nav), _) => controller::golden::update(scene, plan, h, nav, t_gps),
+            (check::Source::Bus(g, a, sc), None) => bus_update(scene, plan, h, g, a, sc, t_gps),
+            (check::Source::Bus(g, a, sc), Some(tile)) => {
+                bus_update_on_dem(scene, plan, h, g, a, sc, t_gps, tile)
+            }
+        }
         .map_err(|e| anyhow!("reference at {t_us} us: {}", e.name()))?;
         for r in periods.records().iter().filter(|r| !r.held) {
             let Some(exact) = golden
@@ -858,15 +891,21 @@ fn print_table(pass: &Pass, played: &Played, every_s: u64, segments: &[u8]) {
         println!("{}", line.trim_end());
         next += every_s * 1_000_000;
     }
-    println!("(attitude in deg from the last NAV frame, propagated at its rates; period in us of the 10 MHz line clock; h: held over a fault; MTF: mismatch x drift smear with the segment's 16 stages; M: largest TDI stage count meeting MTF 0.95)");
+    println!("(attitude in deg flown, or from the last NAV frame propagated at its rates; period in us of the 10 MHz line clock; h: held over a fault; MTF: mismatch x drift smear with the segment's 16 stages; M: largest TDI stage count meeting MTF 0.95)");
 }
 
-/// Roll, pitch and yaw of the last NAV sample at or before `t_us`, propagated at their
-/// rates (deg).
+/// Roll, pitch and yaw flown at `t_us` (a built-in pass), or of the last NAV sample at
+/// or before it, propagated at their rates (deg).
 fn telemetry_attitude_deg(pass: &Pass, t_us: u64) -> Option<[f64; 3]> {
-    let s = pass.samples.iter().rev().find(|s| s.t_us <= t_us)?;
-    let a = s.nav.attitude.to_f64();
-    let dt = (t_us - s.t_us) as f64 * 1e-6;
+    if let Some(truth) = pass.truth.agile() {
+        let a = truth.attitude(t_us as f64 * 1e-6);
+        return Some([a.roll_rad, a.pitch_rad, a.yaw_rad].map(f64::to_degrees));
+    }
+    let (t0_us, a) = pass.samples.iter().rev().find_map(|s| match s.msg {
+        scenario::Msg::Nav(n) if s.t_us <= t_us => Some((s.t_us, n.attitude.to_f64())),
+        _ => None,
+    })?;
+    let dt = (t_us - t0_us) as f64 * 1e-6;
     Some([
         (a.roll_rad + a.roll_rate_rad_s * dt).to_degrees(),
         (a.pitch_rad + a.pitch_rate_rad_s * dt).to_degrees(),

@@ -143,7 +143,7 @@ impl Trigger {
             if let Event::Frame(f) = e {
                 *seen += 1;
                 if f.kind == kind::PERIODS {
-                    *last = Some(f.time_us);
+                    *last = Some(check::pass_us(f.time_us));
                 }
             }
         });
@@ -318,7 +318,7 @@ impl Report {
         Decoder::new().feed(lost, |e| {
             if let Event::Frame(f) = e {
                 *lost_kinds.entry(f.kind).or_insert(0) += 1;
-                lost_until_us = Some(f.time_us);
+                lost_until_us = Some(check::pass_us(f.time_us));
             }
         });
         let mut unlike_model = Vec::new();
