@@ -310,7 +310,10 @@ impl Played {
         }
         if let Some(r) = &self.reset {
             r.print();
-            problems.extend(r.problems());
+            for p in r.problems() {
+                println!("FAILED: {p}");
+                problems.push(p);
+            }
         }
         println!(
             "faults: injected {counted}, rejected {}, outputs changed by faults {}",

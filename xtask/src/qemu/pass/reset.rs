@@ -299,8 +299,11 @@ impl Report {
         let mut changed = 0;
         let mut examples = Vec::new();
         if let Some(fresh) = fresh_at_us {
+            // Mode, ticks and held flags: the drift and yaw request may differ in their
+            // last bits on the bus's frames, whose C2T pole (kept up to a minute by
+            // `controller::track`) is recomputed after a reset.
             for (t, p) in firmware.periods.iter().filter(|(t, _)| *t >= fresh) {
-                if twin.get(t) != Some(&p) {
+                if super::describe(twin.get(t).copied()) != super::describe(Some(p)) {
                     changed += 1;
                     if examples.len() < 5 {
                         let held = Periods::decode(p)

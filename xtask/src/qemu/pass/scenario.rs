@@ -585,13 +585,16 @@ pub fn build(m: Manoeuvres, dem: (DemGrid, Vec<i16>), tick_us: u64) -> Result<Pa
     // profiles change rate at those instants, so the gyros' rate in force is the rate
     // flown: see docs/telemetry.md) and each fix 50 ms after its time of fix.
     let mut kinds = std::collections::BTreeMap::from([(0, Kind::Scales)]);
+    // TIME_SCALES again every second, before the fix: a camera reset loses it.
+    kinds.extend((1..end_us / GNSS_PERIOD_US).map(|k| (k * GNSS_PERIOD_US + 40_000, Kind::Scales)));
     kinds
-        .extend((0..end_us / ATTITUDE_PERIOD_US).map(|k| (k * ATTITUDE_PERIOD_US, Kind::Attitude)));
+        .extend((1..end_us / ATTITUDE_PERIOD_US).map(|k| (k * ATTITUDE_PERIOD_US, Kind::Attitude)));
     kinds.extend((0..end_us / GNSS_PERIOD_US).map(|k| (k * GNSS_PERIOD_US + 50_000, Kind::Gnss)));
     kinds.retain(|&t, _| t <= end_us && !in_gap(t));
     let tags: Vec<u64> = kinds.keys().copied().collect();
-    let terrain_us: Vec<u64> = (0..end_us / TERRAIN_PERIOD_US)
-        .map(|k| k * TERRAIN_PERIOD_US + TERRAIN_OFFSET_US)
+    // The first heights before the first update, after the uploads of the start.
+    let terrain_us: Vec<u64> = std::iter::once(1_000)
+        .chain((0..end_us / TERRAIN_PERIOD_US).map(|k| k * TERRAIN_PERIOD_US + TERRAIN_OFFSET_US))
         .collect();
     let scene = controller::Scene::paper_default();
     // From the orbit's t = 0, whose ITRF is I0.
@@ -643,8 +646,10 @@ pub fn build(m: Manoeuvres, dem: (DemGrid, Vec<i16>), tick_us: u64) -> Result<Pa
         match (slot, kinds.get(&t_us)) {
             (SlotKind::Nav, Some(Kind::Scales)) => {
                 feed(&mut session, frames.msg(t_us, &Msg::Scales));
-                for f in super::stream::uploads(&mut frames, true, Some(&dem), t_us) {
-                    feed(&mut session, f);
+                if t_us == 0 {
+                    for f in super::stream::uploads(&mut frames, true, Some(&dem), t_us) {
+                        feed(&mut session, f);
+                    }
                 }
                 samples.push(Sample {
                     t_us,
