@@ -416,24 +416,24 @@ fn play(elf: &Path, pass: &Pass, plan: Option<reset::Plan>) -> Result<Played> {
     } else {
         (F32_REL_TOLERANCE, "the f32 closed form")
     };
-    let (max_rel, max_ticks, compared, reference_failures) = reference_check(
-        &firmware,
-        &navs,
-        &controller,
-        rel_tolerance,
-        pass.dem.as_ref(),
-    )?;
-    let truth = match pass.truth.agile() {
-        Some(a) => Some(truth::check(
-            a,
-            &firmware,
-            &controller,
-            pass.dem.as_ref(),
-            &pass.terrain,
-            &navs,
-        )?),
-        None => None,
-    };
+    // The truth check beside the reference check: each evaluates the f64 reference of
+    // every update.
+    let (reference, truth) = std::thread::scope(|s| {
+        let truth = s.spawn(|| {
+            pass.truth
+                .agile()
+                .map(|a| {
+                    let dem = pass.dem.as_ref();
+                    truth::check(a, &firmware, &controller, dem, &pass.terrain, &navs)
+                })
+                .transpose()
+        });
+        let dem = pass.dem.as_ref();
+        let reference = reference_check(&firmware, &navs, &controller, rel_tolerance, dem);
+        (reference, truth.join())
+    });
+    let (max_rel, max_ticks, compared, reference_failures) = reference?;
+    let truth = truth.map_err(|_| anyhow!("the truth check panicked"))??;
     println!(
         "QEMU run {:.1} s; twin runs and reference check {:.1} s",
         t_check.duration_since(t_qemu).as_secs_f64() - twin_s,

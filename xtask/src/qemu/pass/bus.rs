@@ -64,36 +64,28 @@ ut1, ut2 = jd(ms - leap * 1000, dut1)
 for m in erfa.c2t06a(tt1, tt2, ut1, ut2, 0.0, 0.0):
     print(" ".join(repr(float(x)) for x in m.ravel()))
 "#;
-        let has = || {
+        let run = || {
             Command::new("python3")
-                .args(["-c", "import erfa, numpy"])
+                .args(["-c", script])
+                .args([
+                    gps0_s.to_string(),
+                    seconds.to_string(),
+                    format!("{}", SCALES.gps_utc_s as i64),
+                    format!("{:?}", SCALES.dut1_s),
+                ])
                 .output()
-                .is_ok_and(|o| o.status.success())
+                .context("running python3 for ERFA's C2T")
         };
-        if !has() {
+        let mut out = run()?;
+        if String::from_utf8_lossy(&out.stderr).contains("No module named") {
             let req = super::super::workspace_root().join("tools/goldens/requirements.txt");
-            let ok = Command::new("python3")
+            Command::new("python3")
                 .args(["-m", "pip", "install", "--quiet", "-r"])
                 .arg(&req)
                 .status()
-                .is_ok_and(|s| s.success());
-            if !ok || !has() {
-                bail!(
-                    "the pass's Earth orientation needs python3 with pyerfa ({})",
-                    req.display()
-                );
-            }
+                .with_context(|| format!("installing {}", req.display()))?;
+            out = run()?;
         }
-        let out = Command::new("python3")
-            .args(["-c", script])
-            .args([
-                gps0_s.to_string(),
-                seconds.to_string(),
-                format!("{}", SCALES.gps_utc_s as i64),
-                format!("{:?}", SCALES.dut1_s),
-            ])
-            .output()
-            .context("running python3 for ERFA's C2T")?;
         if !out.status.success() {
             bail!("ERFA's C2T: {}", String::from_utf8_lossy(&out.stderr));
         }
