@@ -16,7 +16,9 @@
 //!
 //! Protocol and file format: docs/telemetry.md.
 
+mod bus;
 mod check;
+mod geotiff;
 mod plots;
 mod reset;
 mod scenario;
@@ -33,6 +35,7 @@ use std::time::{Duration, Instant};
 
 use controller::report::{mode_from_u8, Periods, Status};
 use controller::{Config, Fault, Mode};
+use core_math::earth::dem::{DemGrid, DemTile};
 
 use crate::plot::Plot;
 use check::{Downlink, EARTH_FIXED_REL_TOLERANCE, F32_REL_TOLERANCE};
@@ -76,6 +79,12 @@ pub struct RunArgs {
     /// The table's segments: indices, or all [default: 0,5,9]
     #[arg(long, value_name = "0,5,9|all", value_parser = parse_segments)]
     segments: Option<Segments>,
+    /// The built-in pass's DEM tile from this GeoTIFF [default: xtask/data/pass-dem.tif]
+    #[arg(long, value_name = "FILE.tif")]
+    dem: Option<PathBuf>,
+    /// Only write the built-in passes' synthetic DEM tile as a GeoTIFF
+    #[arg(long, value_name = "FILE.tif", hide = true)]
+    write_dem: Option<PathBuf>,
     /// Only write the default pass's NAV samples as telemetry CSV
     #[arg(long, value_name = "FILE.csv")]
     export_telemetry: Option<PathBuf>,
@@ -114,8 +123,15 @@ fn parse_segments(v: &str) -> Result<Segments> {
 /// default pass's telemetry.
 pub fn run(args: &RunArgs) -> Result<()> {
     let (board, release) = (args.board.board, !args.debug);
+    if let Some(path) = &args.write_dem {
+        return geotiff::write(path);
+    }
+    let dem = || {
+        let default = workspace_root().join(geotiff::PASS_DEM_PATH);
+        geotiff::read(args.dem.as_ref().unwrap_or(&default))
+    };
     if let Some(path) = &args.export_telemetry {
-        return export(path);
+        return export(path, dem()?);
     }
     if args.demo {
         ensure_target_tools()?;
@@ -127,8 +143,8 @@ pub fn run(args: &RunArgs) -> Result<()> {
     let tick_us = Config::default().update_period_us;
     let pass = match &args.telemetry {
         Some(path) => scenario::from_csv(path, tick_us)?,
-        None if args.short => scenario::short_pass(tick_us)?,
-        None => scenario::default_pass(tick_us)?,
+        None if args.short => scenario::short_pass(dem()?, tick_us)?,
+        None => scenario::default_pass(dem()?, tick_us)?,
     };
     let reset = match args.reset_at {
         Some(at_s) => Some(reset::Plan::new(at_s, args.reset_loses, pass.end_us)?),
@@ -157,8 +173,8 @@ pub fn run(args: &RunArgs) -> Result<()> {
 }
 
 /// `cargo xtask run --export-telemetry FILE`: the default pass's NAV samples as CSV.
-pub fn export(path: &Path) -> Result<()> {
-    let pass = scenario::default_pass(Config::default().update_period_us)?;
+pub fn export(path: &Path, dem: (core_math::earth::dem::DemGrid, Vec<i16>)) -> Result<()> {
+    let pass = scenario::default_pass(dem, Config::default().update_period_us)?;
     scenario::to_csv(&pass, path)?;
     println!(
         "wrote {} NAV samples of the {} to {} (faults are not part of the file)",
@@ -182,7 +198,8 @@ const RESET_TEST_LOSES_S: f64 = 1.0;
 /// reference, every fault counted, no output changed by a fault.
 pub fn e2e_test(board: Board) -> Result<()> {
     let started = Instant::now();
-    let pass = scenario::short_pass(Config::default().update_period_us)?;
+    let dem = geotiff::read(&workspace_root().join(geotiff::PASS_DEM_PATH))?;
+    let pass = scenario::short_pass(dem, Config::default().update_period_us)?;
     let elf = build_firmware(board, "firmware", true, &[], &[])?;
     let result = play(&elf, &pass, None)?;
     result.finish()?;
@@ -293,7 +310,10 @@ impl Played {
         }
         if let Some(r) = &self.reset {
             r.print();
-            problems.extend(r.problems());
+            for p in r.problems() {
+                println!("FAILED: {p}");
+                problems.push(p);
+            }
         }
         println!(
             "faults: injected {counted}, rejected {}, outputs changed by faults {}",
@@ -312,10 +332,11 @@ impl Played {
 /// resets the firmware at its pass time and checks the recovery instead of the fault
 /// counters (which start afresh at the reset).
 fn play(elf: &Path, pass: &Pass, plan: Option<reset::Plan>) -> Result<Played> {
+    check::set_epoch(pass.epoch_us);
     let stream = stream::build(pass)?;
     let uplink = stream.faulty();
     println!(
-        "{}: {} NAV samples, {} bytes up ({} injected faults), firmware {}",
+        "{}: {} telemetry frames, {} bytes up ({} injected faults), firmware {}",
         pass.name,
         pass.samples.len(),
         uplink.len(),
@@ -381,7 +402,11 @@ fn play(elf: &Path, pass: &Pass, plan: Option<reset::Plan>) -> Result<Played> {
         None => compare_with_twin(&firmware, &twin),
         Some(r) => r.changed_by_faults.clone(),
     };
-    let controller = check::new_controller(config)?;
+    // The scene of the checks: the one the pass uploads at its start.
+    let mut controller = check::new_controller(config)?;
+    controller
+        .set_scene(scenario::pass_scene(pass.truth.agile().is_some()))
+        .map_err(|f| anyhow!("the pass's scene was refused: {}", f.name()))?;
     let t_check = Instant::now();
     let (rel_tolerance, tolerance_note) = if config.fixed_point_pixels {
         (
@@ -391,12 +416,24 @@ fn play(elf: &Path, pass: &Pass, plan: Option<reset::Plan>) -> Result<Played> {
     } else {
         (F32_REL_TOLERANCE, "the f32 closed form")
     };
-    let (max_rel, max_ticks, compared, reference_failures) =
-        reference_check(&firmware, &navs, &controller, rel_tolerance)?;
-    let truth = match pass.truth.agile() {
-        Some(a) => Some(truth::check(a, &firmware, &controller)?),
-        None => None,
-    };
+    // The truth check beside the reference check: each evaluates the f64 reference of
+    // every update.
+    let (reference, truth) = std::thread::scope(|s| {
+        let truth = s.spawn(|| {
+            pass.truth
+                .agile()
+                .map(|a| {
+                    let dem = pass.dem.as_ref();
+                    truth::check(a, &firmware, &controller, dem, &pass.terrain, &navs)
+                })
+                .transpose()
+        });
+        let dem = pass.dem.as_ref();
+        let reference = reference_check(&firmware, &navs, &controller, rel_tolerance, dem);
+        (reference, truth.join())
+    });
+    let (max_rel, max_ticks, compared, reference_failures) = reference?;
+    let truth = truth.map_err(|_| anyhow!("the truth check panicked"))??;
     println!(
         "QEMU run {:.1} s; twin runs and reference check {:.1} s",
         t_check.duration_since(t_qemu).as_secs_f64() - twin_s,
@@ -430,11 +467,11 @@ fn play(elf: &Path, pass: &Pass, plan: Option<reset::Plan>) -> Result<Played> {
                 ));
             }
             // The built-in passes upload a DEM tile at their start (stream.rs).
-            if pass.truth.agile().is_some() {
+            if let Some((g, _)) = &pass.dem {
                 let d = fw.dem;
                 println!(
-                    "DEM upload: tile {} in force, {} committed, upload in progress {} (128 x 128 nodes in 74 chunks, away from the ground track)",
-                    d.in_force_id, d.tiles_committed, d.upload_id
+                    "DEM upload: tile {} in force, {} committed, upload in progress {} ({} x {} nodes from the GeoTIFF)",
+                    d.in_force_id, d.tiles_committed, d.upload_id, g.nrows, g.ncols
                 );
                 if d.in_force_id != scenario::PASS_DEM_ID || d.tiles_committed != 1 {
                     count_failures.push(format!(
@@ -519,7 +556,15 @@ fn reference_check(
     inputs: &BTreeMap<u64, check::InForce>,
     controller: &controller::Controller,
     rel_tolerance: f64,
+    dem: Option<&(DemGrid, Vec<i16>)>,
 ) -> Result<(f64, f64, usize, Vec<String>)> {
+    use controller::golden::{bus_update, bus_update_on_dem};
+    let dem = match dem {
+        Some((g, h)) => {
+            Some(DemTile::new(*g, h).map_err(|e| anyhow!("the pass's DEM: {}", e.name()))?)
+        }
+        None => None,
+    };
     let mut max_rel = 0.0f64;
     let mut max_ticks = 0.0f64;
     let mut compared = 0;
@@ -535,13 +580,19 @@ fn reference_check(
             ));
             continue;
         };
-        let golden = controller::golden::update(
-            controller.scene(),
-            controller.plan(),
-            &input.heights_m,
-            &input.nav,
-            t_us,
-        )
+        let (scene, plan, h) = (controller.scene(), controller.plan(), &input.heights_m[..]);
+        let t_gps = t_us + check::epoch_us();
+        let tile = match (&dem, input.dem) {
+            (Some(t), true) => Some(t),
+            _ => None,
+        };
+        let golden = match (&input.source, tile) {
+            (check::Source::Nav(nav), _) => controller::golden::update(scene, plan, h, nav, t_gps),
+            (check::Source::Bus(g, a, sc), None) => bus_update(scene, plan, h, g, a, sc, t_gps),
+            (check::Source::Bus(g, a, sc), Some(tile)) => {
+                bus_update_on_dem(scene, plan, h, g, a, sc, t_gps, tile)
+            }
+        }
         .map_err(|e| anyhow!("reference at {t_us} us: {}", e.name()))?;
         for r in periods.records().iter().filter(|r| !r.held) {
             let Some(exact) = golden
@@ -843,15 +894,21 @@ fn print_table(pass: &Pass, played: &Played, every_s: u64, segments: &[u8]) {
         println!("{}", line.trim_end());
         next += every_s * 1_000_000;
     }
-    println!("(attitude in deg from the last NAV frame, propagated at its rates; period in us of the 10 MHz line clock; h: held over a fault; MTF: mismatch x drift smear with the segment's 16 stages; M: largest TDI stage count meeting MTF 0.95)");
+    println!("(attitude in deg flown, or from the last NAV frame propagated at its rates; period in us of the 10 MHz line clock; h: held over a fault; MTF: mismatch x drift smear with the segment's 16 stages; M: largest TDI stage count meeting MTF 0.95)");
 }
 
-/// Roll, pitch and yaw of the last NAV sample at or before `t_us`, propagated at their
-/// rates (deg).
+/// Roll, pitch and yaw flown at `t_us` (a built-in pass), or of the last NAV sample at
+/// or before it, propagated at their rates (deg).
 fn telemetry_attitude_deg(pass: &Pass, t_us: u64) -> Option<[f64; 3]> {
-    let s = pass.samples.iter().rev().find(|s| s.t_us <= t_us)?;
-    let a = s.nav.attitude.to_f64();
-    let dt = (t_us - s.t_us) as f64 * 1e-6;
+    if let Some(truth) = pass.truth.agile() {
+        let a = truth.attitude(t_us as f64 * 1e-6);
+        return Some([a.roll_rad, a.pitch_rad, a.yaw_rad].map(f64::to_degrees));
+    }
+    let (t0_us, a) = pass.samples.iter().rev().find_map(|s| match s.msg {
+        scenario::Msg::Nav(n) if s.t_us <= t_us => Some((s.t_us, n.attitude.to_f64())),
+        _ => None,
+    })?;
+    let dt = (t_us - t0_us) as f64 * 1e-6;
     Some([
         (a.roll_rad + a.roll_rate_rad_s * dt).to_degrees(),
         (a.pitch_rad + a.pitch_rate_rad_s * dt).to_degrees(),

@@ -4,12 +4,32 @@
 use anyhow::{anyhow, Result};
 use std::collections::BTreeMap;
 use std::convert::Infallible;
+use std::sync::atomic::{AtomicU64, Ordering};
 
+use controller::bus::{Gnss, StarAttitude};
 use controller::frame::{kind, Decoder, Event};
 use controller::golden::NavInput;
 use controller::report::{Periods, Status};
 use controller::session::Session;
 use controller::{Config, Controller, LinePeriodSink, Scene};
+use core_math::earth::frames::TimeScales;
+
+/// GPS time of the pass's t = 0 (us): frames carry GPS time, the checks and reports
+/// pass time. One pass is played at a time; `scenario::build` and `play` set it.
+static EPOCH_US: AtomicU64 = AtomicU64::new(0);
+
+pub fn set_epoch(epoch_us: u64) {
+    EPOCH_US.store(epoch_us, Ordering::Relaxed);
+}
+
+pub fn epoch_us() -> u64 {
+    EPOCH_US.load(Ordering::Relaxed)
+}
+
+/// Pass time of a frame's time tag.
+pub fn pass_us(tag_us: u64) -> u64 {
+    tag_us.saturating_sub(epoch_us())
+}
 
 /// What a run (firmware or twin) sent to the ground.
 #[derive(Default)]
@@ -30,10 +50,10 @@ impl Downlink {
         let mut decoder = Decoder::new();
         decoder.feed(bytes, |e| match e {
             Event::Frame(f) if f.kind == kind::PERIODS && Periods::decode(f.payload).is_some() => {
-                d.periods.push((f.time_us, f.payload.to_vec()))
+                d.periods.push((pass_us(f.time_us), f.payload.to_vec()))
             }
             Event::Frame(f) if f.kind == kind::STATUS => match Status::decode(f.payload) {
-                Some(s) => d.status.push((f.time_us, s)),
+                Some(s) => d.status.push((pass_us(f.time_us), s)),
                 None => d.bad_frames += 1,
             },
             _ => d.bad_frames += 1,
@@ -76,11 +96,19 @@ pub fn new_controller(config: Config) -> Result<Controller> {
     Ok(c)
 }
 
-/// What the controller had in force at one update: the NAV frame and the ground heights.
+/// What the controller had in force at one update: the NAV frame or the bus's GNSS
+/// fix, attitude and time scales, the ground heights, whether a DEM tile was in force.
 #[derive(Clone, Debug)]
 pub struct InForce {
-    pub nav: NavInput,
+    pub source: Source,
     pub heights_m: Vec<f32>,
+    pub dem: bool,
+}
+
+#[derive(Clone, Debug)]
+pub enum Source {
+    Nav(NavInput),
+    Bus(Gnss, StarAttitude, TimeScales),
 }
 
 /// A host run of `bytes` through a `Session`, as the firmware does, byte by byte.
@@ -98,16 +126,35 @@ pub fn twin(bytes: &[u8], config: Config) -> Result<(Downlink, BTreeMap<u64, InF
         });
         if periods_sent {
             let c = &session.controller;
-            if let (Some(nav), Some(t)) = (c.nav(), c.last_update_us()) {
+            let source = match (c.nav(), c.gnss(), c.bus_attitude()) {
+                (Some(nav), ..) => Some(Source::Nav(NavInput {
+                    state: nav.propagator.state,
+                    attitude: nav.attitude,
+                    time_us: nav.time_us,
+                })),
+                (None, Some(g), Some(a)) => {
+                    // The fix as received: v = v_I - w x r.
+                    let (r, v, w) = (
+                        g.propagator.state.position_m,
+                        g.propagator.state.velocity_mps,
+                        core_math::EARTH_RATE_RAD_S,
+                    );
+                    let gnss = Gnss {
+                        fix_us: g.fix_us,
+                        position_m: r,
+                        velocity_mps: [v[0] + w * r[1], v[1] - w * r[0], v[2]],
+                    };
+                    Some(Source::Bus(gnss, a.received, *c.time_scales()))
+                }
+                _ => None,
+            };
+            if let (Some(source), Some(t)) = (source, c.last_update_us()) {
                 inputs.insert(
-                    t,
+                    pass_us(t),
                     InForce {
-                        nav: NavInput {
-                            state: nav.propagator.state,
-                            attitude: nav.attitude,
-                            time_us: nav.time_us,
-                        },
+                        source,
                         heights_m: c.heights_m().to_vec(),
+                        dem: c.dem_tile().is_some(),
                     },
                 );
             }
@@ -179,7 +226,7 @@ pub fn cut_before(uplink: &[u8], at_us: u64) -> usize {
                 tag = Some(f.time_us);
             }
         });
-        match tag {
+        match tag.map(pass_us) {
             Some(t) if (at_us..at_us.saturating_add(1_000_000)).contains(&t) => break,
             Some(t) if t < at_us => cut = i + 1,
             _ => {}

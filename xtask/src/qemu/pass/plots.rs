@@ -112,18 +112,19 @@ pub fn pass_plots(pass: &Pass, firmware: &Downlink, dir: &Path) -> Result<()> {
                 .map(|y| (*t as f64 * 1e-6, f64::from(y) * 1e3))
         })
         .collect();
-    let flown: Vec<(f64, f64)> = pass
-        .samples
-        .iter()
-        .map(|s| {
-            (
-                s.t_us as f64 * 1e-6,
-                f64::from(s.nav.attitude.yaw_rad) * 1e3,
-            )
-        })
-        .collect();
+    let flown: Vec<(f64, f64)> = match pass.truth.agile() {
+        Some(truth) => truth
+            .yaw
+            .iter()
+            .map(|&(t, y, _)| (t as f64 * 1e-6, y * 1e3))
+            .collect(),
+        None => super::scenario::navs(pass)
+            .iter()
+            .map(|(t, n)| (*t as f64 * 1e-6, f64::from(n.attitude.yaw_rad) * 1e3))
+            .collect(),
+    };
     framed(pass, yaw)
-        .series(Series::line("yaw flown (NAV)", flown).palette(0))
+        .series(Series::line("yaw flown", flown).palette(0))
         .series(Series::line("correction requested", requests).palette(1))
         .save(&dir.join("yaw.png"))
 }

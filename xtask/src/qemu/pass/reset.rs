@@ -143,7 +143,7 @@ impl Trigger {
             if let Event::Frame(f) = e {
                 *seen += 1;
                 if f.kind == kind::PERIODS {
-                    *last = Some(f.time_us);
+                    *last = Some(check::pass_us(f.time_us));
                 }
             }
         });
@@ -299,8 +299,11 @@ impl Report {
         let mut changed = 0;
         let mut examples = Vec::new();
         if let Some(fresh) = fresh_at_us {
+            // Mode, ticks and held flags: the drift and yaw request may differ in their
+            // last bits on the bus's frames, whose C2T pole (kept up to a minute by
+            // `controller::track`) is recomputed after a reset.
             for (t, p) in firmware.periods.iter().filter(|(t, _)| *t >= fresh) {
-                if twin.get(t) != Some(&p) {
+                if super::describe(twin.get(t).copied()) != super::describe(Some(p)) {
                     changed += 1;
                     if examples.len() < 5 {
                         let held = Periods::decode(p)
@@ -318,7 +321,7 @@ impl Report {
         Decoder::new().feed(lost, |e| {
             if let Event::Frame(f) = e {
                 *lost_kinds.entry(f.kind).or_insert(0) += 1;
-                lost_until_us = Some(f.time_us);
+                lost_until_us = Some(check::pass_us(f.time_us));
             }
         });
         let mut unlike_model = Vec::new();

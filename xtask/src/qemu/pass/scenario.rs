@@ -5,21 +5,35 @@
 //! CSV file.
 
 use anyhow::{anyhow, bail, Context, Result};
+use controller::bus::{Gnss, StarAttitude};
 use controller::frame::kind;
 use controller::nav::{Attitude, Nav};
 use controller::{Fault, EARTH};
+use core_math::earth::dem::DemGrid;
 use core_math::earth::kepler::Kepler;
 use core_math::vector::{add, dot, scale};
 use core_math::{StateVector, GM_M3_S2};
 
+use super::bus::{EarthOrientation, Noise};
 use super::stream::Frames;
 use crate::csv::Table;
+use core_math::earth::frames::Mat3;
 
-/// One NAV frame's content and time tag.
+/// One telemetry frame's content and time tag (pass time).
 #[derive(Clone, Copy, Debug)]
 pub struct Sample {
     pub t_us: u64,
-    pub nav: Nav,
+    pub msg: Msg,
+}
+
+/// What a telemetry frame carries: a NAV frame (a user's file), or the bus's GNSS,
+/// ATTITUDE and TIME_SCALES ([`super::bus::SCALES`]) frames (the built-in passes).
+#[derive(Clone, Copy, Debug)]
+pub enum Msg {
+    Nav(Nav),
+    Gnss(Gnss),
+    Attitude(StarAttitude),
+    Scales,
 }
 
 /// J2 of the Earth's gravity field (EGM 2008, unnormalised) and its reference radius.
@@ -34,6 +48,8 @@ const ORBIT_STEP_S: f64 = 1.0;
 #[derive(Clone, Debug)]
 pub struct J2Orbit {
     grid: Vec<StateVector>,
+    /// Orbit time of the pass's t = 0 (s).
+    start_s: f64,
 }
 
 fn accel(r: [f64; 3]) -> [f64; 3] {
@@ -107,12 +123,13 @@ impl J2Orbit {
             let next = rk4(&grid[k - 1], ORBIT_STEP_S);
             grid.push(next);
         }
-        J2Orbit { grid }
+        J2Orbit { grid, start_s: 0.0 }
     }
 
-    /// The ECI state at `t_s` (0 <= t within the duration): one Runge-Kutta step from
-    /// the grid point before it.
+    /// The ECI state at pass time `t_s` (0 <= t within the duration): one Runge-Kutta
+    /// step from the grid point before it.
     pub fn state(&self, t_s: f64) -> StateVector {
+        let t_s = t_s + self.start_s;
         let k = ((t_s / ORBIT_STEP_S).floor().max(0.0) as usize).min(self.grid.len() - 1);
         rk4(&self.grid[k], t_s - k as f64 * ORBIT_STEP_S)
     }
@@ -152,24 +169,10 @@ impl Profile {
     }
 }
 
-/// The ground under each segment over the pass: a mountain range crossed along track
-/// (up to 4 600 m, its ridge slanting across the swath), on a plain a few hundred
-/// metres up. Heights in m above the ellipsoid, by time and segment index.
-#[derive(Clone, Copy, Debug)]
-pub struct TerrainProfile {
-    /// Instant the array centre crosses the ridge (s), and the range's half width in
-    /// time (s).
-    pub ridge_s: f64,
-    pub half_width_s: f64,
-}
-
-impl TerrainProfile {
-    pub fn height_m(&self, t_s: f64, segment: usize) -> f64 {
-        // The ridge reaches each segment at a slightly different time (slanting).
-        let x = (t_s - self.ridge_s - 4.0 * segment as f64) / self.half_width_s;
-        let plain = 250.0 + 150.0 * (0.05 * t_s + 0.7 * segment as f64).sin();
-        plain + 4_300.0 * (-x * x).exp() * (1.0 + 0.08 * (1.3 * segment as f64).sin())
-    }
+/// The ground off the DEM tile: a plain a few hundred metres up, changing slowly along
+/// track and across the swath (m above the ellipsoid, by time and segment index).
+fn plain_m(t_s: f64, segment: usize) -> f64 {
+    250.0 + 150.0 * (0.05 * t_s + 0.7 * segment as f64).sin()
 }
 
 /// The truth of a built-in pass: what the spacecraft really did.
@@ -181,8 +184,11 @@ pub struct AgileTruth {
     /// The yaw the attitude control flew following the firmware's requests: (t_us,
     /// yaw, rate) at each NAV instant, linear in between.
     pub yaw: Vec<(u64, f64, f64)>,
-    pub terrain: TerrainProfile,
     pub segments: usize,
+    /// GPS time of the pass's t = 0 (us), the Earth's orientation, and C2T then.
+    pub epoch_us: u64,
+    pub earth: EarthOrientation,
+    pub c2t0: Mat3,
 }
 
 impl AgileTruth {
@@ -208,9 +214,7 @@ impl AgileTruth {
 
     /// Ground heights of the scene's table at `t_s`.
     pub fn heights_m(&self, t_s: f64) -> Vec<f32> {
-        (0..self.segments)
-            .map(|k| self.terrain.height_m(t_s, k) as f32)
-            .collect()
+        (0..self.segments).map(|k| plain_m(t_s, k) as f32).collect()
     }
 
     /// The NAV content the spacecraft would send at `t_s`.
@@ -271,6 +275,19 @@ pub enum FaultSpec {
     Envelope { t_s: f64 },
     /// An extra DEM frame at `t_s` the camera refuses (issue 23).
     Dem { t_s: f64, probe: DemProbe },
+    /// An extra bus frame at `t_s` the camera refuses (issue 23).
+    Bus { t_s: f64, probe: BusProbe },
+}
+
+/// The bus frames the pass injects, each refused alone.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum BusProbe {
+    /// An ATTITUDE whose quaternion's norm is 1.01: `bad_quaternion`.
+    Quaternion,
+    /// A GNSS fix a second after its frame's tag: `fix_time`.
+    FixAfterTag,
+    /// TIME_SCALES with 70 leap seconds: `time_scales`.
+    LeapSeconds,
 }
 
 /// The DEM frames the pass injects, each refused alone (the upload's multi-frame faults,
@@ -286,26 +303,18 @@ pub enum DemProbe {
     SameId,
 }
 
-/// The tile the built-in passes upload at their start: 128 x 128 nodes at 3 arc-seconds
-/// in the South Pacific, far from their ground track, so that it exercises the upload
-/// (74 chunks through the UART, the commit, STATUS) and leaves the ground of every
-/// segment to TERRAIN.
-pub const PASS_DEM_ID: u32 = 23;
-
-pub fn pass_dem() -> (core_math::earth::dem::DemGrid, Vec<i16>) {
-    let grid = core_math::earth::dem::DemGrid {
-        lat0_deg: -45.0,
-        lon0_deg: -150.0,
-        dlat_deg: 1.0 / 1200.0,
-        dlon_deg: 1.0 / 1200.0,
-        nrows: 128,
-        ncols: 128,
-    };
-    let heights = (0..128 * 128)
-        .map(|k: i32| ((k * 37 + (k / 128) * 11) % 4_500 - 300) as i16)
-        .collect();
-    (grid, heights)
+/// The scene the ground uploads at a pass's start: the firmware's boot scene, with the
+/// camera's mounting for the bus's frames.
+pub fn pass_scene(bus: bool) -> controller::Scene {
+    let mut scene = controller::Scene::paper_default();
+    if bus {
+        scene.mounting_q = super::bus::mounting_q().map(|x| x as f32);
+    }
+    scene
 }
+
+/// The id of the tile the built-in passes upload at their start.
+pub const PASS_DEM_ID: u32 = 23;
 
 impl DemProbe {
     pub fn label(&self) -> &'static str {
@@ -317,12 +326,11 @@ impl DemProbe {
     }
 
     /// The payload's kind, the payload, and the fault it must be refused with.
-    pub fn frame(&self) -> (u8, Vec<u8>, Fault) {
-        let (grid, heights) = pass_dem();
-        let crc = controller::dem::heights_crc32(&heights);
+    pub fn frame(&self, (grid, heights): &(DemGrid, Vec<i16>)) -> (u8, Vec<u8>, Fault) {
+        let (grid, crc) = (*grid, controller::dem::heights_crc32(heights));
         match self {
             DemProbe::Pole => {
-                let g = core_math::earth::dem::DemGrid {
+                let g = DemGrid {
                     lat0_deg: 87.99,
                     ..grid
                 };
@@ -331,7 +339,7 @@ impl DemProbe {
             }
             DemProbe::StrayChunk => {
                 let mut out = [0u8; controller::frame::MAX_PAYLOAD];
-                let n = controller::dem::encode_chunk(PASS_DEM_ID + 2, 0, &heights, &mut out)
+                let n = controller::dem::encode_chunk(PASS_DEM_ID + 2, 0, heights, &mut out)
                     .unwrap_or(0);
                 (kind::DEM_CHUNK, out[..n].to_vec(), Fault::DemSequence)
             }
@@ -418,17 +426,17 @@ impl SceneProbe {
 impl FaultSpec {
     pub fn label(&self) -> String {
         match self {
-            FaultSpec::BitFlip { t_s } => format!("bit flip in NAV at {t_s} s"),
-            FaultSpec::Truncate { t_s } => format!("truncated NAV at {t_s} s"),
+            FaultSpec::BitFlip { t_s } => format!("bit flip in the frame at {t_s} s"),
+            FaultSpec::Truncate { t_s } => format!("truncated frame at {t_s} s"),
             FaultSpec::Noise { t_s, bytes } => format!("{bytes} noise bytes at {t_s} s"),
             FaultSpec::Backwards { t_s, back_s } => {
-                format!("NAV time-tagged {back_s} s back at {t_s} s")
+                format!("GNSS time-tagged {back_s} s back at {t_s} s")
             }
-            FaultSpec::NaN { t_s } => format!("NaN velocity in NAV at {t_s} s"),
+            FaultSpec::NaN { t_s } => format!("NaN velocity in GNSS at {t_s} s"),
             FaultSpec::Altitude { t_s, altitude_m } => {
-                format!("altitude {} km in NAV at {t_s} s", altitude_m / 1e3)
+                format!("altitude {} km in GNSS at {t_s} s", altitude_m / 1e3)
             }
-            FaultSpec::Gap { from_s, len_s } => format!("{len_s} s NAV gap from {from_s} s"),
+            FaultSpec::Gap { from_s, len_s } => format!("{len_s} s bus gap from {from_s} s"),
             FaultSpec::TimeTag { t_s, tag_us } => format!("TIME tagged {tag_us} us at {t_s} s"),
             FaultSpec::BadScene { t_s, probe } => {
                 format!("SCENE with {} at {t_s} s", probe.label())
@@ -436,8 +444,9 @@ impl FaultSpec {
             FaultSpec::Terrain { t_s, height_m } => {
                 format!("TERRAIN at {height_m} m at {t_s} s")
             }
-            FaultSpec::Envelope { t_s } => format!("NAV rolling at 0.5 rad/s at {t_s} s"),
+            FaultSpec::Envelope { t_s } => format!("ATTITUDE rolling at 0.5 rad/s at {t_s} s"),
             FaultSpec::Dem { t_s, probe } => format!("DEM frame with {} at {t_s} s", probe.label()),
+            FaultSpec::Bus { t_s, probe } => format!("{probe:?} bus frame at {t_s} s"),
         }
     }
 }
@@ -456,39 +465,53 @@ pub struct Pass {
     pub end_us: u64,
     pub truth: Truth,
     pub faults: Vec<FaultSpec>,
+    /// The DEM tile uploaded before imaging (the built-in passes'), grid and heights.
+    pub dem: Option<(DemGrid, Vec<i16>)>,
+    /// GPS time of t = 0 (us): the frames' time tags are this plus pass time.
+    pub epoch_us: u64,
 }
 
 pub fn us(t_s: f64) -> u64 {
     (t_s * 1e6).round().max(0.0) as u64
 }
 
-/// NAV rate of the built-in passes.
-pub const NAV_PERIOD_US: u64 = 250_000;
-/// TERRAIN uploads of the built-in passes: once a second, 0.1 s after the second, with
-/// the heights at the middle of the second they serve.
+/// The bus's rates in the built-in passes: GNSS at 1 Hz, the star tracker at 10 Hz.
+pub const GNSS_PERIOD_US: u64 = 1_000_000;
+pub const ATTITUDE_PERIOD_US: u64 = 100_000;
+/// TERRAIN uploads of the built-in passes: once a second, 0.13 s after the second
+/// (between two attitudes), with the heights at the middle of the second they serve.
 pub const TERRAIN_PERIOD_US: u64 = 1_000_000;
-pub const TERRAIN_OFFSET_US: u64 = 100_000;
+pub const TERRAIN_OFFSET_US: u64 = 130_000;
 /// Time constant of the attitude control's yaw tracking (s), its largest yaw rate
-/// (rad/s) and its largest change of yaw rate from one NAV instant to the next: a yaw
+/// (rad/s) and yaw acceleration (rad/s^2): a yaw
 /// steering law is slow and smooth (a yaw rate turns the image about the boresight, so
 /// a jerky one would move the swath's ends along track).
 const YAW_TAU_S: f64 = 4.0;
 const MAX_YAW_RATE_RAD_S: f64 = 2e-3;
-const MAX_YAW_RATE_STEP_RAD_S: f64 = 1e-4;
+const MAX_YAW_ACCEL_RAD_S2: f64 = 4e-4;
 
 /// The truth orbit of the built-in passes: sun-synchronous, 645 km, e = 0.001 (perigee
-/// 638 km, apogee 652 km), i = 97.98 deg, J2 included.
-pub fn sun_synchronous(duration_s: f64) -> J2Orbit {
-    J2Orbit::new(
+/// 638 km, apogee 652 km), i = 97.98 deg, J2 included; the pass's t = 0 at orbit time
+/// `start_s`.
+pub fn sun_synchronous(start_s: f64, duration_s: f64) -> J2Orbit {
+    let orbit = J2Orbit::new(
         EARTH.a_m + 645e3,
         0.001,
         97.98f64.to_radians(),
         0.4,
         1.2,
         -1.6,
-        duration_s,
-    )
+        start_s + duration_s,
+    );
+    J2Orbit { start_s, ..orbit }
 }
+
+/// GPS time of the orbit's t = 0 (us since 1980-01-06, late November 2026): the
+/// orbit's inertial frame is the ITRF frozen then (Part I's I).
+pub const EPOCH_GPS_US: u64 = 1_480_000_000_000_000;
+/// Orbit time at which the short pass starts: its roll slew then looks at the ground
+/// the default pass's forward stereo look sees, where the DEM tile lies.
+pub const SHORT_START_S: f64 = 280.0;
 
 /// What one kind of frame goes where in a pass's time line.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -533,43 +556,59 @@ pub fn schedule(
 /// A built-in pass: its attitude manoeuvres, terrain and faults.
 pub struct Manoeuvres {
     pub name: &'static str,
+    /// Orbit time of the pass's t = 0 (s).
+    pub start_s: f64,
     pub duration_s: f64,
     pub roll: Profile,
     pub pitch: Profile,
-    pub terrain: TerrainProfile,
     pub faults: Vec<FaultSpec>,
 }
 
 /// Plays `m` through a host run of the firmware's controller to fly the yaw it asks
-/// for: at each NAV instant the attitude control turns the yaw towards the last
+/// for: at each attitude instant the attitude control turns the yaw towards the last
 /// request (the yaw at that update plus the correction) with a first-order lag, and the
-/// NAV frame reports the yaw and rate it flies. The host run sees exactly the clean
+/// ATTITUDE frame reports the attitude it flies. The host run sees exactly the clean
 /// stream the firmware will see (the injected faults change no output, which the pass
 /// checks), so its requests are the firmware's.
-pub fn build(m: Manoeuvres, tick_us: u64) -> Result<Pass> {
+pub fn build(m: Manoeuvres, dem: (DemGrid, Vec<i16>), tick_us: u64) -> Result<Pass> {
     use controller::frame::kind;
     let end_us = us(m.duration_s);
+    let epoch_us = EPOCH_GPS_US + us(m.start_s);
+    super::check::set_epoch(epoch_us);
     let in_gap = |t_us: u64| {
         m.faults.iter().any(|f| match *f {
             FaultSpec::Gap { from_s, len_s } => t_us > us(from_s) && t_us < us(from_s + len_s),
             _ => false,
         })
     };
-    let nav_us: Vec<u64> = (0..=end_us / NAV_PERIOD_US)
-        .map(|k| k * NAV_PERIOD_US)
-        .filter(|&t| !in_gap(t))
-        .collect();
-    let terrain_us: Vec<u64> = (0..end_us / TERRAIN_PERIOD_US)
-        .map(|k| k * TERRAIN_PERIOD_US + TERRAIN_OFFSET_US)
+    // Tags: TIME_SCALES first, then each attitude at its time of validity (the
+    // profiles change rate at those instants, so the gyros' rate in force is the rate
+    // flown: see docs/telemetry.md) and each fix 50 ms after its time of fix.
+    let mut kinds = std::collections::BTreeMap::from([(0, Kind::Scales)]);
+    // TIME_SCALES again every second, before the fix: a camera reset loses it.
+    kinds.extend((1..end_us / GNSS_PERIOD_US).map(|k| (k * GNSS_PERIOD_US + 40_000, Kind::Scales)));
+    kinds
+        .extend((1..end_us / ATTITUDE_PERIOD_US).map(|k| (k * ATTITUDE_PERIOD_US, Kind::Attitude)));
+    kinds.extend((0..end_us / GNSS_PERIOD_US).map(|k| (k * GNSS_PERIOD_US + 50_000, Kind::Gnss)));
+    kinds.retain(|&t, _| t <= end_us && !in_gap(t));
+    let tags: Vec<u64> = kinds.keys().copied().collect();
+    // The first heights before the first update, after the uploads of the start.
+    let terrain_us: Vec<u64> = std::iter::once(1_000)
+        .chain((0..end_us / TERRAIN_PERIOD_US).map(|k| k * TERRAIN_PERIOD_US + TERRAIN_OFFSET_US))
         .collect();
     let scene = controller::Scene::paper_default();
+    // From the orbit's t = 0, whose ITRF is I0.
+    let gps0_s = (EPOCH_GPS_US / 1_000_000) as i64;
+    let earth = EarthOrientation::new(gps0_s, (m.start_s + m.duration_s).ceil() as usize + 3)?;
     let mut truth = AgileTruth {
-        orbit: sun_synchronous(m.duration_s + 2.0),
+        orbit: sun_synchronous(m.start_s, m.duration_s + 2.0),
         roll: m.roll,
         pitch: m.pitch,
         yaw: Vec::new(),
-        terrain: m.terrain,
         segments: usize::from(scene.count),
+        epoch_us,
+        c2t0: earth.c2t(gps0_s as f64),
+        earth,
     };
     let controller = controller::Controller::new(controller::Config::default(), scene)
         .map_err(|f| anyhow!("the default scene was refused: {}", f.name()))?;
@@ -579,7 +618,8 @@ pub fn build(m: Manoeuvres, tick_us: u64) -> Result<Pass> {
         session.feed(&frame, &mut super::check::Accept, |_| {});
     };
     let (mut samples, mut terrain) = (Vec::new(), Vec::new());
-    // The pass starts steered: the request of a first update at t = 0 with the yaw at 0.
+    // The pass starts steered: the request of a first update at t = 0 with the yaw at 0
+    // (from a NAV frame: Part I's attitude, which has no mounting).
     let mut target_rad = {
         // A controller as the session's is now (fresh, the default scene).
         let mut probe = controller::Controller::new(controller::Config::default(), scene)
@@ -591,7 +631,7 @@ pub fn build(m: Manoeuvres, tick_us: u64) -> Result<Pass> {
                 probe.on_frame(&f);
             }
         });
-        probe.advance(0, &mut super::check::Accept);
+        probe.advance(epoch_us, &mut super::check::Accept);
         f64::from(
             probe
                 .yaw_request_rad()
@@ -600,33 +640,52 @@ pub fn build(m: Manoeuvres, tick_us: u64) -> Result<Pass> {
     };
     truth.yaw.push((0, target_rad, 0.0));
     let mut rate_rad_s = 0.0f64;
-    for (t_us, slot) in schedule(&nav_us, &terrain_us, tick_us, end_us) {
+    let (mut gnss_noise, mut star_noise) = (Noise::new(0x6e55), Noise::new(0x57a7));
+    for (t_us, slot) in schedule(&tags, &terrain_us, tick_us, end_us) {
         let t_s = t_us as f64 * 1e-6;
-        match slot {
-            SlotKind::Nav => {
+        match (slot, kinds.get(&t_us)) {
+            (SlotKind::Nav, Some(Kind::Scales)) => {
+                feed(&mut session, frames.msg(t_us, &Msg::Scales));
+                if t_us == 0 {
+                    for f in super::stream::uploads(&mut frames, true, Some(&dem), t_us) {
+                        feed(&mut session, f);
+                    }
+                }
+                samples.push(Sample {
+                    t_us,
+                    msg: Msg::Scales,
+                });
+            }
+            (SlotKind::Nav, Some(Kind::Gnss)) => {
+                let fix_s = t_s - 0.05;
+                let msg = Msg::Gnss(truth.gnss(fix_s, Some(&mut gnss_noise)));
+                feed(&mut session, frames.msg(t_us, &msg));
+                samples.push(Sample { t_us, msg });
+            }
+            (SlotKind::Nav, _) => {
+                let valid_s = t_s;
                 let c = &session.controller;
                 if let (Some(request), Some(u)) = (c.yaw_request_rad(), c.last_update_us()) {
-                    target_rad = truth.attitude(u as f64 * 1e-6).yaw_rad + f64::from(request);
+                    let u_s = (u - epoch_us) as f64 * 1e-6;
+                    target_rad = truth.attitude(u_s).yaw_rad + f64::from(request);
                 }
-                let yaw = truth.attitude(t_s).yaw_rad;
+                let yaw = truth.attitude(valid_s).yaw_rad;
                 let wanted =
                     ((target_rad - yaw) / YAW_TAU_S).clamp(-MAX_YAW_RATE_RAD_S, MAX_YAW_RATE_RAD_S);
-                rate_rad_s +=
-                    (wanted - rate_rad_s).clamp(-MAX_YAW_RATE_STEP_RAD_S, MAX_YAW_RATE_STEP_RAD_S);
-                if t_us > 0 {
-                    truth.yaw.push((t_us, yaw, rate_rad_s));
-                }
-                let nav = truth.nav(t_s);
-                feed(&mut session, frames.nav(t_us, &nav));
-                samples.push(Sample { t_us, nav });
+                let step = MAX_YAW_ACCEL_RAD_S2 * ATTITUDE_PERIOD_US as f64 * 1e-6;
+                rate_rad_s += (wanted - rate_rad_s).clamp(-step, step);
+                truth.yaw.push((us(valid_s), yaw, rate_rad_s));
+                let msg = Msg::Attitude(truth.star(valid_s, Some(&mut star_noise))?);
+                feed(&mut session, frames.msg(t_us, &msg));
+                samples.push(Sample { t_us, msg });
             }
-            SlotKind::Terrain => {
+            (SlotKind::Terrain, _) => {
                 let heights = truth.heights_m(t_s + 0.5);
                 let payload = terrain_payload(&heights);
                 feed(&mut session, frames.frame(kind::TERRAIN, t_us, &payload));
                 terrain.push((t_us, heights));
             }
-            SlotKind::Time => feed(&mut session, frames.frame(kind::TIME, t_us, &[])),
+            (SlotKind::Time, _) => feed(&mut session, frames.frame(kind::TIME, t_us, &[])),
         }
     }
     Ok(Pass {
@@ -637,7 +696,17 @@ pub fn build(m: Manoeuvres, tick_us: u64) -> Result<Pass> {
         end_us,
         truth: Truth::Agile(Box::new(truth)),
         faults: m.faults,
+        dem: Some(dem),
+        epoch_us,
     })
+}
+
+/// The bus frames of a built-in pass.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Kind {
+    Scales,
+    Gnss,
+    Attitude,
 }
 
 /// A TERRAIN payload of `heights`.
@@ -674,6 +743,22 @@ pub fn link_probes(t0_s: f64) -> Vec<FaultSpec> {
     out
 }
 
+/// The bus probes of issue 23 from `t0_s` on, a second apart.
+fn bus_probes(t0_s: f64) -> Vec<FaultSpec> {
+    [
+        BusProbe::Quaternion,
+        BusProbe::FixAfterTag,
+        BusProbe::LeapSeconds,
+    ]
+    .into_iter()
+    .enumerate()
+    .map(|(k, probe)| FaultSpec::Bus {
+        t_s: t0_s + k as f64,
+        probe,
+    })
+    .collect()
+}
+
 fn deg(corners: &[(f64, f64)]) -> Profile {
     Profile {
         corners: corners.iter().map(|&(t, a)| (t, a.to_radians())).collect(),
@@ -689,11 +774,16 @@ fn deg(corners: &[(f64, f64)]) -> Profile {
 /// reverse it.) Faults spread over it, none at a corner of a profile (a lost frame there
 /// would leave the controller extrapolating the old rate, which is the telemetry's loss,
 /// not an error).
-pub fn default_pass(tick_us: u64) -> Result<Pass> {
+pub fn default_pass(dem: (DemGrid, Vec<i16>), tick_us: u64) -> Result<Pass> {
+    build(default_manoeuvres(), dem, tick_us)
+}
+
+/// The default pass's manoeuvres, terrain and faults.
+pub fn default_manoeuvres() -> Manoeuvres {
     let mut faults = vec![
         FaultSpec::BitFlip { t_s: 30.0 },
         FaultSpec::BitFlip { t_s: 70.5 },
-        FaultSpec::Truncate { t_s: 120.25 },
+        FaultSpec::Truncate { t_s: 120.2 },
         FaultSpec::Noise {
             t_s: 150.0,
             bytes: 48,
@@ -703,7 +793,7 @@ pub fn default_pass(tick_us: u64) -> Result<Pass> {
             back_s: 1.0,
         },
         FaultSpec::Terrain {
-            t_s: 230.31,
+            t_s: 230.335,
             height_m: 9_500.0,
         },
         FaultSpec::Envelope { t_s: 240.125 },
@@ -719,25 +809,25 @@ pub fn default_pass(tick_us: u64) -> Result<Pass> {
         },
     ];
     faults.extend(link_probes(160.0));
-    build(
-        Manoeuvres {
-            name: "default pass (600 s)",
-            duration_s: 600.0,
-            roll: deg(&[(40.0, 0.0), (60.0, 20.0), (140.0, 20.0), (160.0, 0.0)]),
-            pitch: deg(&[(180.0, 0.0), (280.0, 20.0), (310.0, 20.0), (510.0, -20.0)]),
-            terrain: TerrainProfile {
-                ridge_s: 300.0,
-                half_width_s: 90.0,
-            },
-            faults,
-        },
-        tick_us,
-    )
+    faults.extend(bus_probes(200.125));
+    Manoeuvres {
+        name: "default pass (600 s)",
+        start_s: 0.0,
+        duration_s: 600.0,
+        roll: deg(&[(40.0, 0.0), (60.0, 20.0), (140.0, 20.0), (160.0, 0.0)]),
+        pitch: deg(&[(180.0, 0.0), (280.0, 20.0), (310.0, 20.0), (510.0, -20.0)]),
+        faults,
+    }
 }
 
 /// The end-to-end test's pass: one minute, roll 0 -> 20 deg at 1.25 deg/s, then pitch
 /// 0 -> 5 deg at 0.2 deg/s, a ridge at 40 s, every kind of fault.
-pub fn short_pass(tick_us: u64) -> Result<Pass> {
+pub fn short_pass(dem: (DemGrid, Vec<i16>), tick_us: u64) -> Result<Pass> {
+    build(short_manoeuvres(), dem, tick_us)
+}
+
+/// The short pass's manoeuvres, terrain and faults.
+pub fn short_manoeuvres() -> Manoeuvres {
     let mut faults = vec![
         FaultSpec::BitFlip { t_s: 5.0 },
         FaultSpec::Truncate { t_s: 8.0 },
@@ -751,7 +841,7 @@ pub fn short_pass(tick_us: u64) -> Result<Pass> {
         },
         FaultSpec::NaN { t_s: 18.125 },
         FaultSpec::Terrain {
-            t_s: 22.31,
+            t_s: 22.335,
             height_m: -800.0,
         },
         FaultSpec::Envelope { t_s: 24.125 },
@@ -778,20 +868,15 @@ pub fn short_pass(tick_us: u64) -> Result<Pass> {
         },
     ];
     faults.extend(link_probes(28.0));
-    build(
-        Manoeuvres {
-            name: "short pass (60 s)",
-            duration_s: 60.0,
-            roll: deg(&[(8.5, 0.0), (24.5, 20.0)]),
-            pitch: deg(&[(30.0, 0.0), (55.0, 5.0)]),
-            terrain: TerrainProfile {
-                ridge_s: 40.0,
-                half_width_s: 15.0,
-            },
-            faults,
-        },
-        tick_us,
-    )
+    faults.extend(bus_probes(34.125));
+    Manoeuvres {
+        name: "short pass (60 s)",
+        start_s: SHORT_START_S,
+        duration_s: 60.0,
+        roll: deg(&[(8.5, 0.0), (24.5, 20.0)]),
+        pitch: deg(&[(30.0, 0.0), (55.0, 5.0)]),
+        faults,
+    }
 }
 
 /// The CSV columns of a telemetry file, in this order when written.
@@ -845,7 +930,7 @@ pub fn from_csv(path: &std::path::Path, tick_us: u64) -> Result<Pass> {
         let v = |k: usize| field(k);
         samples.push(Sample {
             t_us: us(t_s),
-            nav: Nav {
+            msg: Msg::Nav(Nav {
                 state: StateVector {
                     position_m: [v(1)?, v(2)?, v(3)?],
                     velocity_mps: [v(4)?, v(5)?, v(6)?],
@@ -858,7 +943,7 @@ pub fn from_csv(path: &std::path::Path, tick_us: u64) -> Result<Pass> {
                     pitch_rate_rad_s: v(11)? as f32,
                     yaw_rate_rad_s: v(12)? as f32,
                 },
-            },
+            }),
         });
     }
     let end_us = samples
@@ -874,19 +959,34 @@ pub fn from_csv(path: &std::path::Path, tick_us: u64) -> Result<Pass> {
         terrain: Vec::new(),
         truth: Truth::Telemetry,
         faults: Vec::new(),
+        dem: None,
+        epoch_us: 0,
     })
 }
 
-/// Writes the pass's NAV samples as a telemetry CSV file.
+/// The pass's NAV frames.
+pub fn navs(pass: &Pass) -> Vec<(u64, Nav)> {
+    let nav = |s: &Sample| match s.msg {
+        Msg::Nav(n) => Some((s.t_us, n)),
+        _ => None,
+    };
+    pass.samples.iter().filter_map(nav).collect()
+}
+
+/// Writes the pass's NAV frames as a telemetry CSV file.
 pub fn to_csv(pass: &Pass, path: &std::path::Path) -> Result<()> {
     let preamble = format!("# {} (see docs/telemetry.md)\n", pass.name);
     let mut out = crate::csv::Writer::new(&preamble, &CSV_COLUMNS)?;
-    for s in &pass.samples {
-        let (r, v, a) = (
-            s.nav.state.position_m,
-            s.nav.state.velocity_mps,
-            s.nav.attitude,
-        );
+    // A built-in pass's NAV frames: the truth's state in I0 and Part I's attitude at
+    // 4 Hz (what a NAV client would send for it).
+    let navs: Vec<(u64, Nav)> = match pass.truth.agile() {
+        Some(truth) => (0..=pass.end_us / 250_000)
+            .map(|k| (k * 250_000, truth.nav(k as f64 * 0.25)))
+            .collect(),
+        None => navs(pass),
+    };
+    for (t_us, nav) in navs {
+        let (r, v, a) = (nav.state.position_m, nav.state.velocity_mps, nav.attitude);
         let state = [r[0], r[1], r[2], v[0], v[1], v[2]].map(|x| format!("{x:?}"));
         let attitude = [
             a.roll_rad,
@@ -897,7 +997,7 @@ pub fn to_csv(pass: &Pass, path: &std::path::Path) -> Result<()> {
             a.yaw_rate_rad_s,
         ]
         .map(|x| format!("{x:?}"));
-        let t = (s.t_us as f64 * 1e-6).to_string();
+        let t = (t_us as f64 * 1e-6).to_string();
         out.row(&[[t].as_slice(), &state, &attitude].concat())?;
     }
     std::fs::write(path, out.into_bytes()?).with_context(|| format!("writing {}", path.display()))

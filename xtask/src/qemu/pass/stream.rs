@@ -6,14 +6,18 @@
 //! host twin only the others ("the stream with the injected faulty frames removed").
 
 use anyhow::{anyhow, bail, Context, Result};
+use controller::bus::encode_time_scales;
+use controller::dem::{encode_begin, encode_chunk, heights_crc32};
 use controller::frame::{encode, kind, MAX_FRAME, SYNC};
 use controller::nav::Nav;
 use controller::Fault;
+use core_math::earth::dem::DemGrid;
 
 use controller::EARTH;
 use core_math::vector::{norm, scale};
 
-use super::scenario::{schedule, terrain_payload, us, FaultSpec, Pass, SlotKind};
+use super::bus::SCALES;
+use super::scenario::{schedule, terrain_payload, us, BusProbe, FaultSpec, Msg, Pass, SlotKind};
 
 /// One piece of the stream.
 #[derive(Clone, Debug)]
@@ -64,9 +68,11 @@ pub(super) struct Frames {
 }
 
 impl Frames {
+    /// A frame tagged `time_us` of pass time (GPS time less the pass's epoch).
     pub(super) fn frame(&mut self, kind: u8, time_us: u64, payload: &[u8]) -> Vec<u8> {
         let mut buf = [0u8; MAX_FRAME];
-        let n = encode(kind, self.sequence, time_us, payload, &mut buf).unwrap_or(0);
+        let tag = time_us.saturating_add(super::check::epoch_us());
+        let n = encode(kind, self.sequence, tag, payload, &mut buf).unwrap_or(0);
         self.sequence = self.sequence.wrapping_add(1);
         buf[..n].to_vec()
     }
@@ -75,6 +81,46 @@ impl Frames {
         let n = nav.encode(&mut payload).unwrap_or(0);
         self.frame(kind::NAV, time_us, &payload[..n])
     }
+    pub(super) fn msg(&mut self, time_us: u64, msg: &Msg) -> Vec<u8> {
+        let mut p = [0u8; 64];
+        let (kind, n) = match msg {
+            Msg::Nav(nav) => return self.nav(time_us, nav),
+            Msg::Gnss(g) => (kind::GNSS, g.encode(&mut p)),
+            Msg::Attitude(a) => (kind::ATTITUDE, a.encode(&mut p)),
+            Msg::Scales => (
+                kind::TIME_SCALES,
+                encode_time_scales(SCALES.gps_utc_s as i16, SCALES.dut1_s as f32, &mut p),
+            ),
+        };
+        self.frame(kind, time_us, &p[..n.unwrap_or(0)])
+    }
+}
+
+/// The ground's uploads at the start of a pass, from `t0_us` + 1 us on: the scene the
+/// firmware booted with (with the camera's mounting for the bus's frames), so that the
+/// flight binary plans a scene in flight (its deepest stack, docs/target.md); then the
+/// DEM tile, its DEM_BEGIN and chunks 1 us apart.
+pub(super) fn uploads(
+    frames: &mut Frames,
+    bus: bool,
+    dem: Option<&(DemGrid, Vec<i16>)>,
+    t0_us: u64,
+) -> Vec<Vec<u8>> {
+    let scene = super::scenario::pass_scene(bus);
+    let mut p = vec![0u8; controller::frame::MAX_PAYLOAD];
+    let n = scene.encode(&mut p).unwrap_or(0);
+    let mut out = vec![frames.frame(kind::SCENE, t0_us + 1, &p[..n])];
+    if let Some((grid, heights)) = dem {
+        let id = super::scenario::PASS_DEM_ID;
+        let begin = encode_begin(id, grid, heights_crc32(heights));
+        out.push(frames.frame(kind::DEM_BEGIN, t0_us + 2, &begin));
+        let mut k = 0u16;
+        while let Some(n) = encode_chunk(id, k, heights, &mut p) {
+            out.push(frames.frame(kind::DEM_CHUNK, t0_us + 3 + u64::from(k), &p[..n]));
+            k += 1;
+        }
+    }
+    out
 }
 
 /// Builds the stream of `pass`.
@@ -84,7 +130,7 @@ pub fn build(pass: &Pass) -> Result<Stream> {
     let nav_us: Vec<u64> = pass.samples.iter().map(|s| s.t_us).collect();
     let terrain_us: Vec<u64> = pass.terrain.iter().map(|t| t.0).collect();
     let slots = schedule(&nav_us, &terrain_us, pass.tick_us, pass.end_us);
-    let (mut navs, mut uploads) = (pass.samples.iter(), pass.terrain.iter());
+    let (mut navs, mut terrain) = (pass.samples.iter(), pass.terrain.iter());
 
     let mut frames = Frames::default();
     let mut items: Vec<Item> = Vec::with_capacity(slots.len() + 16);
@@ -95,12 +141,12 @@ pub fn build(pass: &Pass) -> Result<Stream> {
             SlotKind::Nav => {
                 let s = navs
                     .next()
-                    .context("the schedule has more NAV slots than samples")?;
+                    .context("the schedule has more telemetry slots than samples")?;
                 nav_item.insert(s.t_us, items.len());
-                frames.nav(s.t_us, &s.nav)
+                frames.msg(s.t_us, &s.msg)
             }
             SlotKind::Terrain => {
-                let (_, heights) = uploads
+                let (_, heights) = terrain
                     .next()
                     .context("the schedule has more TERRAIN slots than uploads")?;
                 frames.frame(kind::TERRAIN, t, &terrain_payload(heights))
@@ -122,12 +168,19 @@ pub fn build(pass: &Pass) -> Result<Stream> {
     // The first item whose frame is time-tagged after `t_us` (extra frames go before it).
     let times: Vec<u64> = slots.iter().map(|s| s.0).collect();
     let after = |t_us: u64| times.iter().position(|&t| t > t_us).unwrap_or(times.len());
-    let truth_nav = |t_s: f64| -> Result<Nav> {
-        pass.truth
-            .agile()
-            .map(|a| a.nav(t_s))
-            .context("faults are injected into the built-in passes only")
+    let truth = pass
+        .truth
+        .agile()
+        .context("faults are injected into the built-in passes only");
+    // The truth's frames tagged `t_s` (a fix 50 ms before).
+    let gnss = |t_s: f64| {
+        truth
+            .as_ref()
+            .map(|a| a.gnss(t_s - 0.05, None))
+            .map_err(|e| anyhow!("{e}"))
     };
+    let star =
+        |t_s: f64| -> Result<_> { truth.as_ref().map_err(|e| anyhow!("{e}"))?.star(t_s, None) };
     for (k, f) in pass.faults.iter().enumerate() {
         // What the fault changes in place, or the frame (or noise) it adds after the
         // frames of `t_s`; and the counter it must increment.
@@ -147,23 +200,23 @@ pub fn build(pass: &Pass) -> Result<Stream> {
             FaultSpec::Noise { t_s, bytes } => (Some((t_s, noise(bytes, k as u64))), None),
             FaultSpec::Backwards { t_s, back_s } => {
                 let t_old = t_s - back_s;
-                let bytes = frames.nav(us(t_old), &truth_nav(t_old)?);
+                let bytes = frames.msg(us(t_old), &Msg::Gnss(gnss(t_old)?));
                 (Some((t_s, bytes)), Some(Fault::TimeWentBackwards))
             }
             FaultSpec::NaN { t_s } => {
-                let mut nav = truth_nav(t_s)?;
-                nav.state.velocity_mps[0] = f64::NAN;
+                let mut g = gnss(t_s)?;
+                g.velocity_mps[0] = f64::NAN;
                 (
-                    Some((t_s, frames.nav(us(t_s), &nav))),
+                    Some((t_s, frames.msg(us(t_s), &Msg::Gnss(g)))),
                     Some(Fault::NonFinite),
                 )
             }
             FaultSpec::Altitude { t_s, altitude_m } => {
-                let mut nav = truth_nav(t_s)?;
-                let r = nav.state.position_m;
-                nav.state.position_m = scale((EARTH.a_m + altitude_m) / norm(r), r);
+                let mut g = gnss(t_s)?;
+                let r = g.position_m;
+                g.position_m = scale((EARTH.a_m + altitude_m) / norm(r), r);
                 (
-                    Some((t_s, frames.nav(us(t_s), &nav))),
+                    Some((t_s, frames.msg(us(t_s), &Msg::Gnss(g)))),
                     Some(Fault::OutOfRange),
                 )
             }
@@ -184,16 +237,38 @@ pub fn build(pass: &Pass) -> Result<Stream> {
                 (Some((t_s, bytes)), Some(Fault::OutOfRange))
             }
             FaultSpec::Dem { t_s, probe } => {
-                let (k, payload, fault) = probe.frame();
+                let (k, payload, fault) =
+                    probe.frame(pass.dem.as_ref().context("DEM faults need a tile")?);
                 (Some((t_s, frames.frame(k, us(t_s), &payload))), Some(fault))
             }
             FaultSpec::Envelope { t_s } => {
-                let mut nav = truth_nav(t_s)?;
-                nav.attitude.roll_rate_rad_s = 0.5;
+                let mut a = star(t_s)?;
+                a.body_rate_rad_s[0] = 0.5;
                 (
-                    Some((t_s, frames.nav(us(t_s), &nav))),
+                    Some((t_s, frames.msg(us(t_s), &Msg::Attitude(a)))),
                     Some(Fault::AttitudeOutsideModel),
                 )
+            }
+            FaultSpec::Bus { t_s, probe } => {
+                let (bytes, fault) = match probe {
+                    BusProbe::Quaternion => {
+                        let mut a = star(t_s)?;
+                        a.q = a.q.map(|x| x * 1.01);
+                        (frames.msg(us(t_s), &Msg::Attitude(a)), Fault::BadQuaternion)
+                    }
+                    BusProbe::FixAfterTag => {
+                        let mut g = gnss(t_s)?;
+                        g.fix_us = pass.epoch_us + us(t_s + 1.0);
+                        (frames.msg(us(t_s), &Msg::Gnss(g)), Fault::FixTime)
+                    }
+                    BusProbe::LeapSeconds => {
+                        let mut p = [0u8; 8];
+                        let n = encode_time_scales(70, 0.0, &mut p).unwrap_or(0);
+                        let bytes = frames.frame(kind::TIME_SCALES, us(t_s), &p[..n]);
+                        (bytes, Fault::TimeScales)
+                    }
+                };
+                (Some((t_s, bytes)), Some(fault))
             }
         };
         if let Some((t_s, bytes)) = added {
@@ -202,38 +277,13 @@ pub fn build(pass: &Pass) -> Result<Stream> {
         }
         injected.push((f.label(), expect));
     }
-    // The ground's scene upload at the start of the pass, 1 us after the first frame:
-    // the scene the firmware booted with, so that every check reads as before while the
-    // flight binary plans a scene in flight (its deepest stack, docs/target.md).
+    // The ground's uploads after the first frame, before the first tick.
     if let (Some(&t0), Some(&t1)) = (times.first(), times.get(1)) {
+        let dem = pass.dem.as_ref().filter(|_| t1 > t0 + 100);
         if t1 > t0 + 1 {
-            let mut p = vec![0u8; controller::frame::MAX_PAYLOAD];
-            let n = controller::Scene::paper_default()
-                .encode(&mut p)
-                .context("the default scene does not fit a SCENE frame")?;
-            let bytes = frames.frame(kind::SCENE, t0 + 1, &p[..n]);
-            extra.push((1, Item { bytes, fault: None }));
-        }
-        // Then a DEM tile, its DEM_BEGIN and 74 chunks 1 us apart, before the next
-        // tick: away from the ground track ([`super::scenario::pass_dem`]).
-        if pass.truth.agile().is_some() && t1 > t0 + 100 {
-            let (grid, heights) = super::scenario::pass_dem();
-            let id = super::scenario::PASS_DEM_ID;
-            let crc = controller::dem::heights_crc32(&heights);
-            let begin = controller::dem::encode_begin(id, &grid, crc);
-            extra.push((
-                1,
-                Item {
-                    bytes: frames.frame(kind::DEM_BEGIN, t0 + 2, &begin),
-                    fault: None,
-                },
-            ));
-            let mut out = [0u8; controller::frame::MAX_PAYLOAD];
-            let mut k = 0u16;
-            while let Some(n) = controller::dem::encode_chunk(id, k, &heights, &mut out) {
-                let bytes = frames.frame(kind::DEM_CHUNK, t0 + 3 + u64::from(k), &out[..n]);
+            let bus = pass.truth.agile().is_some();
+            for bytes in uploads(&mut frames, bus, dem, t0) {
                 extra.push((1, Item { bytes, fault: None }));
-                k += 1;
             }
         }
     }
