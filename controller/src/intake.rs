@@ -139,7 +139,12 @@ impl Controller {
                 Ok(())
             }
             kind::TIME_SCALES => {
-                self.time_scales = decode_time_scales(frame.payload)?;
+                let scales = decode_time_scales(frame.payload)?;
+                if scales != self.time_scales {
+                    self.time_scales = scales;
+                    // A reset keeps them (`restart::Snapshot`).
+                    self.inputs_generation = self.inputs_generation.wrapping_add(1);
+                }
                 self.rederive_attitude();
                 Ok(())
             }

@@ -1,7 +1,8 @@
 //! What a reset must not lose, and why the core last started.
 //!
-//! A [`Snapshot`] holds the scene in force, its ground heights and the last periods, each
-//! in the telemetry's own encoding (a SCENE, a TERRAIN and a PERIODS payload): the
+//! A [`Snapshot`] holds the scene in force, its ground heights, the time scales and the
+//! last periods, each in the telemetry's own encoding (a SCENE, a TERRAIN, a TIME_SCALES
+//! and a PERIODS payload): the
 //! codecs and checks are the ones the link uses, and the encoding does not depend on how
 //! a build lays out its structures, so a snapshot left by another build is decoded and
 //! checked like any frame from the ground, not misread. The firmware keeps it in RAM that
@@ -10,6 +11,7 @@
 //! scene is planned and the heights put back; every period stays flagged held until
 //! the first update on fresh telemetry (docs/target.md, "Faults and resets").
 
+use crate::bus::{decode_time_scales, encode_time_scales};
 use crate::control::{Controller, SegmentOutput};
 use crate::fault::Fault;
 use crate::frame::MAX_PAYLOAD;
@@ -98,6 +100,10 @@ pub struct Snapshot {
     pub scene: Payload,
     /// The ground heights in force (a TERRAIN payload).
     pub terrain: Payload,
+    /// GPS - UTC and UT1 - UTC in force (a TIME_SCALES payload): without them a reset
+    /// would fall back to the defaults (UT1 - UTC = 0) until the bus sends them again,
+    /// up to 0.9 s of Earth rotation in the C2T.
+    pub time_scales: Payload,
     /// The outputs in force (a PERIODS payload).
     pub periods: Payload,
 }
@@ -106,6 +112,7 @@ impl Snapshot {
     pub const EMPTY: Snapshot = Snapshot {
         scene: Payload::EMPTY,
         terrain: Payload::EMPTY,
+        time_scales: Payload::EMPTY,
         periods: Payload::EMPTY,
     };
 }
@@ -118,15 +125,24 @@ pub struct Restored {
 }
 
 impl Controller {
-    /// Writes the scene and ground heights in force into `out` (they change only with a
-    /// SCENE or TERRAIN frame: [`Controller::inputs_generation`] tells when). False if
-    /// they do not fit (never for a scene the controller accepted).
+    /// Writes the scene, ground heights and time scales in force into `out` (they change
+    /// only with a SCENE, TERRAIN or TIME_SCALES frame: [`Controller::inputs_generation`]
+    /// tells when). False if they do not fit (never for values the controller accepted).
     pub fn snapshot_inputs(&self, out: &mut Snapshot) -> bool {
         let terrain = Terrain {
             heights_m: self.heights_m,
             count: self.scene.count,
         };
-        out.scene.fill(|b| self.scene.encode(b)) && out.terrain.fill(|b| terrain.encode(b))
+        // Exact: the leap seconds are whole and UT1 - UTC came in as an f32.
+        let (leap_s, dut1_s) = (
+            self.time_scales.gps_utc_s as i16,
+            self.time_scales.dut1_s as f32,
+        );
+        out.scene.fill(|b| self.scene.encode(b))
+            && out.terrain.fill(|b| terrain.encode(b))
+            && out
+                .time_scales
+                .fill(|b| encode_time_scales(leap_s, dut1_s, b))
     }
 
     /// Writes the outputs in force into `out` (after every update).
@@ -163,8 +179,10 @@ impl Controller {
         let periods = Periods::decode(snapshot.periods.as_slice()).ok_or(Fault::BadLength)?;
         let scene = Scene::decode(snapshot.scene.as_slice())?;
         let terrain = Terrain::decode(snapshot.terrain.as_slice(), &scene)?;
+        let time_scales = decode_time_scales(snapshot.time_scales.as_slice())?;
         self.set_scene(scene)?;
         self.heights_m = terrain.heights_m;
+        self.time_scales = time_scales;
         self.inputs_generation = self.inputs_generation.wrapping_add(1);
         let records = periods.records().iter();
         for r in records.filter(|r| written.get(usize::from(r.index)) == Some(&true)) {

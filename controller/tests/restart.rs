@@ -153,3 +153,39 @@ fn status_reports_the_reset() {
     }
     assert_eq!(ResetCause::from_u8(0), None);
 }
+
+/// The time scales survive a reset too (they came with the bus's TIME_SCALES frame, and
+/// the bus may send them rarely): without them the C2T after a reset would take
+/// UT1 - UTC = 0. A TIME_SCALES frame that changes them is a change of the kept inputs.
+#[test]
+fn the_time_scales_in_force_survive_a_reset() {
+    let (mut c, _) = flown();
+    let generation = c.inputs_generation();
+    let mut p = [0u8; 8];
+    let n = controller::bus::encode_time_scales(19, -0.3125, &mut p).unwrap();
+    feed(&mut c, &frame(kind::TIME_SCALES, 4, 1_030_000, &p[..n]));
+    assert_eq!(c.counters.total(), 0);
+    assert_ne!(c.inputs_generation(), generation);
+    let sent = *c.time_scales();
+    assert_eq!((sent.gps_utc_s, sent.dut1_s), (19.0, -0.3125));
+    // The same values again change nothing that is kept.
+    let generation = c.inputs_generation();
+    feed(&mut c, &frame(kind::TIME_SCALES, 5, 1_040_000, &p[..n]));
+    assert_eq!(c.inputs_generation(), generation);
+
+    let mut after_reset = Controller::blank(Config::default());
+    assert_ne!(*after_reset.time_scales(), sent);
+    after_reset
+        .restore(&snapshot_of(&c), &mut Registers::default())
+        .unwrap();
+    assert_eq!(*after_reset.time_scales(), sent);
+
+    // A kept TIME_SCALES payload that does not check out is refused like the frame.
+    let mut bad = snapshot_of(&c);
+    bad.time_scales.len = 7;
+    let mut fresh = Controller::blank(Config::default());
+    assert_eq!(
+        fresh.restore(&bad, &mut Registers::default()),
+        Err(Fault::BadLength)
+    );
+}

@@ -44,7 +44,7 @@ struct Record {
 }
 
 const MAGIC: u32 = 0x5444_4952; // "TDIR"
-const VERSION: u32 = 2;
+const VERSION: u32 = 3;
 
 impl Record {
     // Out of line: the boot, the HardFault handler and the cause's note all seal or
@@ -149,10 +149,18 @@ pub fn keep(c: &Controller, kept: &mut Kept) {
     if kept.inputs_generation != Some(c.inputs_generation()) {
         kept.inputs_generation = Some(c.inputs_generation());
         region.inputs_crc = if c.snapshot_inputs(&mut region.snapshot) {
-            payload_crc(&[&region.snapshot.scene, &region.snapshot.terrain])
+            payload_crc(&[
+                &region.snapshot.scene,
+                &region.snapshot.terrain,
+                &region.snapshot.time_scales,
+            ])
         } else {
             // Never for a scene the controller took; a CRC that cannot match says "none".
-            !payload_crc(&[&region.snapshot.scene, &region.snapshot.terrain])
+            !payload_crc(&[
+                &region.snapshot.scene,
+                &region.snapshot.terrain,
+                &region.snapshot.time_scales,
+            ])
         };
     }
     if kept.updates != Some(c.updates) {
@@ -172,7 +180,12 @@ pub fn snapshot(boot: &Boot) -> Option<&'static Snapshot> {
     let region = unsafe { region() };
     let ok = boot.cause != ResetCause::PowerOn
         && region.record.checks_out()
-        && region.inputs_crc == payload_crc(&[&region.snapshot.scene, &region.snapshot.terrain])
+        && region.inputs_crc
+            == payload_crc(&[
+                &region.snapshot.scene,
+                &region.snapshot.terrain,
+                &region.snapshot.time_scales,
+            ])
         && region.periods_crc == payload_crc(&[&region.snapshot.periods]);
     ok.then_some(&region.snapshot)
 }
@@ -215,7 +228,11 @@ pub fn boot(hardware: Option<ResetCause>) -> Boot {
         // SAFETY: called by `main` before the loop runs: no other user (`region`).
         let region = unsafe { region() };
         region.snapshot = Snapshot::EMPTY;
-        region.inputs_crc = !payload_crc(&[&region.snapshot.scene, &region.snapshot.terrain]);
+        region.inputs_crc = !payload_crc(&[
+            &region.snapshot.scene,
+            &region.snapshot.terrain,
+            &region.snapshot.time_scales,
+        ]);
         region.periods_crc = !payload_crc(&[&region.snapshot.periods]);
     }
     Boot { cause, resets }
