@@ -195,6 +195,33 @@ impl Controller {
         }
     }
 
+    /// The MTF at `stages` under the mismatch `worst` and the drift tangent `tan_max`,
+    /// and the stage limit, in f32.
+    #[cfg(not(feature = "earth-fixed"))]
+    #[inline(always)]
+    fn mtf_and_stages(&self, stages: u32, worst: f32, tan_max: f32) -> Result<(f32, u32), Fault> {
+        mtf_and_stages_f32(&self.plan, stages, worst, tan_max)
+    }
+
+    /// The same by the configured backend: with fixed-point pixels, every sinc in Q30
+    /// integers (`core_math::mtf::int`; soft float on the M3 made them a third of an
+    /// update: docs/controller.md, "What it costs").
+    #[cfg(feature = "earth-fixed")]
+    #[inline(always)]
+    fn mtf_and_stages(&self, stages: u32, worst: f32, tan_max: f32) -> Result<(f32, u32), Fault> {
+        if self.config.fixed_point_pixels {
+            let mtf = core_math::mtf::int::smear_mtf_pair(stages, worst, tan_max);
+            let m = self
+                .plan
+                .stage_rule
+                .max_stages_with_drift_int(worst, tan_max, u32::from(self.plan.max_stages))
+                .map_err(Fault::from)?;
+            Ok((mtf, m))
+        } else {
+            mtf_and_stages_f32(&self.plan, stages, worst, tan_max)
+        }
+    }
+
     fn height(&self, index: u8) -> f32 {
         self.heights_m
             .get(usize::from(index))
@@ -264,18 +291,7 @@ impl Controller {
         let (worst_mismatch, mtf, max_stages) = if v_lo > 0.0 {
             let (below, above) = ((v_line / v_lo - 1.0).abs(), (1.0 - v_line / v_hi).abs());
             let worst = if below > above { below } else { above };
-            let half_pi_m = core::f32::consts::FRAC_PI_2 * stages as f32;
-            // Each factor is |sinc|, the modulus of the smear's transfer function: past
-            // the first zero the contrast is reversed and weaker, not gone
-            // (docs/controller.md, "Per update"). In [0, 1]: the polynomial's
-            // (sinc(x) - 1) / x^2 part is negative on its whole range, and past pi
-            // |sinc| < 1/pi.
-            let mtf = smear_mtf(half_pi_m * worst) * smear_mtf(half_pi_m * tan_max);
-            let m = self
-                .plan
-                .stage_rule
-                .max_stages_with_drift(worst, tan_max, u32::from(self.plan.max_stages))
-                .map_err(Fault::from)?;
+            let (mtf, m) = self.mtf_and_stages(stages, worst, tan_max)?;
             (worst, mtf, m as u16)
         } else {
             // The image is slower than the interpolation bound: no bound on the
@@ -304,6 +320,27 @@ impl Controller {
             held: false,
         })
     }
+}
+
+/// The MTF and the stage limit in f32 (the M4F boards').
+#[inline(always)]
+fn mtf_and_stages_f32(
+    plan: &crate::plan::Plan,
+    stages: u32,
+    worst: f32,
+    tan_max: f32,
+) -> Result<(f32, u32), Fault> {
+    let half_pi_m = core::f32::consts::FRAC_PI_2 * stages as f32;
+    // Each factor is |sinc|, the modulus of the smear's transfer function: past the
+    // first zero the contrast is reversed and weaker, not gone (docs/controller.md, "Per
+    // update"). In [0, 1]: the polynomial's (sinc(x) - 1) / x^2 part is negative on its
+    // whole range, and past pi |sinc| < 1/pi.
+    let mtf = smear_mtf(half_pi_m * worst) * smear_mtf(half_pi_m * tan_max);
+    let m = plan
+        .stage_rule
+        .max_stages_with_drift(worst, tan_max, u32::from(plan.max_stages))
+        .map_err(Fault::from)?;
+    Ok((mtf, m))
 }
 
 /// The time from `t0_us` to `t_us` (s). Both are < 2^53 us and, where it is used,
