@@ -138,7 +138,7 @@ impl Controller {
             let height_m = self.height(index);
             // NaN never equals: the first segment makes the first ground.
             if height_m != ground_h_m {
-                ground = self.make_ground(&instant, height_m);
+                ground = self.make_ground(&instant, height_m, steer);
                 ground_h_m = height_m;
             }
             let result = match (&ground, &dem_frame) {
@@ -222,6 +222,44 @@ impl Controller {
         }
     }
 
+    /// v2/v1 at the segment's centre seen by the camera turned by the yaw request.
+    #[cfg(not(feature = "earth-fixed"))]
+    #[inline(always)]
+    fn steered_tangent(
+        &self,
+        update: &Ground,
+        seg: &SegmentPlan,
+        sin: f32,
+        cos: f32,
+    ) -> Result<f32, Fault> {
+        let m = steered_centre(update, seg, sin, cos)?;
+        Ok(m.v2_mps / m.v1_mps)
+    }
+
+    /// The same by the configured backend: with fixed-point pixels, the centre's
+    /// `EARTH_FIXED.motion` on the ground's turned update (integers only), the f32 form
+    /// where the turn left the envelope.
+    #[cfg(feature = "earth-fixed")]
+    #[inline(always)]
+    fn steered_tangent(
+        &self,
+        update: &Ground,
+        seg: &SegmentPlan,
+        sin: f32,
+        cos: f32,
+    ) -> Result<f32, Fault> {
+        match (&update.yawed, seg.fixed.first()) {
+            (Some(up), Some(px)) => {
+                let m = core_math::EARTH_FIXED.motion(up, px)?;
+                Ok(m.v2_mps.to_bits() as f32 / m.v1_mps.to_bits() as f32)
+            }
+            _ => {
+                let m = steered_centre(&update.float, seg, sin, cos)?;
+                Ok(m.v2_mps / m.v1_mps)
+            }
+        }
+    }
+
     fn height(&self, index: u8) -> f32 {
         self.heights_m
             .get(usize::from(index))
@@ -299,10 +337,7 @@ impl Controller {
             (f32::MAX, 0.0, 0)
         };
         let tan_residual = match steer {
-            Some((sin, cos, _)) => {
-                let m = steered_centre(float(update), seg, sin, cos)?;
-                m.v2_mps / m.v1_mps
-            }
+            Some((sin, cos, _)) => self.steered_tangent(update, seg, sin, cos)?,
             None => tan_centre,
         };
         let [drift_rad, worst_drift_rad, residual_drift_rad] =
@@ -377,12 +412,20 @@ struct Ground {
     float: GeneralUpdate<f32>,
     /// None unless `Config::fixed_point_pixels`.
     fixed: Option<core_math::earth::fixed::EarthFixedUpdate>,
+    /// `fixed` turned by the yaw request, for the steered centres; None without a
+    /// request, or where the turn leaves the fixed formats' envelope.
+    yawed: Option<core_math::earth::fixed::EarthFixedUpdate>,
 }
 
 impl Controller {
     #[cfg(not(feature = "earth-fixed"))]
     #[inline(always)]
-    fn make_ground(&self, instant: &GeneralInstant<f32>, height_m: f32) -> Result<Ground, Fault> {
+    fn make_ground(
+        &self,
+        instant: &GeneralInstant<f32>,
+        height_m: f32,
+        _steer: Option<(f32, f32, f32)>,
+    ) -> Result<Ground, Fault> {
         GENERAL_F32
             .ground(instant, &EARTH, height_m)
             .map_err(Fault::from)
@@ -391,14 +434,29 @@ impl Controller {
     /// The f32 update of the ground and, for fixed-point pixels, the same widened to
     /// f64 and rounded once to the fixed-point formats: per ground height, not per pixel.
     #[cfg(feature = "earth-fixed")]
-    fn make_ground(&self, instant: &GeneralInstant<f32>, height_m: f32) -> Result<Ground, Fault> {
+    fn make_ground(
+        &self,
+        instant: &GeneralInstant<f32>,
+        height_m: f32,
+        steer: Option<(f32, f32, f32)>,
+    ) -> Result<Ground, Fault> {
         let float = GENERAL_F32.ground(instant, &EARTH, height_m)?;
         let fixed = if self.config.fixed_point_pixels {
             Some(fixed_update(&float, instant.r2_m2)?)
         } else {
             None
         };
-        Ok(Ground { float, fixed })
+        // |sin|, |cos| <= 1 to f32's rounding: their Q30 stays inside i32.
+        let q30 = |x: f32| (x * (1u32 << 30) as f32) as i32;
+        let yawed = match (&fixed, steer) {
+            (Some(f), Some((sin, cos, _))) => f.yawed(q30(sin), q30(cos)).ok(),
+            _ => None,
+        };
+        Ok(Ground {
+            float,
+            fixed,
+            yawed,
+        })
     }
 }
 

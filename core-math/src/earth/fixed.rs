@@ -236,6 +236,46 @@ impl EarthFixed {
     }
 }
 
+impl EarthFixedUpdate {
+    /// The update of the same instant with the camera turned by a further yaw delta
+    /// about its boresight, given by its sine and cosine in Q30: every B-frame vector
+    /// turned by Rz(delta)^T, as [`crate::earth::GeneralUpdate::yawed`] does, in 32 x 32
+    /// -> 64 products rounded once (half a unit of each format, with the sine's and
+    /// cosine's own rounding of 2^-31 relative). A component the turn takes past the
+    /// envelope (up to sqrt 2 of the largest before it) is
+    /// [`ModelError::OutOfDomain`]. Integers only: the per-segment steered centre of a
+    /// core without an FPU is then one [`Backend::motion`].
+    pub fn yawed(&self, sin_q30: i32, cos_q30: i32) -> Result<EarthFixedUpdate, ModelError> {
+        let turn = |x: [i32; 3], max: i64, p: Param| -> Result<[i32; 3], ModelError> {
+            let (c, s) = (i64::from(cos_q30), i64::from(sin_q30));
+            let (x0, x1) = (i64::from(x[0]), i64::from(x[1]));
+            let mut out = [0i32; 3];
+            for (o, v) in out.iter_mut().zip([c * x0 + s * x1, c * x1 - s * x0]) {
+                let r = (v + (1 << 29)) >> 30;
+                if r.abs() > max {
+                    return Err(ModelError::OutOfDomain(p));
+                }
+                *o = r as i32;
+            }
+            out[2] = x[2];
+            Ok(out)
+        };
+        // The envelope's bounds in each vector's format, as `round_update` refuses them.
+        const N: i64 = (envelope::MAX_UNIT * (1u64 << 30) as f64) as i64;
+        const RHO: i64 =
+            ((envelope::MAX_UNIT + envelope::MAX_STRETCH2_MINUS_1) * (1u64 << 30) as f64) as i64;
+        const W: i64 = (envelope::MAX_W_RAD_S * (1u64 << 33) as f64) as i64;
+        const V: i64 = (envelope::MAX_V_OVER_R_RAD_S * (1u64 << 39) as f64) as i64;
+        Ok(EarthFixedUpdate {
+            n: turn(self.n, N, Param::Position)?,
+            rho: turn(self.rho, RHO, Param::Position)?,
+            w: turn(self.w, W, Param::AngularVelocity)?,
+            v: turn(self.v, V, Param::Velocity)?,
+            ..*self
+        })
+    }
+}
+
 impl Backend<Earth> for EarthFixed {
     type Real = I24F40;
     type Pixel = EarthFixedPixel;
