@@ -435,21 +435,26 @@ pub mod int {
         /// zero at pi y = pi.
         #[inline(always)]
         pub fn y_q30(self, m: u32) -> Option<u32> {
+            match self.y_wide_q30(m) {
+                Some(y) if y <= ONE_Q30 => Some(y as u32),
+                _ => None,
+            }
+        }
+
+        /// y = M x / 2 in Q30, truncated, or `None` from 2^32 on.
+        #[inline(always)]
+        fn y_wide_q30(self, m: u32) -> Option<u64> {
             // < 2^47: exact.
             let prod = u64::from(m) * u64::from(self.mant);
-            let y = if self.exp2 >= 0 {
+            if self.exp2 >= 0 {
                 let s = self.exp2 as u32;
-                if prod > ONE_Q30.checked_shr(s).unwrap_or(0) {
+                if prod >= (1u64 << 62).checked_shr(s).unwrap_or(0) {
                     return None;
                 }
-                prod << s
+                Some(prod << s)
             } else {
-                prod.checked_shr(self.exp2.unsigned_abs()).unwrap_or(0)
-            };
-            if y > ONE_Q30 {
-                return None;
+                Some(prod.checked_shr(self.exp2.unsigned_abs()).unwrap_or(0))
             }
-            Some(y as u32)
         }
     }
 
@@ -488,14 +493,30 @@ pub mod int {
         x.y_q30(m).map(sinc_pi_q30)
     }
 
+    /// |sinc(pi/2 M x)| in Q30 for M x / 2 below 2^32: on the main lobe as
+    /// [`factor_q30`]; past it, with y = k + f (f in [0, 1)), |sin(pi y)| = sin(pi f),
+    /// so |sinc(pi y)| = f sinc(pi f) / y, one integer division.
+    #[inline(always)]
+    fn smear_q30(x: Smear, m: u32) -> Option<i32> {
+        let y = x.y_wide_q30(m)?;
+        if y <= ONE_Q30 {
+            return Some(sinc_pi_q30(y as u32));
+        }
+        let f = y & (ONE_Q30 - 1);
+        let s = sinc_pi_q30(f as u32).max(0) as u64;
+        // f s in Q60 (< 2^60) over y in Q30: Q30, below 1/pi.
+        Some((f * s).checked_div(y).unwrap_or(0) as i32)
+    }
+
     /// The smear MTF of `stages` TDI stages under a relative mismatch `e` and a drift
     /// tangent `t`, |sinc(pi/2 M e)| |sinc(pi/2 M t)|, what
     /// `smear_mtf(pi/2 M e) * smear_mtf(pi/2 M t)` gives in f32: within 1e-8 of the
-    /// exact product on the main lobe (then rounded to f32); beyond it, that f32 form.
+    /// exact product (then rounded to f32) while M x / 2 stays below 2^32; beyond, that
+    /// f32 form.
     pub fn smear_mtf_pair(stages: u32, e: f32, t: f32) -> f32 {
         match (
-            Smear::new(e).and_then(|x| factor_q30(x, stages)),
-            Smear::new(t).and_then(|x| factor_q30(x, stages)),
+            Smear::new(e).and_then(|x| smear_q30(x, stages)),
+            Smear::new(t).and_then(|x| smear_q30(x, stages)),
         ) {
             (Some(a), Some(b)) => {
                 let p = (i64::from(a) * i64::from(b)).max(0) >> 30;
