@@ -222,18 +222,72 @@ impl Controller {
         }
     }
 
-    /// v2/v1 at the segment's centre seen by the camera turned by the yaw request.
+    /// (v2, v1) at the segment's centre seen by the camera turned by the yaw request.
     #[cfg(not(feature = "earth-fixed"))]
     #[inline(always)]
-    fn steered_tangent(
+    fn steered_centre(
         &self,
         update: &Ground,
         seg: &SegmentPlan,
         sin: f32,
         cos: f32,
-    ) -> Result<f32, Fault> {
+    ) -> Result<(f32, f32), Fault> {
         let m = steered_centre(update, seg, sin, cos)?;
-        Ok(m.v2_mps / m.v1_mps)
+        Ok((m.v2_mps, m.v1_mps))
+    }
+
+    /// The drift angles at the centre, the worst, and the steered centre's (the
+    /// centre's without a request), from their tangents.
+    #[cfg(not(feature = "earth-fixed"))]
+    #[inline(always)]
+    fn drift_angles(
+        &self,
+        _centre: &ImageMotion<f32>,
+        tan_centre: f32,
+        _drift: (f32, f32),
+        tan_max: f32,
+        residual: Option<(f32, f32)>,
+    ) -> [f32; 3] {
+        let tan_residual = match residual {
+            Some((v2, v1)) => v2 / v1,
+            None => tan_centre,
+        };
+        drift_angles_rad(tan_centre, tan_max, tan_residual)
+    }
+
+    /// The same by the configured backend: with fixed-point pixels each angle from its
+    /// (v2, v1) pair in integers ([`atan_pair_rad`]), the worst never below the
+    /// centre's magnitude.
+    #[cfg(feature = "earth-fixed")]
+    #[inline(always)]
+    fn drift_angles(
+        &self,
+        centre: &ImageMotion<f32>,
+        tan_centre: f32,
+        drift: (f32, f32),
+        tan_max: f32,
+        residual: Option<(f32, f32)>,
+    ) -> [f32; 3] {
+        if self.config.fixed_point_pixels {
+            let centre_rad = atan_pair_rad(centre.v2_mps, centre.v1_mps);
+            let worst_rad = atan_pair_rad(drift.0, drift.1);
+            let worst_rad = if worst_rad < centre_rad.abs() {
+                centre_rad.abs()
+            } else {
+                worst_rad
+            };
+            let residual_rad = match residual {
+                Some((v2, v1)) => atan_pair_rad(v2, v1),
+                None => centre_rad,
+            };
+            [centre_rad, worst_rad, residual_rad]
+        } else {
+            let tan_residual = match residual {
+                Some((v2, v1)) => v2 / v1,
+                None => tan_centre,
+            };
+            drift_angles_rad(tan_centre, tan_max, tan_residual)
+        }
     }
 
     /// The same by the configured backend: with fixed-point pixels, the centre's
@@ -241,21 +295,22 @@ impl Controller {
     /// where the turn left the envelope.
     #[cfg(feature = "earth-fixed")]
     #[inline(always)]
-    fn steered_tangent(
+    fn steered_centre(
         &self,
         update: &Ground,
         seg: &SegmentPlan,
         sin: f32,
         cos: f32,
-    ) -> Result<f32, Fault> {
+    ) -> Result<(f32, f32), Fault> {
         match (&update.yawed, seg.fixed.first()) {
+            // The pair in I24F40 units: only its ratio is used.
             (Some(up), Some(px)) => {
                 let m = core_math::EARTH_FIXED.motion(up, px)?;
-                Ok(m.v2_mps.to_bits() as f32 / m.v1_mps.to_bits() as f32)
+                Ok((m.v2_mps.to_bits() as f32, m.v1_mps.to_bits() as f32))
             }
             _ => {
                 let m = steered_centre(&update.float, seg, sin, cos)?;
-                Ok(m.v2_mps / m.v1_mps)
+                Ok((m.v2_mps, m.v1_mps))
             }
         }
     }
@@ -336,12 +391,12 @@ impl Controller {
             // mismatch, no contrast promised.
             (f32::MAX, 0.0, 0)
         };
-        let tan_residual = match steer {
-            Some((sin, cos, _)) => self.steered_tangent(update, seg, sin, cos)?,
-            None => tan_centre,
+        let residual = match steer {
+            Some((sin, cos, _)) => Some(self.steered_centre(update, seg, sin, cos)?),
+            None => None,
         };
         let [drift_rad, worst_drift_rad, residual_drift_rad] =
-            drift_angles_rad(tan_centre, tan_max, tan_residual);
+            self.drift_angles(&centre, tan_centre, (drift_v2, drift_v1), tan_max, residual);
         Ok(SegmentOutput {
             index: seg.index,
             ticks,
@@ -527,5 +582,73 @@ mod tests {
             "{worst_err:e}"
         );
         std::eprintln!("drift angles: worst error {worst_err:.2e} rad");
+    }
+
+    /// The integer drift angle of a (v2, v1) pair (the Cortex-M3's) against atan2 in
+    /// f64 of the same f32 inputs: within 5e-9 rad plus half an f32 ulp of the result,
+    /// over ratios from 1e-9 to 1e9, either sign, and the edge cases.
+    #[cfg(feature = "earth-fixed")]
+    #[test]
+    fn integer_drift_angle_matches_atan() {
+        use super::sweep::{atan_pair_rad, q30_to_f32};
+        let mut rng = core_math::sample::SplitMix64(0x5EED_2026_1127);
+        let mut worst_err = 0f64;
+        let mut check = |num: f32, den: f32| {
+            let got = f64::from(atan_pair_rad(num, den));
+            let want = libm::atan(f64::from(num) / f64::from(den));
+            let err = libm::fabs(got - want);
+            assert!(
+                err <= 5e-9 + 0.5 * f64::from(f32::EPSILON) * libm::fabs(want),
+                "atan({num:e} / {den:e}) = {got} vs {want}"
+            );
+            worst_err = worst_err.max(err);
+        };
+        for _ in 0..400_000 {
+            let den = (libm::exp(rng.uniform(-20.0, 20.0)) * rng.uniform(-1.0, 1.0)) as f32;
+            let ratio = libm::exp(rng.uniform(-21.0, 21.0)) * rng.uniform(-1.0, 1.0);
+            let num = (f64::from(den) * ratio) as f32;
+            if den != 0.0 && den.is_normal() {
+                check(num, den);
+            }
+        }
+        for (num, den) in [
+            (0.0, 1.0),
+            (-0.0, 1.0),
+            (1.0, 1.0),
+            (-1.0, 1.0),
+            (1.0, -1.0),
+            (7_000.0, 1e-30),
+            (1e-30, 7_000.0),
+            (f32::MAX, 1.0),
+            (1.0, f32::MAX),
+            (f32::MIN_POSITIVE, 3.0),
+        ] {
+            check(num, den);
+        }
+        // Non-finite inputs and a zero denominator take atan_f32 of the quotient.
+        assert_eq!(
+            atan_pair_rad(1.0, 0.0),
+            drift_angles_rad(f32::INFINITY, 0.0, 0.0)[0]
+        );
+        assert!(atan_pair_rad(f32::NAN, 1.0).is_nan());
+        std::eprintln!("integer drift angle: worst error {worst_err:.2e} rad");
+        // Q30 to f32 against the conversion and scaling in f32 (round to nearest even:
+        // they may differ at exact ties only, by one ulp).
+        let mut x = 0x9E37_79B9u32;
+        for i in 0..1_000_000u32 {
+            x ^= x << 13;
+            x ^= x >> 17;
+            x ^= x << 5;
+            let q = x >> (i % 32);
+            let want = q as f32 * (1.0 / (1u32 << 30) as f32);
+            let got = q30_to_f32(q);
+            let exact = f64::from(q) / (1u64 << 30) as f64;
+            assert!(
+                libm::fabs(f64::from(got) - exact)
+                    <= 0.5 * f64::from(want) * f64::from(f32::EPSILON),
+                "{q}: {got} vs {want}"
+            );
+        }
+        assert_eq!(q30_to_f32(0), 0.0);
     }
 }
