@@ -383,6 +383,8 @@ pub mod int {
 
     /// 1 in Q30.
     const ONE_Q30: u64 = 1 << 30;
+    /// pi^2 / 6 in Q30, rounded up.
+    const PI2_OVER_6_Q30: u64 = 1_766_234_506;
 
     /// sin(pi y)/(pi y) as a polynomial in y^2, (-1)^k pi^(2k) / (2k+1)!, k = 0..=9, in
     /// Q30 (every one below 2: Horner's rule on y^2 <= 1 never grows a partial sum past
@@ -473,18 +475,18 @@ pub mod int {
     }
 
     /// A value in [0, 1] as Q30, truncated (at most one unit, 9.3e-10, below it).
-    fn unit_q30(x: f32) -> u64 {
+    fn unit_q30(x: f32) -> u32 {
         let bits = x.to_bits();
         let e = (bits >> 23) as i32;
         if bits >> 31 != 0 || e < 127 - 40 {
             return 0;
         }
         if e >= 127 {
-            return ONE_Q30;
+            return 1 << 30;
         }
-        let mant = u64::from((bits & 0x7f_ffff) | 0x80_0000);
+        let mant = (bits & 0x7f_ffff) | 0x80_0000;
         // x = mant 2^(e - 150); Q30: mant 2^(e - 120), a right shift of 120 - e.
-        (mant << 7) >> (127 - e)
+        ((u64::from(mant) << 7) >> (127 - e)) as u32
     }
 
     /// sinc(pi/2 M x) in Q30 on the main lobe, `None` past it.
@@ -550,6 +552,26 @@ pub mod int {
             if larger == 0.0 {
                 return Ok(limit);
             }
+            // Both finite (`magnitudes`).
+            let (Some(xe), Some(xt)) = (Smear::new(e), Smear::new(t)) else {
+                return Ok(0);
+            };
+            let floor_q30 = unit_q30(self.mtf_floor);
+            // The limit itself, where the product's lower bound (1 - x^2/6)(1 - y^2/6)
+            // >= 1 - (x^2 + y^2)/6 (sinc(x) >= 1 - x^2/6 for every x) clears the floor by
+            // 2^-25, more than the truncations of y and the floor and the polynomial's
+            // error together (about 13 units of Q30): then `meets(limit)` holds and
+            // every smaller count meets too, what the search below would return, without
+            // its guess in soft float. The usual case of a nominal update.
+            if let (Some(ye), Some(yt)) = (xe.y_q30(limit), xt.y_q30(limit)) {
+                // x = pi y: (x^2 + y^2)/6 = pi^2/6 (y_e^2 + y_t^2); Q30 products.
+                let s = ((u64::from(ye) * u64::from(ye)) >> 30)
+                    + ((u64::from(yt) * u64::from(yt)) >> 30);
+                let loss = (s * PI2_OVER_6_Q30) >> 30;
+                if loss + (1 << 5) + u64::from(floor_q30) <= ONE_Q30 {
+                    return Ok(limit);
+                }
+            }
             let r = smaller / larger;
             let guess = self.mismatch_budget / (larger * Real::sqrt(1.0 + self.pair_kappa * r * r));
             let mut m = if guess >= limit as f32 {
@@ -557,11 +579,7 @@ pub mod int {
             } else {
                 guess as u32
             };
-            // Both finite (`magnitudes`).
-            let (Some(xe), Some(xt)) = (Smear::new(e), Smear::new(t)) else {
-                return Ok(0);
-            };
-            let floor = (unit_q30(self.mtf_floor) << 30) as i64;
+            let floor = (u64::from(floor_q30) << 30) as i64;
             let meets = |m: u32| match (factor_q30(xe, m), factor_q30(xt, m)) {
                 (Some(a), Some(b)) => i64::from(a) * i64::from(b) >= floor,
                 // Past either factor's first zero the product is under every floor.

@@ -171,7 +171,7 @@ pub fn drift_angle_rad(t: f32) -> f32 {
 }
 
 /// atan(`num` / `den`) (rad) in integers, for a core without an FPU: the two f32
-/// mantissas divided in Q39, the odd polynomial of degree 19 on [0, 1] in Q30 (fitted
+/// mantissas divided in Q40, the odd polynomial of degree 19 on [0, 1] in Q30 (fitted
 /// to atan by weighted least squares, within 4.2e-9 evaluated this way), the octant
 /// past 1 by pi/2 - atan(den/num); then rounded once to f32 (docs/fixed-point.md, "The
 /// update on the Cortex-M3"). Non-finite inputs and a zero `den`: `atan_f32` of the
@@ -193,13 +193,19 @@ pub(super) fn atan_pair_rad(num: f32, den: f32) -> f32 {
         mantissa(small)
     };
     let shift = (big >> 23) - (small >> 23).max(1);
-    // small / big in Q39 (< 2^63 before the division), then Q30 rounded.
-    let q39 = (m_small << 39)
-        .checked_shr(shift)
-        .unwrap_or(0)
-        .checked_div(mantissa(big))
-        .unwrap_or(0);
-    let r = ((q39 + (1 << 8)) >> 9).min(1 << 30) as i64;
+    // m_small / m_big (< 2) in Q40 by five steps of long division, 8 bits each, in the
+    // core's 32-bit divide (the remainder stays below 2^24: no 64-bit division call);
+    // then over 2^shift, in Q30 rounded.
+    let m_big = mantissa(big) as u32;
+    let (mut q, mut rem) = (0u64, m_small as u32);
+    for _ in 0..5 {
+        let n = rem << 8;
+        let d = n.checked_div(m_big).unwrap_or(0);
+        q = (q << 8) + u64::from(d);
+        rem = n - d * m_big;
+    }
+    let r = (q.checked_shr(shift).unwrap_or(0) + (1 << 9)) >> 10;
+    let r = r.min(1 << 30) as i64;
     let at = atan_unit_q30(r);
     let q = if past_one { HALF_PI_Q30 - at } else { at };
     let rad = q30_to_f32(q.max(0) as u32);
