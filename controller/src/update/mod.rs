@@ -104,26 +104,13 @@ impl Controller {
         };
         // The yaw steering request: at the boresight a turn about it turns (v1, v2) by
         // the turn and changes nothing else, so atan(v2/v1) there zeroes its drift.
-        let boresight_h = self.height(self.plan.boresight_segment);
-        let steer = GENERAL_F32
-            .ground(&instant, &EARTH, boresight_h)
-            .and_then(|u| GENERAL_F32.motion(&u, &self.plan.boresight))
-            .ok()
-            .and_then(|m| {
-                let speed = Real::sqrt(m.v1_mps * m.v1_mps + m.v2_mps * m.v2_mps);
-                let sign = if m.v1_mps < 0.0 { -1.0 } else { 1.0 };
-                let (sin, cos) = (sign * m.v2_mps / speed, sign * m.v1_mps / speed);
-                (sin.is_finite() && cos.is_finite())
-                    .then(|| (sin, cos, drift_angle_rad(m.v2_mps / m.v1_mps)))
-            });
-        self.yaw_request_rad = steer.map(|(_, _, rad)| rad);
-        // Output slots by `get` (`index` < MAX_SEGMENTS by construction of the plan): no
-        // panic path (docs/no-panic.md).
         // Segments over the same ground height share its update: made once per height
         // in a row (a flat scene makes one, terrain one per segment). It stays in one
         // place in memory, which the out-of-line `segment` and `extremes` read.
-        let mut ground_h_m = f32::NAN;
-        let mut ground: Result<Ground, Fault> = Err(Fault::OutOfRange);
+        let (steer, mut ground_h_m, mut ground) = self.steer_and_ground(&instant);
+        self.yaw_request_rad = steer.map(|(_, _, rad)| rad);
+        // Output slots by `get` (`index` < MAX_SEGMENTS by construction of the plan): no
+        // panic path (docs/no-panic.md).
         // The DEM's route needs a tile in force and the ITRF of the instant.
         let dem_frame = if self.dem_ground.is_some() {
             itrf
@@ -315,6 +302,64 @@ impl Controller {
         }
     }
 
+    /// The yaw request's (sin, cos, angle) from the boresight's motion, and the first
+    /// ground of the update with its height (none yet: NaN never equals a height).
+    #[cfg(not(feature = "earth-fixed"))]
+    #[inline(always)]
+    fn steer_and_ground(
+        &self,
+        instant: &GeneralInstant<f32>,
+    ) -> (Steer, f32, Result<Ground, Fault>) {
+        (self.steer_f32(instant), f32::NAN, Err(Fault::OutOfRange))
+    }
+
+    /// The same by the configured backend. With fixed-point pixels the boresight
+    /// segment's ground comes first (the loop then reuses it for every segment at its
+    /// height), and the request from its fixed-point update: the boresight's v/f in
+    /// integers (`EarthFixedUpdate::boresight_over_focal`) instead of a second f32
+    /// ground and motion in soft float.
+    #[cfg(feature = "earth-fixed")]
+    #[inline(always)]
+    fn steer_and_ground(
+        &self,
+        instant: &GeneralInstant<f32>,
+    ) -> (Steer, f32, Result<Ground, Fault>) {
+        if !self.config.fixed_point_pixels {
+            return (self.steer_f32(instant), f32::NAN, Err(Fault::OutOfRange));
+        }
+        let boresight_h = self.height(self.plan.boresight_segment);
+        let mut ground = self.make_ground(instant, boresight_h, None);
+        let steer = match &ground {
+            Ok(Ground { fixed: Some(f), .. }) => {
+                f.boresight_over_focal().ok().and_then(|(vf1, vf2)| {
+                    // Q63 rad/s, below 2^63: their squares stay inside f32's range.
+                    let (v1, v2) = (vf1 as f32, vf2 as f32);
+                    steer_from(v1, v2, atan_pair_rad(v2, v1))
+                })
+            }
+            _ => None,
+        };
+        if let (Ok(g), Some((sin, cos, _))) = (&mut ground, steer) {
+            g.yawed = g
+                .fixed
+                .as_ref()
+                .and_then(|f| f.yawed(q30(sin), q30(cos)).ok());
+        }
+        (steer, boresight_h, ground)
+    }
+
+    /// The yaw request from the boresight's motion in f32 at the boresight segment's
+    /// height.
+    #[inline(always)]
+    fn steer_f32(&self, instant: &GeneralInstant<f32>) -> Option<(f32, f32, f32)> {
+        let boresight_h = self.height(self.plan.boresight_segment);
+        GENERAL_F32
+            .ground(instant, &EARTH, boresight_h)
+            .and_then(|u| GENERAL_F32.motion(&u, &self.plan.boresight))
+            .ok()
+            .and_then(|m| steer_from(m.v1_mps, m.v2_mps, drift_angle_rad(m.v2_mps / m.v1_mps)))
+    }
+
     fn height(&self, index: u8) -> f32 {
         self.heights_m
             .get(usize::from(index))
@@ -433,6 +478,26 @@ fn mtf_and_stages_f32(
     Ok((mtf, m))
 }
 
+/// The yaw request as the turn's (sin, cos) and its angle (rad).
+type Steer = Option<(f32, f32, f32)>;
+
+/// The yaw turn (sin, cos) that zeroes the boresight's drift, from its (v1, v2) (any
+/// common scale), and the request `rad`; None when they are not finite.
+#[inline(always)]
+fn steer_from(v1: f32, v2: f32, rad: f32) -> Option<(f32, f32, f32)> {
+    let speed = Real::sqrt(v1 * v1 + v2 * v2);
+    let sign = if v1 < 0.0 { -1.0 } else { 1.0 };
+    let (sin, cos) = (sign * v2 / speed, sign * v1 / speed);
+    (sin.is_finite() && cos.is_finite()).then_some((sin, cos, rad))
+}
+
+/// A sine or cosine in Q30 (|x| <= 1 to f32's rounding: inside i32).
+#[cfg(feature = "earth-fixed")]
+#[inline(always)]
+fn q30(x: f32) -> i32 {
+    (x * (1u32 << 30) as f32) as i32
+}
+
 /// The time from `t0_us` to `t_us` (s). Both are < 2^53 us and, where it is used,
 /// t - t0 lies within an update period before and a staleness limit after: the
 /// difference is exact in i64 and small in f32. Converted from i32 when it fits (one
@@ -501,8 +566,6 @@ impl Controller {
         } else {
             None
         };
-        // |sin|, |cos| <= 1 to f32's rounding: their Q30 stays inside i32.
-        let q30 = |x: f32| (x * (1u32 << 30) as f32) as i32;
         let yawed = match (&fixed, steer) {
             (Some(f), Some((sin, cos, _))) => f.yawed(q30(sin), q30(cos)).ok(),
             _ => None,

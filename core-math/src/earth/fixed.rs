@@ -276,6 +276,40 @@ impl EarthFixedUpdate {
     }
 }
 
+impl EarthFixedUpdate {
+    /// The image motion at the boresight (p1 = p2 = 0) over the focal length, (v1/f,
+    /// v2/f) in Q63 (rad/s): [`Backend::motion`]'s integers at t1 = t2 = 0, where no
+    /// pixel constant is left (the yaw request needs only its direction). The same
+    /// refusals.
+    pub fn boresight_over_focal(&self) -> Result<(i64, i64), ModelError> {
+        // beta = -rho3 (Q30 -> Q31), n.u' = -n3.
+        let beta = -i64::from(self.rho[2]);
+        if beta >= 0 {
+            return Err(ModelError::LineOfSightMissesEarth);
+        }
+        let b31 = (beta.unsigned_abs() << 1) as u32;
+        let n3 = i64::from(self.n[2]);
+        let nn30 = ((n3 * n3) as u64 >> 30) as u32;
+        let alpha = (1u32 << 30) + ((self.k2m1 as u64 * nn30 as u64) >> 36) as u32;
+        let bb = b31 as u64 * b31 as u64;
+        let ac = alpha as u64 * self.c as u64;
+        if ac > bb {
+            return Err(ModelError::LineOfSightMissesEarth);
+        }
+        let root = sqrt_u64(bb - ac);
+        let num = ((root + b31 as u64) >> 1) as u32;
+        let inv_s = ((num as u64 * self.inv_c as u64) >> 32) as u32;
+        let e = |vk: i32| ((vk as i64 * inv_s as i64 + (1 << 30)) >> 31) as i32;
+        let [w1, w2, _] = self.w;
+        let vf1 = (i64::from(w2) << 30) - (i64::from(e(self.v[0])) << 30);
+        let vf2 = -(i64::from(w1) << 30) - (i64::from(e(self.v[1])) << 30);
+        if vf1 == 0 {
+            return Err(ModelError::NoAlongTrackMotion);
+        }
+        Ok((vf1, vf2))
+    }
+}
+
 impl Backend<Earth> for EarthFixed {
     type Real = I24F40;
     type Pixel = EarthFixedPixel;
