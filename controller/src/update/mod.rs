@@ -229,17 +229,12 @@ impl Controller {
     #[inline(always)]
     fn drift_angles(
         &self,
-        _centre: &ImageMotion<f32>,
-        tan_centre: f32,
+        centre: &ImageMotion<f32>,
         _drift: (f32, f32),
         tan_max: f32,
         residual: Option<(f32, f32)>,
     ) -> [f32; 3] {
-        let tan_residual = match residual {
-            Some((v2, v1)) => v2 / v1,
-            None => tan_centre,
-        };
-        drift_angles_rad(tan_centre, tan_max, tan_residual)
+        drift_angles_f32(centre, tan_max, residual)
     }
 
     /// The same by the configured backend: with fixed-point pixels each angle from its
@@ -250,7 +245,6 @@ impl Controller {
     fn drift_angles(
         &self,
         centre: &ImageMotion<f32>,
-        tan_centre: f32,
         drift: (f32, f32),
         tan_max: f32,
         residual: Option<(f32, f32)>,
@@ -269,11 +263,7 @@ impl Controller {
             };
             [centre_rad, worst_rad, residual_rad]
         } else {
-            let tan_residual = match residual {
-                Some((v2, v1)) => v2 / v1,
-                None => tan_centre,
-            };
-            drift_angles_rad(tan_centre, tan_max, tan_residual)
+            drift_angles_f32(centre, tan_max, residual)
         }
     }
 
@@ -396,7 +386,6 @@ impl Controller {
             None => self.extremes(update, seg)?,
         };
         let reversed = centre.v1_mps > 0.0;
-        let tan_centre = centre.v2_mps / centre.v1_mps;
         // v1's extremes are tracked signed, and its sign checked once after the loop;
         // the largest |v2/v1| as the pair (|v2|, |v1|) that gives it, compared by
         // cross-multiplying (|v1| > 0): one division at the end, not one a pixel. The loop
@@ -441,7 +430,7 @@ impl Controller {
             None => None,
         };
         let [drift_rad, worst_drift_rad, residual_drift_rad] =
-            self.drift_angles(&centre, tan_centre, (drift_v2, drift_v1), tan_max, residual);
+            self.drift_angles(&centre, (drift_v2, drift_v1), tan_max, residual);
         Ok(SegmentOutput {
             index: seg.index,
             ticks,
@@ -476,6 +465,22 @@ fn mtf_and_stages_f32(
         .max_stages_with_drift(worst, tan_max, u32::from(plan.max_stages))
         .map_err(Fault::from)?;
     Ok((mtf, m))
+}
+
+/// The drift angles in f32 from their tangents (the centre's, the worst, the steered
+/// centre's: the centre's without a request).
+#[inline(always)]
+fn drift_angles_f32(
+    centre: &ImageMotion<f32>,
+    tan_max: f32,
+    residual: Option<(f32, f32)>,
+) -> [f32; 3] {
+    let tan_centre = centre.v2_mps / centre.v1_mps;
+    let tan_residual = match residual {
+        Some((v2, v1)) => v2 / v1,
+        None => tan_centre,
+    };
+    drift_angles_rad(tan_centre, tan_max, tan_residual)
 }
 
 /// The yaw request as the turn's (sin, cos) and its angle (rad).

@@ -205,7 +205,7 @@ pub(super) fn atan_pair_rad(num: f32, den: f32) -> f32 {
         rem = n - d * m_big;
     }
     let r = (q.checked_shr(shift).unwrap_or(0) + (1 << 9)) >> 10;
-    let r = r.min(1 << 30) as i64;
+    let r = r.min(1 << 30) as i32;
     let at = atan_unit_q30(r);
     let q = if past_one { HALF_PI_Q30 - at } else { at };
     let rad = q30_to_f32(q.max(0) as u32);
@@ -225,12 +225,12 @@ fn atan_pair_cold(num: f32, den: f32) -> f32 {
 
 /// pi/2 in Q30, rounded.
 #[cfg(feature = "earth-fixed")]
-const HALF_PI_Q30: i64 = 1_686_629_713;
+const HALF_PI_Q30: i32 = 1_686_629_713;
 
 /// atan(x) / x as a polynomial in x^2 on [0, 1], Q30 (a weighted least-squares fit:
 /// `docs/fixed-point.md`, "The update on the Cortex-M3").
 #[cfg(feature = "earth-fixed")]
-const ATAN_Q30: [i64; 10] = [
+const ATAN_Q30: [i32; 10] = [
     1_073_741_803,
     -357_912_299,
     214_710_104,
@@ -243,16 +243,18 @@ const ATAN_Q30: [i64; 10] = [
     -1_620_580,
 ];
 
-/// atan(x) for x in Q30 on [0, 1], in Q30.
+/// atan(x) for x in Q30 on [0, 1], in Q30: every partial sum below 1.1 in Q30, so
+/// each step is one 32 x 32 -> 64 product.
 #[cfg(feature = "earth-fixed")]
 #[inline(always)]
-fn atan_unit_q30(x: i64) -> i64 {
-    let z = (x * x) >> 30;
+fn atan_unit_q30(x: i32) -> i32 {
+    let mul = |a: i32, b: i32| ((i64::from(a) * i64::from(b) + (1 << 29)) >> 30) as i32;
+    let z = ((i64::from(x) * i64::from(x)) >> 30) as i32;
     let mut acc = ATAN_Q30[9];
     for &c in ATAN_Q30[..9].iter().rev() {
-        acc = ((acc * z + (1 << 29)) >> 30) + c;
+        acc = mul(acc, z) + c;
     }
-    (x * acc + (1 << 29)) >> 30
+    mul(x, acc)
 }
 
 /// `q` 2^-30 as f32, rounded to nearest (ties away from zero), without the software
