@@ -583,23 +583,15 @@ impl Controller {
     }
 }
 
-/// `float` widened to f64 and rounded to the fixed-point backend's formats.
+/// `float` rounded to the fixed-point backend's formats, in integers
+/// (`EarthFixed::from_general_f32`: within a unit and 1.7e-9 relative of the same
+/// update widened to f64 and rounded there, which cost soft f64 on the M3).
 #[cfg(feature = "earth-fixed")]
 fn fixed_update(
     float: &GeneralUpdate<f32>,
     r2_m2: f32,
 ) -> Result<core_math::earth::fixed::EarthFixedUpdate, Fault> {
-    let w = |x: [f32; 3]| x.map(f64::from);
-    let wide = GeneralUpdate {
-        n_b: w(float.n_b),
-        rho_b_m: w(float.rho_b_m),
-        stretch2_minus_1: f64::from(float.stretch2_minus_1),
-        c_m2: f64::from(float.c_m2),
-        inv_c_per_m2: f64::from(float.inv_c_per_m2),
-        w_b_rad_s: w(float.w_b_rad_s),
-        v_b_mps: w(float.v_b_mps),
-    };
-    Ok(core_math::EARTH_FIXED.from_general(&wide, f64::from(r2_m2))?)
+    Ok(core_math::EARTH_FIXED.from_general_f32(float, r2_m2)?)
 }
 
 #[cfg(not(feature = "earth-fixed"))]
