@@ -184,8 +184,23 @@ fn against_the_reference(config: Config, rel_tol: f64) {
 /// the other way (a whole update at the turned yaw, not the turned update).
 #[test]
 fn steering_the_yaw_as_requested_leaves_the_reported_residual_drift() {
+    steering_leaves_the_residual(Config::default());
+}
+
+/// The same with fixed-point pixels (the Cortex-M3's controller): the residual from the
+/// fixed-point update turned by the request (`EarthFixedUpdate::yawed`).
+#[cfg(feature = "earth-fixed")]
+#[test]
+fn fixed_point_steering_leaves_the_reported_residual_drift() {
+    steering_leaves_the_residual(Config {
+        fixed_point_pixels: true,
+        ..Config::default()
+    });
+}
+
+fn steering_leaves_the_residual(config: Config) {
     let scene = agile_scene();
-    let mut c = Controller::new(Config::default(), scene).unwrap();
+    let mut c = Controller::new(config, scene).unwrap();
     let mut regs = Registers::default();
     let mut att = agile_attitude();
     att.yaw_rate_rad_s = 0.0;

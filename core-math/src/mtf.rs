@@ -372,3 +372,235 @@ impl<T: Real> StageRule<T> {
         self.mismatch_budget
     }
 }
+
+/// The smear MTF and the stage limit in fixed point, for cores without an FPU: on the
+/// main lobe every sinc in Q30 integers instead of soft float, within 5e-9 of
+/// sin(x)/x (docs/fixed-point.md, "The update on the Cortex-M3").
+pub mod int {
+    use super::{smear_mtf, StageRule, GUESS_STEPS, HALF_PI, MAX_STAGE_LIMIT};
+    use crate::error::ModelError;
+    use crate::real::Real;
+
+    /// 1 in Q30.
+    const ONE_Q30: u64 = 1 << 30;
+    /// pi^2 / 6 in Q30, rounded up.
+    const PI2_OVER_6_Q30: u64 = 1_766_234_506;
+
+    /// sin(pi y)/(pi y) as a polynomial in y^2, (-1)^k pi^(2k) / (2k+1)!, k = 0..=9, in
+    /// Q30 (every one below 2: Horner's rule on y^2 <= 1 never grows a partial sum past
+    /// 1.7). Truncated after them the series errs by at most pi^20/21! = 1.7e-10 on
+    /// |y| <= 1.
+    const SINC_PI_Q30: [i32; 10] = [
+        1_073_741_824,
+        -1_766_234_505,
+        871_601_792,
+        -204_818_212,
+        28_076_038,
+        -2_519_085,
+        159_374,
+        -7_490,
+        272,
+        -8,
+    ];
+
+    /// A finite x >= 0 as `mant` 2^`exp2`: M x / 2, the smear argument of M stages over
+    /// pi, is exact in integers from it (`mant` < 2^24, M <= 2^23).
+    #[derive(Clone, Copy, Debug)]
+    pub struct Smear {
+        mant: u32,
+        /// Q30 of M x / 2 is M `mant` 2^`exp2`.
+        exp2: i32,
+    }
+
+    impl Smear {
+        /// `None` for an infinite or NaN `x`; its sign is dropped.
+        pub fn new(x: f32) -> Option<Self> {
+            let bits = x.abs().to_bits();
+            let e = (bits >> 23) as i32;
+            if e == 255 {
+                return None;
+            }
+            // Subnormals as 0: M x / 2 then stays below 2^-100.
+            let mant = if e == 0 {
+                0
+            } else {
+                (bits & 0x7f_ffff) | 0x80_0000
+            };
+            // x = mant 2^(e - 150); M x / 2 in Q30 is M mant 2^(e - 121).
+            Some(Smear {
+                mant,
+                exp2: e - 121,
+            })
+        }
+
+        /// y = M x / 2 in Q30, truncated (2^-30 at most), or `None` past 1, sinc's first
+        /// zero at pi y = pi.
+        #[inline(always)]
+        pub fn y_q30(self, m: u32) -> Option<u32> {
+            match self.y_wide_q30(m) {
+                Some(y) if y <= ONE_Q30 => Some(y as u32),
+                _ => None,
+            }
+        }
+
+        /// y = M x / 2 in Q30, truncated, or `None` from 2^32 on.
+        #[inline(always)]
+        fn y_wide_q30(self, m: u32) -> Option<u64> {
+            // < 2^47: exact.
+            let prod = u64::from(m) * u64::from(self.mant);
+            if self.exp2 >= 0 {
+                let s = self.exp2 as u32;
+                if prod >= (1u64 << 62).checked_shr(s).unwrap_or(0) {
+                    return None;
+                }
+                Some(prod << s)
+            } else {
+                Some(prod.checked_shr(self.exp2.unsigned_abs()).unwrap_or(0))
+            }
+        }
+    }
+
+    /// sin(pi y)/(pi y) for y in Q30 on [0, 1], in Q30: [`SINC_PI_Q30`] by Horner's rule
+    /// in 32 x 32 -> 64 products, within 5e-9 of the exact value (truncation 1.7e-10,
+    /// ten roundings of 2^-31, the constants' 2^-31 each; measured:
+    /// `core-math/tests/mtf_period.rs`).
+    #[inline(always)]
+    pub fn sinc_pi_q30(y_q30: u32) -> i32 {
+        let y2 = ((u64::from(y_q30) * u64::from(y_q30)) >> 30) as i32;
+        let mut acc = SINC_PI_Q30[9];
+        for &c in SINC_PI_Q30[..9].iter().rev() {
+            acc = ((i64::from(acc) * i64::from(y2) + (1 << 29)) >> 30) as i32 + c;
+        }
+        acc
+    }
+
+    /// A value in [0, 1] as Q30, truncated (at most one unit, 9.3e-10, below it).
+    fn unit_q30(x: f32) -> u32 {
+        let bits = x.to_bits();
+        let e = (bits >> 23) as i32;
+        if bits >> 31 != 0 || e < 127 - 40 {
+            return 0;
+        }
+        if e >= 127 {
+            return 1 << 30;
+        }
+        let mant = (bits & 0x7f_ffff) | 0x80_0000;
+        // x = mant 2^(e - 150); Q30: mant 2^(e - 120), a right shift of 120 - e.
+        ((u64::from(mant) << 7) >> (127 - e)) as u32
+    }
+
+    /// sinc(pi/2 M x) in Q30 on the main lobe, `None` past it.
+    #[inline(always)]
+    fn factor_q30(x: Smear, m: u32) -> Option<i32> {
+        x.y_q30(m).map(sinc_pi_q30)
+    }
+
+    /// |sinc(pi/2 M x)| in Q30 for M x / 2 below 2^32: on the main lobe as
+    /// [`factor_q30`]; past it, with y = k + f (f in [0, 1)), |sin(pi y)| = sin(pi f),
+    /// so |sinc(pi y)| = f sinc(pi f) / y, one integer division.
+    #[inline(always)]
+    fn smear_q30(x: Smear, m: u32) -> Option<i32> {
+        let y = x.y_wide_q30(m)?;
+        if y <= ONE_Q30 {
+            return Some(sinc_pi_q30(y as u32));
+        }
+        let f = y & (ONE_Q30 - 1);
+        let s = sinc_pi_q30(f as u32).max(0) as u64;
+        // f s in Q60 (< 2^60) over y in Q30: Q30, below 1/pi.
+        Some((f * s).checked_div(y).unwrap_or(0) as i32)
+    }
+
+    /// The smear MTF of `stages` TDI stages under a relative mismatch `e` and a drift
+    /// tangent `t`, |sinc(pi/2 M e)| |sinc(pi/2 M t)|, what
+    /// `smear_mtf(pi/2 M e) * smear_mtf(pi/2 M t)` gives in f32: within 1e-8 of the
+    /// exact product (then rounded to f32) while M x / 2 stays below 2^32; beyond, that
+    /// f32 form.
+    pub fn smear_mtf_pair(stages: u32, e: f32, t: f32) -> f32 {
+        match (
+            Smear::new(e).and_then(|x| smear_q30(x, stages)),
+            Smear::new(t).and_then(|x| smear_q30(x, stages)),
+        ) {
+            (Some(a), Some(b)) => {
+                let p = (i64::from(a) * i64::from(b)).max(0) >> 30;
+                p as f32 * (1.0 / ONE_Q30 as f32)
+            }
+            _ => beyond_main_lobe(stages, e, t),
+        }
+    }
+
+    #[cold]
+    #[inline(never)]
+    fn beyond_main_lobe(stages: u32, e: f32, t: f32) -> f32 {
+        let h = HALF_PI as f32 * stages as f32;
+        smear_mtf(h * e) * smear_mtf(h * t)
+    }
+
+    impl StageRule<f32> {
+        /// [`StageRule::max_stages_with_drift`] with each count's product of sincs in
+        /// Q30 integers (the same guess in f32, the same steps, the same fallback): a
+        /// count may differ from the f32 form's only where the product lies within 1e-8
+        /// of the floor, where the f32 form's own rounding decides too.
+        pub fn max_stages_with_drift_int(
+            &self,
+            rel_mismatch: f32,
+            tan_drift: f32,
+            stage_limit: u32,
+        ) -> Result<u32, ModelError> {
+            let (e, t) = super::magnitudes(rel_mismatch, tan_drift)?;
+            let limit = stage_limit.min(MAX_STAGE_LIMIT);
+            let (larger, smaller) = if e > t { (e, t) } else { (t, e) };
+            if larger == 0.0 {
+                return Ok(limit);
+            }
+            // Both finite (`magnitudes`).
+            let (Some(xe), Some(xt)) = (Smear::new(e), Smear::new(t)) else {
+                return Ok(0);
+            };
+            let floor_q30 = unit_q30(self.mtf_floor);
+            // The limit itself, where the product's lower bound (1 - x^2/6)(1 - y^2/6)
+            // >= 1 - (x^2 + y^2)/6 (sinc(x) >= 1 - x^2/6 for every x) clears the floor by
+            // 2^-25, more than the truncations of y and the floor and the polynomial's
+            // error together (about 13 units of Q30): then `meets(limit)` holds and
+            // every smaller count meets too, what the search below would return, without
+            // its guess in soft float. The usual case of a nominal update.
+            if let (Some(ye), Some(yt)) = (xe.y_q30(limit), xt.y_q30(limit)) {
+                // x = pi y: (x^2 + y^2)/6 = pi^2/6 (y_e^2 + y_t^2); Q30 products.
+                let s = ((u64::from(ye) * u64::from(ye)) >> 30)
+                    + ((u64::from(yt) * u64::from(yt)) >> 30);
+                let loss = (s * PI2_OVER_6_Q30) >> 30;
+                if loss + (1 << 5) + u64::from(floor_q30) <= ONE_Q30 {
+                    return Ok(limit);
+                }
+            }
+            let r = smaller / larger;
+            let guess = self.mismatch_budget / (larger * Real::sqrt(1.0 + self.pair_kappa * r * r));
+            let mut m = if guess >= limit as f32 {
+                limit
+            } else {
+                guess as u32
+            };
+            let floor = (u64::from(floor_q30) << 30) as i64;
+            let meets = |m: u32| match (factor_q30(xe, m), factor_q30(xt, m)) {
+                (Some(a), Some(b)) => i64::from(a) * i64::from(b) >= floor,
+                // Past either factor's first zero the product is under every floor.
+                _ => false,
+            };
+            let mut ok = m == 0 || meets(m);
+            let mut steps = 0;
+            while !ok && steps < GUESS_STEPS {
+                m -= 1;
+                ok = m == 0 || meets(m);
+                steps += 1;
+            }
+            if ok {
+                for _ in 0..GUESS_STEPS {
+                    if m == limit || !meets(m + 1) {
+                        return Ok(m);
+                    }
+                    m += 1;
+                }
+            }
+            self.max_stages_with_drift_by_bisection(rel_mismatch, tan_drift, stage_limit)
+        }
+    }
+}

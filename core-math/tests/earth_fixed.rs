@@ -492,3 +492,77 @@ fn typed_refusals() {
         Err(ModelError::NonFinite(Param::Roll))
     );
 }
+
+/// The fixed-point update turned by a yaw (`EarthFixedUpdate::yawed`, the Cortex-M3
+/// controller's steered centre) against the f64 general form's turned update
+/// (`GeneralUpdate::yawed`, exact): the same motion within the backend's 2e-6 target,
+/// over altitudes, rolls, rates and turns of up to 1.2 rad either way.
+#[test]
+fn yawed_update_matches_the_turned_general_form() {
+    let mut rng = SplitMix64(0x7A3D_2026_1127);
+    let general = core_math::General::<f64>::new();
+    let (mut worst, mut checked) = (0f64, 0);
+    for _ in 0..400 {
+        let mut c = scene(rng.uniform(300e3, 1_200e3), rng.uniform(-30.0, 30.0));
+        c.geometry.attitude.pitch_rad = rng.uniform(-0.35, 0.35);
+        c.geometry.attitude.yaw_rad = rng.uniform(-0.1, 0.1);
+        c.geometry.attitude.roll_rate_rad_s = rng.uniform(-0.02, 0.02);
+        c.geometry.attitude.pitch_rate_rad_s = rng.uniform(-0.01, 0.01);
+        c.n_px = rng.uniform(-30_000.0, 30_000.0);
+        let delta = rng.uniform(-1.2, 1.2);
+        let (s, co) = (libm::sin(delta), libm::cos(delta));
+        let q30 = |x: f64| libm::round(x * (1u64 << 30) as f64) as i32;
+        let g = geometry_from_f64(&c.geometry).unwrap();
+        let gw = g.to_f64();
+        let up = EARTH_FIXED.update(&g).unwrap();
+        let px = EARTH_FIXED.pixel(&c.camera, c.n_px).unwrap();
+        let fixed = EARTH_FIXED
+            .motion(&up.yawed(q30(s), q30(co)).unwrap(), &px)
+            .map(|m| motion_to_f64(&m));
+        let up64 = general.update(&gw).unwrap().yawed(s, co);
+        let want = general.motion(&up64, &general.pixel(&c.camera, c.n_px).unwrap());
+        match (fixed, want) {
+            (Ok(f), Ok(w)) => {
+                worst = worst.max(rel(&f, &w));
+                checked += 1;
+            }
+            (f, w) => assert_eq!(f.is_ok(), w.is_ok(), "{f:?} vs {w:?}"),
+        }
+    }
+    assert!(checked > 300, "{checked}");
+    assert!(worst <= FAR_TARGET, "{worst:e}");
+    eprintln!("yawed fixed update: worst relative error {worst:.2e} over {checked} pixels");
+}
+
+/// The boresight's motion over f (`EarthFixedUpdate::boresight_over_focal`, the
+/// Cortex-M3 controller's yaw request) against the f64 reference at the same pixel:
+/// direction (rad) and speed (relative) within the backend's 2e-6 target.
+#[test]
+fn boresight_over_focal_matches_the_reference() {
+    let mut rng = SplitMix64(0xB02E_5147);
+    let mut worst = (0f64, 0f64);
+    for _ in 0..300 {
+        let mut c = scene(rng.uniform(300e3, 1_200e3), rng.uniform(-30.0, 30.0));
+        c.geometry.attitude.pitch_rad = rng.uniform(-0.35, 0.35);
+        c.geometry.attitude.yaw_rad = rng.uniform(-1.0, 1.0);
+        c.geometry.attitude.roll_rate_rad_s = rng.uniform(-0.02, 0.02);
+        c.geometry.attitude.yaw_rate_rad_s = rng.uniform(-0.01, 0.01);
+        let g = geometry_from_f64(&c.geometry).unwrap();
+        let up = EARTH_FIXED.update(&g).unwrap();
+        let (vf1, vf2) = up.boresight_over_focal().unwrap();
+        let f = c.camera.focal_m;
+        let q63 = (1u64 << 63) as f64;
+        let (v1, v2) = (vf1 as f64 / q63 * f, vf2 as f64 / q63 * f);
+        let r = EarthReference
+            .evaluate(&c.camera, &g.to_f64(), 0.0)
+            .unwrap();
+        let angle = (libm::atan2(v2, v1) - libm::atan2(r.v2_mps, r.v1_mps)).abs();
+        let speed = (libm::hypot(v1, v2) / libm::hypot(r.v1_mps, r.v2_mps) - 1.0).abs();
+        worst = (worst.0.max(angle), worst.1.max(speed));
+    }
+    assert!(worst.0 <= FAR_TARGET && worst.1 <= FAR_TARGET, "{worst:?}");
+    eprintln!(
+        "boresight over f: worst direction {:.2e} rad, speed {:.2e}",
+        worst.0, worst.1
+    );
+}

@@ -385,3 +385,80 @@ fn stage_limit_with_drift_is_the_largest_count_meeting_the_floor() {
         );
     }
 }
+
+/// The fixed-point sinc (`mtf::int`, the Cortex-M3's) against libm's sine in f64 over
+/// its whole range, y = 0 ... 1 (x = pi y up to the first zero): within 5e-9.
+#[test]
+fn fixed_point_sinc_matches_libm() {
+    use core_math::mtf::int::sinc_pi_q30;
+    let mut worst = 0f64;
+    let n = 1u32 << 20;
+    for i in 0..=n {
+        let y_q30 = ((u64::from(i) << 30) / u64::from(n)) as u32;
+        let x = std::f64::consts::PI * f64::from(y_q30) / (1u64 << 30) as f64;
+        let exact = if x == 0.0 { 1.0 } else { libm::sin(x) / x };
+        let got = f64::from(sinc_pi_q30(y_q30)) / (1u64 << 30) as f64;
+        worst = worst.max((got - exact).abs());
+    }
+    assert!(worst <= 5e-9, "{worst:e}");
+    eprintln!("fixed-point sinc: worst error {worst:.2e}");
+}
+
+/// The fixed-point smear MTF and stage limit (`mtf::int`) against f64 with libm's
+/// sine: the MTF within 1e-8 plus f32's rounding on every lobe, the stage limit meeting the floor to
+/// 1e-8 and the next count missing it, over mismatches and drifts from none to past the
+/// first zero.
+#[test]
+fn fixed_point_mtf_and_stage_limit_match_libm() {
+    use core_math::mtf::int::smear_mtf_pair;
+    let product = |m: u32, e: f64, t: f64| {
+        let s = |x: f64| {
+            if x == 0.0 {
+                1.0
+            } else {
+                libm::fabs(libm::sin(x) / x)
+            }
+        };
+        let h = std::f64::consts::FRAC_PI_2 * m as f64;
+        s(h * e) * s(h * t)
+    };
+    let mut state = 0x5EED_2024_u64;
+    let mut next = || {
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let (mut worst_mtf, mut differ) = (0f64, 0);
+    for floor in [0.25, 0.5, 0.8, 0.9, 0.95, 0.99] {
+        let rule32 = StageRule::<f32>::new(floor).unwrap();
+        for _ in 0..5_000 {
+            let e = (10f64.powf(-7.0 + 6.5 * next()) * if next() < 0.1 { 0.0 } else { 1.0 }) as f32;
+            let t = (10f64.powf(-7.0 + 6.5 * next()) * if next() < 0.1 { 0.0 } else { 1.0 }) as f32;
+            let (e64, t64) = (f64::from(e), f64::from(t));
+            let limit = 1 + (next() * 300.0) as u32;
+            let stages = 1 + (next() * 300.0) as u32;
+            let mtf = f64::from(smear_mtf_pair(stages, e, t));
+            let want = product(stages, e64, t64);
+            let err = (mtf - want).abs();
+            assert!(
+                err <= 1e-8 + want * f64::from(f32::EPSILON),
+                "stages {stages}, e {e:e}, t {t:e}: {mtf} vs {want}"
+            );
+            worst_mtf = worst_mtf.max(err);
+            let got = rule32.max_stages_with_drift_int(e, t, limit).unwrap();
+            assert!(
+                got == 0 || product(got, e64, t64) >= floor - 1e-8,
+                "floor {floor}, e {e:e}, t {t:e}: {got} misses the floor"
+            );
+            assert!(
+                got == limit || product(got + 1, e64, t64) < floor + 1e-8,
+                "floor {floor}, e {e:e}, t {t:e}: {got} not the largest"
+            );
+            if got != rule32.max_stages_with_drift(e, t, limit).unwrap() {
+                differ += 1;
+            }
+        }
+    }
+    eprintln!("fixed-point MTF: worst error {worst_mtf:.2e}; stage limits differing from f32's: {differ} of 30 000");
+}

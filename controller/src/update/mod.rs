@@ -104,26 +104,13 @@ impl Controller {
         };
         // The yaw steering request: at the boresight a turn about it turns (v1, v2) by
         // the turn and changes nothing else, so atan(v2/v1) there zeroes its drift.
-        let boresight_h = self.height(self.plan.boresight_segment);
-        let steer = GENERAL_F32
-            .ground(&instant, &EARTH, boresight_h)
-            .and_then(|u| GENERAL_F32.motion(&u, &self.plan.boresight))
-            .ok()
-            .and_then(|m| {
-                let speed = Real::sqrt(m.v1_mps * m.v1_mps + m.v2_mps * m.v2_mps);
-                let sign = if m.v1_mps < 0.0 { -1.0 } else { 1.0 };
-                let (sin, cos) = (sign * m.v2_mps / speed, sign * m.v1_mps / speed);
-                (sin.is_finite() && cos.is_finite())
-                    .then(|| (sin, cos, drift_angle_rad(m.v2_mps / m.v1_mps)))
-            });
-        self.yaw_request_rad = steer.map(|(_, _, rad)| rad);
-        // Output slots by `get` (`index` < MAX_SEGMENTS by construction of the plan): no
-        // panic path (docs/no-panic.md).
         // Segments over the same ground height share its update: made once per height
         // in a row (a flat scene makes one, terrain one per segment). It stays in one
         // place in memory, which the out-of-line `segment` and `extremes` read.
-        let mut ground_h_m = f32::NAN;
-        let mut ground: Result<Ground, Fault> = Err(Fault::OutOfRange);
+        let (steer, mut ground_h_m, mut ground) = self.steer_and_ground(&instant);
+        self.yaw_request_rad = steer.map(|(_, _, rad)| rad);
+        // Output slots by `get` (`index` < MAX_SEGMENTS by construction of the plan): no
+        // panic path (docs/no-panic.md).
         // The DEM's route needs a tile in force and the ITRF of the instant.
         let dem_frame = if self.dem_ground.is_some() {
             itrf
@@ -138,7 +125,7 @@ impl Controller {
             let height_m = self.height(index);
             // NaN never equals: the first segment makes the first ground.
             if height_m != ground_h_m {
-                ground = self.make_ground(&instant, height_m);
+                ground = self.make_ground(&instant, height_m, steer);
                 ground_h_m = height_m;
             }
             let result = match (&ground, &dem_frame) {
@@ -195,6 +182,174 @@ impl Controller {
         }
     }
 
+    /// The MTF at `stages` under the mismatch `worst` and the drift tangent `tan_max`,
+    /// and the stage limit, in f32.
+    #[cfg(not(feature = "earth-fixed"))]
+    #[inline(always)]
+    fn mtf_and_stages(&self, stages: u32, worst: f32, tan_max: f32) -> Result<(f32, u32), Fault> {
+        mtf_and_stages_f32(&self.plan, stages, worst, tan_max)
+    }
+
+    /// The same by the configured backend: with fixed-point pixels, every sinc in Q30
+    /// integers (`core_math::mtf::int`; soft float on the M3 made them a third of an
+    /// update: docs/controller.md, "What it costs").
+    #[cfg(feature = "earth-fixed")]
+    #[inline(always)]
+    fn mtf_and_stages(&self, stages: u32, worst: f32, tan_max: f32) -> Result<(f32, u32), Fault> {
+        if self.config.fixed_point_pixels {
+            let mtf = core_math::mtf::int::smear_mtf_pair(stages, worst, tan_max);
+            let m = self
+                .plan
+                .stage_rule
+                .max_stages_with_drift_int(worst, tan_max, u32::from(self.plan.max_stages))
+                .map_err(Fault::from)?;
+            Ok((mtf, m))
+        } else {
+            mtf_and_stages_f32(&self.plan, stages, worst, tan_max)
+        }
+    }
+
+    /// (v2, v1) at the segment's centre seen by the camera turned by the yaw request.
+    #[cfg(not(feature = "earth-fixed"))]
+    #[inline(always)]
+    fn steered_centre(
+        &self,
+        update: &Ground,
+        seg: &SegmentPlan,
+        sin: f32,
+        cos: f32,
+    ) -> Result<(f32, f32), Fault> {
+        let m = steered_centre(update, seg, sin, cos)?;
+        Ok((m.v2_mps, m.v1_mps))
+    }
+
+    /// The drift angles at the centre, the worst, and the steered centre's (the
+    /// centre's without a request), from their tangents.
+    #[cfg(not(feature = "earth-fixed"))]
+    #[inline(always)]
+    fn drift_angles(
+        &self,
+        centre: &ImageMotion<f32>,
+        _drift: (f32, f32),
+        tan_max: f32,
+        residual: Option<(f32, f32)>,
+    ) -> [f32; 3] {
+        drift_angles_f32(centre, tan_max, residual)
+    }
+
+    /// The same by the configured backend: with fixed-point pixels each angle from its
+    /// (v2, v1) pair in integers ([`atan_pair_rad`]), the worst never below the
+    /// centre's magnitude.
+    #[cfg(feature = "earth-fixed")]
+    #[inline(always)]
+    fn drift_angles(
+        &self,
+        centre: &ImageMotion<f32>,
+        drift: (f32, f32),
+        tan_max: f32,
+        residual: Option<(f32, f32)>,
+    ) -> [f32; 3] {
+        if self.config.fixed_point_pixels {
+            let centre_rad = atan_pair_rad(centre.v2_mps, centre.v1_mps);
+            let worst_rad = atan_pair_rad(drift.0, drift.1);
+            let worst_rad = if worst_rad < centre_rad.abs() {
+                centre_rad.abs()
+            } else {
+                worst_rad
+            };
+            let residual_rad = match residual {
+                Some((v2, v1)) => atan_pair_rad(v2, v1),
+                None => centre_rad,
+            };
+            [centre_rad, worst_rad, residual_rad]
+        } else {
+            drift_angles_f32(centre, tan_max, residual)
+        }
+    }
+
+    /// The same by the configured backend: with fixed-point pixels, the centre's
+    /// `EARTH_FIXED.motion` on the ground's turned update (integers only), the f32 form
+    /// where the turn left the envelope.
+    #[cfg(feature = "earth-fixed")]
+    #[inline(always)]
+    fn steered_centre(
+        &self,
+        update: &Ground,
+        seg: &SegmentPlan,
+        sin: f32,
+        cos: f32,
+    ) -> Result<(f32, f32), Fault> {
+        match (&update.yawed, seg.fixed.first()) {
+            // The pair in I24F40 units: only its ratio is used.
+            (Some(up), Some(px)) => {
+                let m = core_math::EARTH_FIXED.motion(up, px)?;
+                Ok((m.v2_mps.to_bits() as f32, m.v1_mps.to_bits() as f32))
+            }
+            _ => {
+                let m = steered_centre(&update.float, seg, sin, cos)?;
+                Ok((m.v2_mps, m.v1_mps))
+            }
+        }
+    }
+
+    /// The yaw request's (sin, cos, angle) from the boresight's motion, and the first
+    /// ground of the update with its height (none yet: NaN never equals a height).
+    #[cfg(not(feature = "earth-fixed"))]
+    #[inline(always)]
+    fn steer_and_ground(
+        &self,
+        instant: &GeneralInstant<f32>,
+    ) -> (Steer, f32, Result<Ground, Fault>) {
+        (self.steer_f32(instant), f32::NAN, Err(Fault::OutOfRange))
+    }
+
+    /// The same by the configured backend. With fixed-point pixels the boresight
+    /// segment's ground comes first (the loop then reuses it for every segment at its
+    /// height), and the request from its fixed-point update: the boresight's v/f in
+    /// integers (`EarthFixedUpdate::boresight_over_focal`) instead of a second f32
+    /// ground and motion in soft float.
+    #[cfg(feature = "earth-fixed")]
+    #[inline(always)]
+    fn steer_and_ground(
+        &self,
+        instant: &GeneralInstant<f32>,
+    ) -> (Steer, f32, Result<Ground, Fault>) {
+        if !self.config.fixed_point_pixels {
+            return (self.steer_f32(instant), f32::NAN, Err(Fault::OutOfRange));
+        }
+        let boresight_h = self.height(self.plan.boresight_segment);
+        let mut ground = self.make_ground(instant, boresight_h, None);
+        let steer = match &ground {
+            Ok(Ground { fixed: Some(f), .. }) => {
+                f.boresight_over_focal().ok().and_then(|(vf1, vf2)| {
+                    // Q63 rad/s, below 2^63: their squares stay inside f32's range.
+                    let (v1, v2) = (vf1 as f32, vf2 as f32);
+                    steer_from(v1, v2, atan_pair_rad(v2, v1))
+                })
+            }
+            _ => None,
+        };
+        if let (Ok(g), Some((sin, cos, _))) = (&mut ground, steer) {
+            g.yawed = g
+                .fixed
+                .as_ref()
+                .and_then(|f| f.yawed(q30(sin), q30(cos)).ok());
+        }
+        (steer, boresight_h, ground)
+    }
+
+    /// The yaw request from the boresight's motion in f32 at the boresight segment's
+    /// height.
+    #[inline(always)]
+    fn steer_f32(&self, instant: &GeneralInstant<f32>) -> Option<(f32, f32, f32)> {
+        let boresight_h = self.height(self.plan.boresight_segment);
+        GENERAL_F32
+            .ground(instant, &EARTH, boresight_h)
+            .and_then(|u| GENERAL_F32.motion(&u, &self.plan.boresight))
+            .ok()
+            .and_then(|m| steer_from(m.v1_mps, m.v2_mps, drift_angle_rad(m.v2_mps / m.v1_mps)))
+    }
+
     fn height(&self, index: u8) -> f32 {
         self.heights_m
             .get(usize::from(index))
@@ -231,7 +386,6 @@ impl Controller {
             None => self.extremes(update, seg)?,
         };
         let reversed = centre.v1_mps > 0.0;
-        let tan_centre = centre.v2_mps / centre.v1_mps;
         // v1's extremes are tracked signed, and its sign checked once after the loop;
         // the largest |v2/v1| as the pair (|v2|, |v1|) that gives it, compared by
         // cross-multiplying (|v1| > 0): one division at the end, not one a pixel. The loop
@@ -264,33 +418,19 @@ impl Controller {
         let (worst_mismatch, mtf, max_stages) = if v_lo > 0.0 {
             let (below, above) = ((v_line / v_lo - 1.0).abs(), (1.0 - v_line / v_hi).abs());
             let worst = if below > above { below } else { above };
-            let half_pi_m = core::f32::consts::FRAC_PI_2 * stages as f32;
-            // Each factor is |sinc|, the modulus of the smear's transfer function: past
-            // the first zero the contrast is reversed and weaker, not gone
-            // (docs/controller.md, "Per update"). In [0, 1]: the polynomial's
-            // (sinc(x) - 1) / x^2 part is negative on its whole range, and past pi
-            // |sinc| < 1/pi.
-            let mtf = smear_mtf(half_pi_m * worst) * smear_mtf(half_pi_m * tan_max);
-            let m = self
-                .plan
-                .stage_rule
-                .max_stages_with_drift(worst, tan_max, u32::from(self.plan.max_stages))
-                .map_err(Fault::from)?;
+            let (mtf, m) = self.mtf_and_stages(stages, worst, tan_max)?;
             (worst, mtf, m as u16)
         } else {
             // The image is slower than the interpolation bound: no bound on the
             // mismatch, no contrast promised.
             (f32::MAX, 0.0, 0)
         };
-        let tan_residual = match steer {
-            Some((sin, cos, _)) => {
-                let m = steered_centre(float(update), seg, sin, cos)?;
-                m.v2_mps / m.v1_mps
-            }
-            None => tan_centre,
+        let residual = match steer {
+            Some((sin, cos, _)) => Some(self.steered_centre(update, seg, sin, cos)?),
+            None => None,
         };
         let [drift_rad, worst_drift_rad, residual_drift_rad] =
-            drift_angles_rad(tan_centre, tan_max, tan_residual);
+            self.drift_angles(&centre, (drift_v2, drift_v1), tan_max, residual);
         Ok(SegmentOutput {
             index: seg.index,
             ticks,
@@ -304,6 +444,63 @@ impl Controller {
             held: false,
         })
     }
+}
+
+/// The MTF and the stage limit in f32 (the M4F boards').
+#[inline(always)]
+fn mtf_and_stages_f32(
+    plan: &crate::plan::Plan,
+    stages: u32,
+    worst: f32,
+    tan_max: f32,
+) -> Result<(f32, u32), Fault> {
+    let half_pi_m = core::f32::consts::FRAC_PI_2 * stages as f32;
+    // Each factor is |sinc|, the modulus of the smear's transfer function: past the
+    // first zero the contrast is reversed and weaker, not gone (docs/controller.md, "Per
+    // update"). In [0, 1]: the polynomial's (sinc(x) - 1) / x^2 part is negative on its
+    // whole range, and past pi |sinc| < 1/pi.
+    let mtf = smear_mtf(half_pi_m * worst) * smear_mtf(half_pi_m * tan_max);
+    let m = plan
+        .stage_rule
+        .max_stages_with_drift(worst, tan_max, u32::from(plan.max_stages))
+        .map_err(Fault::from)?;
+    Ok((mtf, m))
+}
+
+/// The drift angles in f32 from their tangents (the centre's, the worst, the steered
+/// centre's: the centre's without a request).
+#[inline(always)]
+fn drift_angles_f32(
+    centre: &ImageMotion<f32>,
+    tan_max: f32,
+    residual: Option<(f32, f32)>,
+) -> [f32; 3] {
+    let tan_centre = centre.v2_mps / centre.v1_mps;
+    let tan_residual = match residual {
+        Some((v2, v1)) => v2 / v1,
+        None => tan_centre,
+    };
+    drift_angles_rad(tan_centre, tan_max, tan_residual)
+}
+
+/// The yaw request as the turn's (sin, cos) and its angle (rad).
+type Steer = Option<(f32, f32, f32)>;
+
+/// The yaw turn (sin, cos) that zeroes the boresight's drift, from its (v1, v2) (any
+/// common scale), and the request `rad`; None when they are not finite.
+#[inline(always)]
+fn steer_from(v1: f32, v2: f32, rad: f32) -> Option<(f32, f32, f32)> {
+    let speed = Real::sqrt(v1 * v1 + v2 * v2);
+    let sign = if v1 < 0.0 { -1.0 } else { 1.0 };
+    let (sin, cos) = (sign * v2 / speed, sign * v1 / speed);
+    (sin.is_finite() && cos.is_finite()).then_some((sin, cos, rad))
+}
+
+/// A sine or cosine in Q30 (|x| <= 1 to f32's rounding: inside i32).
+#[cfg(feature = "earth-fixed")]
+#[inline(always)]
+fn q30(x: f32) -> i32 {
+    (x * (1u32 << 30) as f32) as i32
 }
 
 /// The time from `t0_us` to `t_us` (s). Both are < 2^53 us and, where it is used,
@@ -340,12 +537,20 @@ struct Ground {
     float: GeneralUpdate<f32>,
     /// None unless `Config::fixed_point_pixels`.
     fixed: Option<core_math::earth::fixed::EarthFixedUpdate>,
+    /// `fixed` turned by the yaw request, for the steered centres; None without a
+    /// request, or where the turn leaves the fixed formats' envelope.
+    yawed: Option<core_math::earth::fixed::EarthFixedUpdate>,
 }
 
 impl Controller {
     #[cfg(not(feature = "earth-fixed"))]
     #[inline(always)]
-    fn make_ground(&self, instant: &GeneralInstant<f32>, height_m: f32) -> Result<Ground, Fault> {
+    fn make_ground(
+        &self,
+        instant: &GeneralInstant<f32>,
+        height_m: f32,
+        _steer: Option<(f32, f32, f32)>,
+    ) -> Result<Ground, Fault> {
         GENERAL_F32
             .ground(instant, &EARTH, height_m)
             .map_err(Fault::from)
@@ -354,34 +559,39 @@ impl Controller {
     /// The f32 update of the ground and, for fixed-point pixels, the same widened to
     /// f64 and rounded once to the fixed-point formats: per ground height, not per pixel.
     #[cfg(feature = "earth-fixed")]
-    fn make_ground(&self, instant: &GeneralInstant<f32>, height_m: f32) -> Result<Ground, Fault> {
+    fn make_ground(
+        &self,
+        instant: &GeneralInstant<f32>,
+        height_m: f32,
+        steer: Option<(f32, f32, f32)>,
+    ) -> Result<Ground, Fault> {
         let float = GENERAL_F32.ground(instant, &EARTH, height_m)?;
         let fixed = if self.config.fixed_point_pixels {
             Some(fixed_update(&float, instant.r2_m2)?)
         } else {
             None
         };
-        Ok(Ground { float, fixed })
+        let yawed = match (&fixed, steer) {
+            (Some(f), Some((sin, cos, _))) => f.yawed(q30(sin), q30(cos)).ok(),
+            _ => None,
+        };
+        Ok(Ground {
+            float,
+            fixed,
+            yawed,
+        })
     }
 }
 
-/// `float` widened to f64 and rounded to the fixed-point backend's formats.
+/// `float` rounded to the fixed-point backend's formats, in integers
+/// (`EarthFixed::from_general_f32`: within a unit and 1.7e-9 relative of the same
+/// update widened to f64 and rounded there, which cost soft f64 on the M3).
 #[cfg(feature = "earth-fixed")]
 fn fixed_update(
     float: &GeneralUpdate<f32>,
     r2_m2: f32,
 ) -> Result<core_math::earth::fixed::EarthFixedUpdate, Fault> {
-    let w = |x: [f32; 3]| x.map(f64::from);
-    let wide = GeneralUpdate {
-        n_b: w(float.n_b),
-        rho_b_m: w(float.rho_b_m),
-        stretch2_minus_1: f64::from(float.stretch2_minus_1),
-        c_m2: f64::from(float.c_m2),
-        inv_c_per_m2: f64::from(float.inv_c_per_m2),
-        w_b_rad_s: w(float.w_b_rad_s),
-        v_b_mps: w(float.v_b_mps),
-    };
-    Ok(core_math::EARTH_FIXED.from_general(&wide, f64::from(r2_m2))?)
+    Ok(core_math::EARTH_FIXED.from_general_f32(float, r2_m2)?)
 }
 
 #[cfg(not(feature = "earth-fixed"))]
@@ -432,5 +642,73 @@ mod tests {
             "{worst_err:e}"
         );
         std::eprintln!("drift angles: worst error {worst_err:.2e} rad");
+    }
+
+    /// The integer drift angle of a (v2, v1) pair (the Cortex-M3's) against atan2 in
+    /// f64 of the same f32 inputs: within 5e-9 rad plus half an f32 ulp of the result,
+    /// over ratios from 1e-9 to 1e9, either sign, and the edge cases.
+    #[cfg(feature = "earth-fixed")]
+    #[test]
+    fn integer_drift_angle_matches_atan() {
+        use super::sweep::{atan_pair_rad, q30_to_f32};
+        let mut rng = core_math::sample::SplitMix64(0x5EED_2026_1127);
+        let mut worst_err = 0f64;
+        let mut check = |num: f32, den: f32| {
+            let got = f64::from(atan_pair_rad(num, den));
+            let want = libm::atan(f64::from(num) / f64::from(den));
+            let err = libm::fabs(got - want);
+            assert!(
+                err <= 5e-9 + 0.5 * f64::from(f32::EPSILON) * libm::fabs(want),
+                "atan({num:e} / {den:e}) = {got} vs {want}"
+            );
+            worst_err = worst_err.max(err);
+        };
+        for _ in 0..400_000 {
+            let den = (libm::exp(rng.uniform(-20.0, 20.0)) * rng.uniform(-1.0, 1.0)) as f32;
+            let ratio = libm::exp(rng.uniform(-21.0, 21.0)) * rng.uniform(-1.0, 1.0);
+            let num = (f64::from(den) * ratio) as f32;
+            if den != 0.0 && den.is_normal() {
+                check(num, den);
+            }
+        }
+        for (num, den) in [
+            (0.0, 1.0),
+            (-0.0, 1.0),
+            (1.0, 1.0),
+            (-1.0, 1.0),
+            (1.0, -1.0),
+            (7_000.0, 1e-30),
+            (1e-30, 7_000.0),
+            (f32::MAX, 1.0),
+            (1.0, f32::MAX),
+            (f32::MIN_POSITIVE, 3.0),
+        ] {
+            check(num, den);
+        }
+        // Non-finite inputs and a zero denominator take atan_f32 of the quotient.
+        assert_eq!(
+            atan_pair_rad(1.0, 0.0),
+            drift_angles_rad(f32::INFINITY, 0.0, 0.0)[0]
+        );
+        assert!(atan_pair_rad(f32::NAN, 1.0).is_nan());
+        std::eprintln!("integer drift angle: worst error {worst_err:.2e} rad");
+        // Q30 to f32 against the conversion and scaling in f32 (round to nearest even:
+        // they may differ at exact ties only, by one ulp).
+        let mut x = 0x9E37_79B9u32;
+        for i in 0..1_000_000u32 {
+            x ^= x << 13;
+            x ^= x >> 17;
+            x ^= x << 5;
+            let q = x >> (i % 32);
+            let want = q as f32 * (1.0 / (1u32 << 30) as f32);
+            let got = q30_to_f32(q);
+            let exact = f64::from(q) / (1u64 << 30) as f64;
+            assert!(
+                libm::fabs(f64::from(got) - exact)
+                    <= 0.5 * f64::from(want) * f64::from(f32::EPSILON),
+                "{q}: {got} vs {want}"
+            );
+        }
+        assert_eq!(q30_to_f32(0), 0.0);
     }
 }

@@ -169,3 +169,106 @@ pub(super) fn drift_angles_rad(tan_centre: f32, tan_max: f32, tan_residual: f32)
 pub fn drift_angle_rad(t: f32) -> f32 {
     core_math::trig::atan_f32(t)
 }
+
+/// atan(`num` / `den`) (rad) in integers, for a core without an FPU: the two f32
+/// mantissas divided in Q40, the odd polynomial of degree 19 on [0, 1] in Q30 (fitted
+/// to atan by weighted least squares, within 4.2e-9 evaluated this way), the octant
+/// past 1 by pi/2 - atan(den/num); then rounded once to f32 (docs/fixed-point.md, "The
+/// update on the Cortex-M3"). Non-finite inputs and a zero `den`: `atan_f32` of the
+/// f32 quotient.
+#[cfg(feature = "earth-fixed")]
+#[inline(never)]
+pub(super) fn atan_pair_rad(num: f32, den: f32) -> f32 {
+    let (a, b) = (num.to_bits() & 0x7fff_ffff, den.to_bits() & 0x7fff_ffff);
+    if a >= 0x7f80_0000 || !(0x0080_0000..0x7f80_0000).contains(&b) {
+        return atan_pair_cold(num, den);
+    }
+    // For positive finite f32s the bits order as the values.
+    let (small, big, past_one) = if a <= b { (a, b, false) } else { (b, a, true) };
+    let mantissa = |x: u32| u64::from((x & 0x7f_ffff) | 0x80_0000);
+    // A subnormal or zero numerator counts as 0 (its ratio is below 2^-100).
+    let m_small = if small < 0x0080_0000 {
+        0
+    } else {
+        mantissa(small)
+    };
+    let shift = (big >> 23) - (small >> 23).max(1);
+    // m_small / m_big (< 2) in Q40 by five steps of long division, 8 bits each, in the
+    // core's 32-bit divide (the remainder stays below 2^24: no 64-bit division call);
+    // then over 2^shift, in Q30 rounded.
+    let m_big = mantissa(big) as u32;
+    let (mut q, mut rem) = (0u64, m_small as u32);
+    for _ in 0..5 {
+        let n = rem << 8;
+        let d = n.checked_div(m_big).unwrap_or(0);
+        q = (q << 8) + u64::from(d);
+        rem = n - d * m_big;
+    }
+    let r = (q.checked_shr(shift).unwrap_or(0) + (1 << 9)) >> 10;
+    let r = r.min(1 << 30) as i32;
+    let at = atan_unit_q30(r);
+    let q = if past_one { HALF_PI_Q30 - at } else { at };
+    let rad = q30_to_f32(q.max(0) as u32);
+    if (num.to_bits() ^ den.to_bits()) >> 31 != 0 {
+        -rad
+    } else {
+        rad
+    }
+}
+
+#[cfg(feature = "earth-fixed")]
+#[cold]
+#[inline(never)]
+fn atan_pair_cold(num: f32, den: f32) -> f32 {
+    drift_angle_rad(num / den)
+}
+
+/// pi/2 in Q30, rounded.
+#[cfg(feature = "earth-fixed")]
+const HALF_PI_Q30: i32 = 1_686_629_713;
+
+/// atan(x) / x as a polynomial in x^2 on [0, 1], Q30 (a weighted least-squares fit:
+/// `docs/fixed-point.md`, "The update on the Cortex-M3").
+#[cfg(feature = "earth-fixed")]
+const ATAN_Q30: [i32; 10] = [
+    1_073_741_803,
+    -357_912_299,
+    214_710_104,
+    -152_978_376,
+    116_801_687,
+    -88_194_453,
+    59_085_752,
+    -30_591_534,
+    10_272_750,
+    -1_620_580,
+];
+
+/// atan(x) for x in Q30 on [0, 1], in Q30: every partial sum below 1.1 in Q30, so
+/// each step is one 32 x 32 -> 64 product.
+#[cfg(feature = "earth-fixed")]
+#[inline(always)]
+fn atan_unit_q30(x: i32) -> i32 {
+    let mul = |a: i32, b: i32| ((i64::from(a) * i64::from(b) + (1 << 29)) >> 30) as i32;
+    let z = ((i64::from(x) * i64::from(x)) >> 30) as i32;
+    let mut acc = ATAN_Q30[9];
+    for &c in ATAN_Q30[..9].iter().rev() {
+        acc = mul(acc, z) + c;
+    }
+    mul(x, acc)
+}
+
+/// `q` 2^-30 as f32, rounded to nearest (ties away from zero), without the software
+/// conversion and multiplication.
+#[cfg(feature = "earth-fixed")]
+#[inline(always)]
+pub(super) fn q30_to_f32(q: u32) -> f32 {
+    if q == 0 {
+        return 0.0;
+    }
+    let lz = q.leading_zeros();
+    // The leading one at bit 31, then 24 bits of mantissa and the rounding bit below.
+    let m = q << lz;
+    let exp = 127 + 1 - lz; // q 2^-30 = 2^(31 - lz - 30) x 1.m
+    let bits = (exp << 23) + ((m >> 8) & 0x7f_ffff) + ((m >> 7) & 1);
+    f32::from_bits(bits)
+}

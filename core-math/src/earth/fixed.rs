@@ -179,6 +179,110 @@ impl EarthFixed {
         Self::round_update(up, r2_m2)
     }
 
+    /// [`EarthFixed::from_general`] for an update formed in f32, in integers only (no
+    /// soft f64 on a core without an FPU): every f32 is an exact integer times a power
+    /// of two, 1/|r| comes from an integer square root and one 64-bit division (within
+    /// 1.5e-9 relative), and each product is rounded once to its format. The same
+    /// checks and refusals; each value within a unit or two of the format of
+    /// `from_general` on the same update widened to f64
+    /// (`core-math/tests/earth_fixed.rs`).
+    pub fn from_general_f32(
+        &self,
+        up: &crate::earth::GeneralUpdate<f32>,
+        r2_m2: f32,
+    ) -> Result<EarthFixedUpdate, ModelError> {
+        let position = ModelError::OutOfDomain(Param::Position);
+        if !(r2_m2 > 0.0 && r2_m2.is_finite()) {
+            return Err(position);
+        }
+        let (rm, re) = parts(r2_m2);
+        // r^2 = M 2^(re - sh), M = rm 2^sh in [2^62, 2^64), re - sh even.
+        let sh = if (re - 40) % 2 == 0 { 40 } else { 39 };
+        let big_m = (rm as u64) << sh;
+        // |r| = s 2^h, s in [2^31, 2^32] (within 2 units), 1/|r| = inv 2^(-63 - h).
+        let s = sqrt_u64(big_m);
+        let h = (re - sh) / 2;
+        let inv = (1u64 << 63).checked_div(s).ok_or(position)? as i64;
+        // x / |r| in Q`frac`: its mantissa times inv, exact in i64 (< 2^56).
+        let over_r = |x: f32, frac: i32| -> Option<i64> {
+            let (m, e) = parts(x);
+            round_shift(m * inv, e - 63 - h + frac)
+        };
+        // (1/|r|)^2 = inv2 2^(-94 - 2h), inv2 = inv^2 2^-32 <= 2^32 (inv <= 2^32).
+        let inv2 = if inv >= 1 << 32 {
+            1 << 32
+        } else {
+            ((inv as u64 * inv as u64) >> 32) as i64
+        };
+        let (cm, ce) = parts(up.c_m2);
+        if cm <= 0 {
+            return Err(position);
+        }
+        // C / r^2 = cm inv2 2^(ce - 126 - 2h + 32).
+        let c_prod = cm * inv2;
+        let c_exp = ce - 94 - 2 * h;
+        let c = round_shift(c_prod, c_exp + 32).ok_or(position)?;
+        // The envelope's bounds in each format, as `round_update` checks them.
+        const C_LO: i64 = (envelope::C_OVER_R2.0 * 4_294_967_296.0) as i64;
+        const C_HI: i64 = (envelope::C_OVER_R2.1 * 4_294_967_296.0) as i64;
+        const K2M1: i64 = (envelope::MAX_STRETCH2_MINUS_1 * (1u64 << 36) as f64) as i64;
+        const N: i64 = (envelope::MAX_UNIT * (1u64 << 30) as f64) as i64;
+        const RHO: i64 =
+            ((envelope::MAX_UNIT + envelope::MAX_STRETCH2_MINUS_1) * (1u64 << 30) as f64) as i64;
+        const W: i64 = (envelope::MAX_W_RAD_S * (1u64 << 33) as f64) as i64;
+        const V: i64 = (envelope::MAX_V_OVER_R_RAD_S * (1u64 << 39) as f64) as i64;
+        if !(C_LO..=C_HI).contains(&c) {
+            return Err(position);
+        }
+        // r^2 / C in Q27 = 2^(27 - c_exp) / c_prod. With c_prod = d 2^t + (less than
+        // 2^t), d in [2^31, 2^32): 2^(27 - c_exp - t) / d = (2^63 / d) 2^(-36 - c_exp - t),
+        // one division of 2^63 by 32 bits (within 2^-31 relative, d's truncation
+        // included).
+        let t = 32 - (c_prod as u64).leading_zeros() as i32;
+        let d = (c_prod as u64).checked_shr(t.max(0) as u32).unwrap_or(0);
+        let quotient = (1u64 << 63).checked_div(d).ok_or(position)? as i64;
+        let inv_c = round_shift(quotient, -36 - c_exp - t).ok_or(position)?;
+        let direct = |x: f32, frac: i32| -> Option<i64> {
+            let (m, e) = parts(x);
+            round_shift(m, e + frac)
+        };
+        let k2m1 = direct(up.stretch2_minus_1, 36);
+        if !matches!(k2m1, Some(k) if k <= K2M1) {
+            return Err(ModelError::OutOfDomain(Param::Flattening));
+        }
+        let within = |q: Option<i64>, max: i64, err: ModelError| match q {
+            Some(q) if q.abs() <= max => Ok(q as i32),
+            _ => Err(err),
+        };
+        let mut n = [0; 3];
+        let mut rho = [0; 3];
+        let mut w = [0; 3];
+        let mut v = [0; 3];
+        for k in 0..3 {
+            n[k] = within(direct(up.n_b[k], 30), N, position)?;
+            rho[k] = within(over_r(up.rho_b_m[k], 30), RHO, position)?;
+            w[k] = within(
+                direct(up.w_b_rad_s[k], 33),
+                W,
+                ModelError::OutOfDomain(Param::AngularVelocity),
+            )?;
+            v[k] = within(
+                over_r(up.v_b_mps[k], 39),
+                V,
+                ModelError::OutOfDomain(Param::Velocity),
+            )?;
+        }
+        Ok(EarthFixedUpdate {
+            n,
+            rho,
+            k2m1: within(k2m1, K2M1, position)?,
+            c: c as u32,
+            inv_c: u32::try_from(inv_c).map_err(|_| position)?,
+            w,
+            v,
+        })
+    }
+
     /// The f64 update, every length over |r|, rounded to the per-pixel formats.
     fn round_update(
         up: &crate::earth::GeneralUpdate<f64>,
@@ -233,6 +337,112 @@ impl EarthFixed {
             w,
             v,
         })
+    }
+}
+
+impl EarthFixedUpdate {
+    /// The update of the same instant with the camera turned by a further yaw delta
+    /// about its boresight, given by its sine and cosine in Q30: every B-frame vector
+    /// turned by Rz(delta)^T, as [`crate::earth::GeneralUpdate::yawed`] does, in 32 x 32
+    /// -> 64 products rounded once (half a unit of each format, with the sine's and
+    /// cosine's own rounding of 2^-31 relative). A component the turn takes past the
+    /// envelope (up to sqrt 2 of the largest before it) is
+    /// [`ModelError::OutOfDomain`]. Integers only: the per-segment steered centre of a
+    /// core without an FPU is then one [`Backend::motion`].
+    pub fn yawed(&self, sin_q30: i32, cos_q30: i32) -> Result<EarthFixedUpdate, ModelError> {
+        let turn = |x: [i32; 3], max: i64, p: Param| -> Result<[i32; 3], ModelError> {
+            let (c, s) = (i64::from(cos_q30), i64::from(sin_q30));
+            let (x0, x1) = (i64::from(x[0]), i64::from(x[1]));
+            let mut out = [0i32; 3];
+            for (o, v) in out.iter_mut().zip([c * x0 + s * x1, c * x1 - s * x0]) {
+                let r = (v + (1 << 29)) >> 30;
+                if r.abs() > max {
+                    return Err(ModelError::OutOfDomain(p));
+                }
+                *o = r as i32;
+            }
+            out[2] = x[2];
+            Ok(out)
+        };
+        // The envelope's bounds in each vector's format, as `round_update` refuses them.
+        const N: i64 = (envelope::MAX_UNIT * (1u64 << 30) as f64) as i64;
+        const RHO: i64 =
+            ((envelope::MAX_UNIT + envelope::MAX_STRETCH2_MINUS_1) * (1u64 << 30) as f64) as i64;
+        const W: i64 = (envelope::MAX_W_RAD_S * (1u64 << 33) as f64) as i64;
+        const V: i64 = (envelope::MAX_V_OVER_R_RAD_S * (1u64 << 39) as f64) as i64;
+        Ok(EarthFixedUpdate {
+            n: turn(self.n, N, Param::Position)?,
+            rho: turn(self.rho, RHO, Param::Position)?,
+            w: turn(self.w, W, Param::AngularVelocity)?,
+            v: turn(self.v, V, Param::Velocity)?,
+            ..*self
+        })
+    }
+}
+
+impl EarthFixedUpdate {
+    /// The image motion at the boresight (p1 = p2 = 0) over the focal length, (v1/f,
+    /// v2/f) in Q63 (rad/s): [`Backend::motion`]'s integers at t1 = t2 = 0, where no
+    /// pixel constant is left (the yaw request needs only its direction). The same
+    /// refusals.
+    pub fn boresight_over_focal(&self) -> Result<(i64, i64), ModelError> {
+        // beta = -rho3 (Q30 -> Q31), n.u' = -n3.
+        let beta = -i64::from(self.rho[2]);
+        if beta >= 0 {
+            return Err(ModelError::LineOfSightMissesEarth);
+        }
+        let b31 = (beta.unsigned_abs() << 1) as u32;
+        let n3 = i64::from(self.n[2]);
+        let nn30 = ((n3 * n3) as u64 >> 30) as u32;
+        let alpha = (1u32 << 30) + ((self.k2m1 as u64 * nn30 as u64) >> 36) as u32;
+        let bb = b31 as u64 * b31 as u64;
+        let ac = alpha as u64 * self.c as u64;
+        if ac > bb {
+            return Err(ModelError::LineOfSightMissesEarth);
+        }
+        let root = sqrt_u64(bb - ac);
+        let num = ((root + b31 as u64) >> 1) as u32;
+        let inv_s = ((num as u64 * self.inv_c as u64) >> 32) as u32;
+        let e = |vk: i32| ((vk as i64 * inv_s as i64 + (1 << 30)) >> 31) as i32;
+        let [w1, w2, _] = self.w;
+        let vf1 = (i64::from(w2) << 30) - (i64::from(e(self.v[0])) << 30);
+        let vf2 = -(i64::from(w1) << 30) - (i64::from(e(self.v[1])) << 30);
+        if vf1 == 0 {
+            return Err(ModelError::NoAlongTrackMotion);
+        }
+        Ok((vf1, vf2))
+    }
+}
+
+/// A finite f32 as m 2^e exactly (m signed, |m| < 2^24; zero as (0, 0)).
+#[inline(always)]
+fn parts(x: f32) -> (i64, i32) {
+    let bits = x.to_bits();
+    let e = ((bits >> 23) & 0xff) as i32;
+    let frac = i64::from(bits & 0x7f_ffff);
+    let (m, e) = if e == 0 {
+        (frac, -149)
+    } else {
+        (frac | 0x80_0000, e - 150)
+    };
+    (if bits >> 31 != 0 { -m } else { m }, e)
+}
+
+/// m 2^sh rounded to nearest (ties up), `None` past i64.
+#[inline(always)]
+fn round_shift(m: i64, sh: i32) -> Option<i64> {
+    if sh >= 0 {
+        let k = sh.unsigned_abs();
+        if k >= 63 || m.unsigned_abs() >= 1u64 << (63 - k) {
+            return (m == 0).then_some(0);
+        }
+        Some(m << k)
+    } else {
+        let k = sh.unsigned_abs();
+        if k >= 63 {
+            return Some(0);
+        }
+        Some((m + (1 << (k - 1))) >> k)
     }
 }
 
@@ -411,6 +621,94 @@ fn sqrt_u64(x: u64) -> u64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// `from_general_f32` (integers) against `from_general` on the same f32 update
+    /// widened to f64 (exact there, rounded once): every field within one unit of its
+    /// format plus 3e-9 of its value (1/|r|'s error, 50 times below the f32 update's own
+    /// rounding), the same refusals, over altitudes 200-2 500 km, attitudes, rates and
+    /// ground heights.
+    #[test]
+    fn from_general_f32_matches_the_f64_rounding() {
+        extern crate std;
+        use crate::earth::{circular_state, Ellipsoid, GeneralUpdate};
+        let mut rng = crate::sample::SplitMix64(0xF32F_1CED_2026);
+        let general = General::<f32>::new();
+        let (mut worst, mut checked) = (0f64, 0);
+        for _ in 0..20_000 {
+            let radius = Ellipsoid::WGS84.a_m + rng.uniform(150e3, 2_700e3);
+            let g = EarthGeometry {
+                state: circular_state(radius, rng.uniform(0.0, 3.1), rng.uniform(-3.2, 3.2)),
+                attitude: Attitude {
+                    roll_rad: rng.uniform(-0.6, 0.6),
+                    pitch_rad: rng.uniform(-0.5, 0.5),
+                    yaw_rad: rng.uniform(-3.2, 3.2),
+                    roll_rate_rad_s: rng.uniform(-0.05, 0.05),
+                    pitch_rate_rad_s: rng.uniform(-0.05, 0.05),
+                    yaw_rate_rad_s: rng.uniform(-0.05, 0.05),
+                },
+                ground_h_m: rng.uniform(-500.0, 9_000.0),
+                ellipsoid: Ellipsoid::WGS84,
+                earth_rate_rad_s: crate::EARTH_RATE_RAD_S,
+            };
+            let gf = EarthGeometry {
+                state: g.state,
+                attitude: Attitude {
+                    roll_rad: g.attitude.roll_rad as f32,
+                    pitch_rad: g.attitude.pitch_rad as f32,
+                    yaw_rad: g.attitude.yaw_rad as f32,
+                    roll_rate_rad_s: g.attitude.roll_rate_rad_s as f32,
+                    pitch_rate_rad_s: g.attitude.pitch_rate_rad_s as f32,
+                    yaw_rate_rad_s: g.attitude.yaw_rate_rad_s as f32,
+                },
+                ground_h_m: g.ground_h_m,
+                ellipsoid: g.ellipsoid,
+                earth_rate_rad_s: g.earth_rate_rad_s,
+            };
+            let Ok(up) = general.update(&gf) else {
+                continue;
+            };
+            let p = g.state.position_m;
+            let r2 = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]) as f32;
+            let w = |x: [f32; 3]| x.map(f64::from);
+            let wide = GeneralUpdate {
+                n_b: w(up.n_b),
+                rho_b_m: w(up.rho_b_m),
+                stretch2_minus_1: f64::from(up.stretch2_minus_1),
+                c_m2: f64::from(up.c_m2),
+                inv_c_per_m2: f64::from(up.inv_c_per_m2),
+                w_b_rad_s: w(up.w_b_rad_s),
+                v_b_mps: w(up.v_b_mps),
+            };
+            let want = EarthFixed.from_general(&wide, f64::from(r2));
+            let got = EarthFixed.from_general_f32(&up, r2);
+            match (want, got) {
+                (Ok(a), Ok(b)) => {
+                    // Units off beyond the last one, over the value: the relative error
+                    // of 1/|r| (and of its square for C and 1/C).
+                    let mut d = |x: i64, y: i64| {
+                        let excess = x.abs_diff(y).saturating_sub(1) as f64;
+                        worst = worst.max(excess / (x.unsigned_abs().max(1) as f64));
+                    };
+                    for k in 0..3 {
+                        d(a.n[k].into(), b.n[k].into());
+                        d(a.rho[k].into(), b.rho[k].into());
+                        d(a.w[k].into(), b.w[k].into());
+                        d(a.v[k].into(), b.v[k].into());
+                    }
+                    d(a.k2m1.into(), b.k2m1.into());
+                    d(a.c.into(), b.c.into());
+                    d(a.inv_c.into(), b.inv_c.into());
+                    checked += 1;
+                }
+                (a, b) => assert_eq!(a.is_ok(), b.is_ok(), "{a:?} vs {b:?}"),
+            }
+        }
+        assert!(checked > 15_000, "{checked}");
+        assert!(worst <= 3e-9, "{worst:e}");
+        std::eprintln!(
+            "from_general_f32: beyond one unit, worst {worst:.2e} relative over {checked} updates"
+        );
+    }
 
     /// Against the exact floor square root (u128 arithmetic, independent of the scheme)
     /// over every magnitude, the extremes included.
