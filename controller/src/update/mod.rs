@@ -21,6 +21,14 @@ use crate::sink::LinePeriodSink;
 use crate::track::{self, ItrfFrame};
 
 impl Controller {
+    /// Whether the sample pixels are evaluated in fixed point: `Config::fixed_point_pixels`,
+    /// or always with the feature `fixed-only`, which leaves the f32 route unlinked.
+    #[cfg(feature = "earth-fixed")]
+    #[inline(always)]
+    fn fixed_pixels(&self) -> bool {
+        cfg!(feature = "fixed-only") || self.config.fixed_point_pixels
+    }
+
     /// Moves the clock to `now_us` (from the time source) and runs the update that is due,
     /// if any, writing periods to `sink`. Returns true when an update ran.
     pub fn advance<S: LinePeriodSink>(&mut self, now_us: u64, sink: &mut S) -> bool {
@@ -175,7 +183,7 @@ impl Controller {
     #[cfg(feature = "earth-fixed")]
     #[inline(always)]
     fn extremes(&self, update: &Ground, seg: &SegmentPlan) -> Result<Extremes, Fault> {
-        if self.config.fixed_point_pixels {
+        if self.fixed_pixels() {
             extremes_fixed(update, seg)
         } else {
             extremes(&update.float, seg)
@@ -196,7 +204,7 @@ impl Controller {
     #[cfg(feature = "earth-fixed")]
     #[inline(always)]
     fn mtf_and_stages(&self, stages: u32, worst: f32, tan_max: f32) -> Result<(f32, u32), Fault> {
-        if self.config.fixed_point_pixels {
+        if self.fixed_pixels() {
             let mtf = core_math::mtf::int::smear_mtf_pair(stages, worst, tan_max);
             let m = self
                 .plan
@@ -249,7 +257,7 @@ impl Controller {
         tan_max: f32,
         residual: Option<(f32, f32)>,
     ) -> [f32; 3] {
-        if self.config.fixed_point_pixels {
+        if self.fixed_pixels() {
             let centre_rad = atan_pair_rad(centre.v2_mps, centre.v1_mps);
             let worst_rad = atan_pair_rad(drift.0, drift.1);
             let worst_rad = if worst_rad < centre_rad.abs() {
@@ -314,7 +322,7 @@ impl Controller {
         &self,
         instant: &GeneralInstant<f32>,
     ) -> (Steer, f32, Result<Ground, Fault>) {
-        if !self.config.fixed_point_pixels {
+        if !self.fixed_pixels() {
             return (self.steer_f32(instant), f32::NAN, Err(Fault::OutOfRange));
         }
         let boresight_h = self.height(self.plan.boresight_segment);
@@ -535,7 +543,7 @@ type Ground = GeneralUpdate<f32>;
 #[cfg(feature = "earth-fixed")]
 struct Ground {
     float: GeneralUpdate<f32>,
-    /// None unless `Config::fixed_point_pixels`.
+    /// None unless [`Controller::fixed_pixels`].
     fixed: Option<core_math::earth::fixed::EarthFixedUpdate>,
     /// `fixed` turned by the yaw request, for the steered centres; None without a
     /// request, or where the turn leaves the fixed formats' envelope.
@@ -566,7 +574,7 @@ impl Controller {
         steer: Option<(f32, f32, f32)>,
     ) -> Result<Ground, Fault> {
         let float = GENERAL_F32.ground(instant, &EARTH, height_m)?;
-        let fixed = if self.config.fixed_point_pixels {
+        let fixed = if self.fixed_pixels() {
             Some(fixed_update(&float, instant.r2_m2)?)
         } else {
             None
