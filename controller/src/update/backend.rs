@@ -1,0 +1,344 @@
+//! Which route evaluates a segment: the f32 general form, or with the feature
+//! `earth-fixed` and fixed-point pixels the integer forms (`core_math::EARTH_FIXED`,
+//! `core_math::mtf::int`) that a core without an FPU flies; the ground each segment is
+//! evaluated from, the MTF and stage limit, the drift angles and the yaw steering by
+//! either route (docs/controller.md, "Backends").
+
+use super::*;
+
+impl Controller {
+    /// The segment's [`Extremes`] by the configured backend.
+    #[cfg(not(feature = "earth-fixed"))]
+    #[inline(always)]
+    pub(super) fn extremes(&self, update: &Ground, seg: &SegmentPlan) -> Result<Extremes, Fault> {
+        extremes(update, seg)
+    }
+
+    /// The segment's [`Extremes`] by the configured backend.
+    #[cfg(feature = "earth-fixed")]
+    #[inline(always)]
+    pub(super) fn extremes(&self, update: &Ground, seg: &SegmentPlan) -> Result<Extremes, Fault> {
+        if self.fixed_pixels() {
+            extremes_fixed(update, seg)
+        } else {
+            extremes(&update.float, seg)
+        }
+    }
+
+    /// The MTF at `stages` under the mismatch `worst` and the drift tangent `tan_max`,
+    /// and the stage limit, in f32.
+    #[cfg(not(feature = "earth-fixed"))]
+    #[inline(always)]
+    pub(super) fn mtf_and_stages(
+        &self,
+        stages: u32,
+        worst: f32,
+        tan_max: f32,
+    ) -> Result<(f32, u32), Fault> {
+        mtf_and_stages_f32(&self.plan, stages, worst, tan_max)
+    }
+
+    /// The same by the configured backend: with fixed-point pixels, every sinc in Q30
+    /// integers (`core_math::mtf::int`; soft float on the M3 made them a third of an
+    /// update: docs/controller.md, "What it costs").
+    #[cfg(feature = "earth-fixed")]
+    #[inline(always)]
+    pub(super) fn mtf_and_stages(
+        &self,
+        stages: u32,
+        worst: f32,
+        tan_max: f32,
+    ) -> Result<(f32, u32), Fault> {
+        if self.fixed_pixels() {
+            let mtf = core_math::mtf::int::smear_mtf_pair(stages, worst, tan_max);
+            let m = self
+                .plan
+                .stage_rule
+                .max_stages_with_drift_int(worst, tan_max, u32::from(self.plan.max_stages))
+                .map_err(Fault::from)?;
+            Ok((mtf, m))
+        } else {
+            mtf_and_stages_f32(&self.plan, stages, worst, tan_max)
+        }
+    }
+
+    /// (v2, v1) at the segment's centre seen by the camera turned by the yaw request.
+    #[cfg(not(feature = "earth-fixed"))]
+    #[inline(always)]
+    pub(super) fn steered_centre(
+        &self,
+        update: &Ground,
+        seg: &SegmentPlan,
+        sin: f32,
+        cos: f32,
+    ) -> Result<(f32, f32), Fault> {
+        let m = steered_centre(update, seg, sin, cos)?;
+        Ok((m.v2_mps, m.v1_mps))
+    }
+
+    /// The drift angles at the centre, the worst, and the steered centre's (the
+    /// centre's without a request), from their tangents.
+    #[cfg(not(feature = "earth-fixed"))]
+    #[inline(always)]
+    pub(super) fn drift_angles(
+        &self,
+        centre: &ImageMotion<f32>,
+        _drift: (f32, f32),
+        tan_max: f32,
+        residual: Option<(f32, f32)>,
+    ) -> [f32; 3] {
+        drift_angles_f32(centre, tan_max, residual)
+    }
+
+    /// The same by the configured backend: with fixed-point pixels each angle from its
+    /// (v2, v1) pair in integers ([`atan_pair_rad`]), the worst never below the
+    /// centre's magnitude.
+    #[cfg(feature = "earth-fixed")]
+    #[inline(always)]
+    pub(super) fn drift_angles(
+        &self,
+        centre: &ImageMotion<f32>,
+        drift: (f32, f32),
+        tan_max: f32,
+        residual: Option<(f32, f32)>,
+    ) -> [f32; 3] {
+        if self.fixed_pixels() {
+            let centre_rad = atan_pair_rad(centre.v2_mps, centre.v1_mps);
+            let worst_rad = atan_pair_rad(drift.0, drift.1);
+            let worst_rad = if worst_rad < centre_rad.abs() {
+                centre_rad.abs()
+            } else {
+                worst_rad
+            };
+            let residual_rad = match residual {
+                Some((v2, v1)) => atan_pair_rad(v2, v1),
+                None => centre_rad,
+            };
+            [centre_rad, worst_rad, residual_rad]
+        } else {
+            drift_angles_f32(centre, tan_max, residual)
+        }
+    }
+
+    /// The same by the configured backend: with fixed-point pixels, the centre's
+    /// `EARTH_FIXED.motion` on the ground's turned update (integers only), the f32 form
+    /// where the turn left the envelope.
+    #[cfg(feature = "earth-fixed")]
+    #[inline(always)]
+    pub(super) fn steered_centre(
+        &self,
+        update: &Ground,
+        seg: &SegmentPlan,
+        sin: f32,
+        cos: f32,
+    ) -> Result<(f32, f32), Fault> {
+        match (&update.yawed, seg.fixed.first()) {
+            // The pair in I24F40 units: only its ratio is used.
+            (Some(up), Some(px)) => {
+                let m = core_math::EARTH_FIXED.motion(up, px)?;
+                Ok((m.v2_mps.to_bits() as f32, m.v1_mps.to_bits() as f32))
+            }
+            _ => {
+                let m = steered_centre(&update.float, seg, sin, cos)?;
+                Ok((m.v2_mps, m.v1_mps))
+            }
+        }
+    }
+
+    /// The yaw request's (sin, cos, angle) from the boresight's motion, and the first
+    /// ground of the update with its height (none yet: NaN never equals a height).
+    #[cfg(not(feature = "earth-fixed"))]
+    #[inline(always)]
+    pub(super) fn steer_and_ground(
+        &self,
+        instant: &GeneralInstant<f32>,
+    ) -> (Steer, f32, Result<Ground, Fault>) {
+        (self.steer_f32(instant), f32::NAN, Err(Fault::OutOfRange))
+    }
+
+    /// The same by the configured backend. With fixed-point pixels the boresight
+    /// segment's ground comes first (the loop then reuses it for every segment at its
+    /// height), and the request from its fixed-point update: the boresight's v/f in
+    /// integers (`EarthFixedUpdate::boresight_over_focal`) instead of a second f32
+    /// ground and motion in soft float.
+    #[cfg(feature = "earth-fixed")]
+    #[inline(always)]
+    pub(super) fn steer_and_ground(
+        &self,
+        instant: &GeneralInstant<f32>,
+    ) -> (Steer, f32, Result<Ground, Fault>) {
+        if !self.fixed_pixels() {
+            return (self.steer_f32(instant), f32::NAN, Err(Fault::OutOfRange));
+        }
+        let boresight_h = self.height(self.plan.boresight_segment);
+        let mut ground = self.make_ground(instant, boresight_h, None);
+        let steer = match &ground {
+            Ok(Ground { fixed: Some(f), .. }) => {
+                f.boresight_over_focal().ok().and_then(|(vf1, vf2)| {
+                    // Q63 rad/s, below 2^63: their squares stay inside f32's range.
+                    let (v1, v2) = (vf1 as f32, vf2 as f32);
+                    steer_from(v1, v2, atan_pair_rad(v2, v1))
+                })
+            }
+            _ => None,
+        };
+        if let (Ok(g), Some((sin, cos, _))) = (&mut ground, steer) {
+            g.yawed = g
+                .fixed
+                .as_ref()
+                .and_then(|f| f.yawed(q30(sin), q30(cos)).ok());
+        }
+        (steer, boresight_h, ground)
+    }
+
+    /// The yaw request from the boresight's motion in f32 at the boresight segment's
+    /// height.
+    #[inline(always)]
+    pub(super) fn steer_f32(&self, instant: &GeneralInstant<f32>) -> Option<(f32, f32, f32)> {
+        let boresight_h = self.height(self.plan.boresight_segment);
+        GENERAL_F32
+            .ground(instant, &EARTH, boresight_h)
+            .and_then(|u| GENERAL_F32.motion(&u, &self.plan.boresight))
+            .ok()
+            .and_then(|m| steer_from(m.v1_mps, m.v2_mps, drift_angle_rad(m.v2_mps / m.v1_mps)))
+    }
+}
+
+/// The MTF and the stage limit in f32 (the M4F boards').
+#[inline(always)]
+pub(super) fn mtf_and_stages_f32(
+    plan: &crate::plan::Plan,
+    stages: u32,
+    worst: f32,
+    tan_max: f32,
+) -> Result<(f32, u32), Fault> {
+    let half_pi_m = core::f32::consts::FRAC_PI_2 * stages as f32;
+    // Each factor is |sinc|, the modulus of the smear's transfer function: past the
+    // first zero the contrast is reversed and weaker, not gone (docs/controller.md, "Per
+    // update"). In [0, 1]: the polynomial's (sinc(x) - 1) / x^2 part is negative on its
+    // whole range, and past pi |sinc| < 1/pi.
+    let mtf = smear_mtf(half_pi_m * worst) * smear_mtf(half_pi_m * tan_max);
+    let m = plan
+        .stage_rule
+        .max_stages_with_drift(worst, tan_max, u32::from(plan.max_stages))
+        .map_err(Fault::from)?;
+    Ok((mtf, m))
+}
+
+/// The drift angles in f32 from their tangents (the centre's, the worst, the steered
+/// centre's: the centre's without a request).
+#[inline(always)]
+pub(super) fn drift_angles_f32(
+    centre: &ImageMotion<f32>,
+    tan_max: f32,
+    residual: Option<(f32, f32)>,
+) -> [f32; 3] {
+    let tan_centre = centre.v2_mps / centre.v1_mps;
+    let tan_residual = match residual {
+        Some((v2, v1)) => v2 / v1,
+        None => tan_centre,
+    };
+    drift_angles_rad(tan_centre, tan_max, tan_residual)
+}
+
+/// The yaw request as the turn's (sin, cos) and its angle (rad).
+pub(super) type Steer = Option<(f32, f32, f32)>;
+
+/// The yaw turn (sin, cos) that zeroes the boresight's drift, from its (v1, v2) (any
+/// common scale), and the request `rad`; None when they are not finite.
+#[inline(always)]
+pub(super) fn steer_from(v1: f32, v2: f32, rad: f32) -> Option<(f32, f32, f32)> {
+    let speed = Real::sqrt(v1 * v1 + v2 * v2);
+    let sign = if v1 < 0.0 { -1.0 } else { 1.0 };
+    let (sin, cos) = (sign * v2 / speed, sign * v1 / speed);
+    (sin.is_finite() && cos.is_finite()).then_some((sin, cos, rad))
+}
+
+/// A sine or cosine in Q30 (|x| <= 1 to f32's rounding: inside i32).
+#[cfg(feature = "earth-fixed")]
+#[inline(always)]
+pub(super) fn q30(x: f32) -> i32 {
+    (x * (1u32 << 30) as f32) as i32
+}
+
+/// What the segments over one ground height are evaluated from: the f32 general form's
+/// update (docs/controller.md, "Backends").
+#[cfg(not(feature = "earth-fixed"))]
+pub(super) type Ground = GeneralUpdate<f32>;
+
+/// What the segments over one ground height are evaluated from: the f32 update, which
+/// the steered centre uses, and the same rounded to the fixed-point backend's formats,
+/// which every sample pixel uses (docs/controller.md, "Backends").
+#[cfg(feature = "earth-fixed")]
+pub(super) struct Ground {
+    pub(super) float: GeneralUpdate<f32>,
+    /// None unless [`Controller::fixed_pixels`].
+    pub(super) fixed: Option<core_math::earth::fixed::EarthFixedUpdate>,
+    /// `fixed` turned by the yaw request, for the steered centres; None without a
+    /// request, or where the turn leaves the fixed formats' envelope.
+    yawed: Option<core_math::earth::fixed::EarthFixedUpdate>,
+}
+
+impl Controller {
+    #[cfg(not(feature = "earth-fixed"))]
+    #[inline(always)]
+    pub(super) fn make_ground(
+        &self,
+        instant: &GeneralInstant<f32>,
+        height_m: f32,
+        _steer: Option<(f32, f32, f32)>,
+    ) -> Result<Ground, Fault> {
+        GENERAL_F32
+            .ground(instant, &EARTH, height_m)
+            .map_err(Fault::from)
+    }
+
+    /// The f32 update of the ground and, for fixed-point pixels, the same widened to
+    /// f64 and rounded once to the fixed-point formats: per ground height, not per pixel.
+    #[cfg(feature = "earth-fixed")]
+    pub(super) fn make_ground(
+        &self,
+        instant: &GeneralInstant<f32>,
+        height_m: f32,
+        steer: Option<(f32, f32, f32)>,
+    ) -> Result<Ground, Fault> {
+        let float = GENERAL_F32.ground(instant, &EARTH, height_m)?;
+        let fixed = if self.fixed_pixels() {
+            Some(fixed_update(&float, instant.r2_m2)?)
+        } else {
+            None
+        };
+        let yawed = match (&fixed, steer) {
+            (Some(f), Some((sin, cos, _))) => f.yawed(q30(sin), q30(cos)).ok(),
+            _ => None,
+        };
+        Ok(Ground {
+            float,
+            fixed,
+            yawed,
+        })
+    }
+}
+
+/// `float` rounded to the fixed-point backend's formats, in integers
+/// (`EarthFixed::from_general_f32`: within a unit and 1.7e-9 relative of the same
+/// update widened to f64 and rounded there, which cost soft f64 on the M3).
+#[cfg(feature = "earth-fixed")]
+pub(super) fn fixed_update(
+    float: &GeneralUpdate<f32>,
+    r2_m2: f32,
+) -> Result<core_math::earth::fixed::EarthFixedUpdate, Fault> {
+    Ok(core_math::EARTH_FIXED.from_general_f32(float, r2_m2)?)
+}
+
+#[cfg(not(feature = "earth-fixed"))]
+#[inline(always)]
+pub(super) fn float(g: &Ground) -> &GeneralUpdate<f32> {
+    g
+}
+
+#[cfg(feature = "earth-fixed")]
+#[inline(always)]
+pub(super) fn float(g: &Ground) -> &GeneralUpdate<f32> {
+    &g.float
+}
