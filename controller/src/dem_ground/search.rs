@@ -289,9 +289,10 @@ impl DemGround {
             col,
             drow_dh: ray.jr * ds_dh,
             dcol_dh: ray.jc * ds_dh,
-            // tan^2(theta) = |d|^2 A^2 / disc - 1 (the incidence on the raised
-            // ellipsoid).
-            tan2: ray.uu * big_a * big_a / disc - 1.0,
+            // |d|^2 A^2 / disc is sec^2(theta) on the raised ellipsoid's sphere in
+            // coordinates whose z is stretched by A/B, up to a factor [`TAN2_SHARE`]
+            // bounds: tan^2 bounds the true one above, positive for vertical rays.
+            tan2: ray.uu * big_a * big_a * (1.0 + TAN2_SHARE) / disc - 1.0,
         })
     }
 
