@@ -50,17 +50,12 @@ const EDGE_SHARE: f32 = 0.1;
 pub const TRACE_TOLERANCE_M: f32 = 1.0;
 /// Most evaluations of the march in height.
 pub const MAX_TRACE: u32 = 128;
-/// Share of sec^2(theta) added to the incidence the ray's quadratic gives, so that its
-/// tan^2(theta) bounds the true one above ([`DemGround::locate`]). The quadratic is the
-/// sphere of radius A in coordinates whose z is stretched by kappa = A/B <= 1/(1 - f):
-/// it takes |d|^2 for the stretched direction's |d'|^2 <= kappa^2 |d|^2, and the
-/// stretch turns the direction and the normal each by at most kappa - 1, so that theta
-/// is off by at most eps = 2 (kappa - 1) and sec^2 by at most
-/// 1 / (1 - eps tan(theta) - eps^2 / 2)^2 for tan(theta) <= 3 ([`MAX_TAN2`]): with
-/// WGS 84's f, 1.0067 x 1.0417 = 1.0487, rounded up. Without it a near-vertical ray's
-/// tan^2 came out negative, its march stalled at 1 cm steps and its sample fell back to
-/// the TERRAIN height (docs/controller.md, "The DEM ground").
-const TAN2_SHARE: f32 = 0.05;
+/// Share of sec^2(theta) added to the incidence [`DemGround::locate`] finds, for its
+/// f32 rounding (a few units in the last place): tan^2(theta), and so q, then bounds
+/// the true one above, and stays above zero for a vertical ray (whose q's square root
+/// would otherwise be NaN, stalling the march at its 1 cm floor: docs/controller.md,
+/// "The DEM ground").
+const TAN2_ROUNDING: f32 = 1e-5;
 /// Largest tan^2(theta) for which the tile-edge tests extrapolate along the ray (72 deg
 /// from the vertical; beyond, the march).
 const MAX_TAN2: f32 = 9.0;
