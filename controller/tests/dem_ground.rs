@@ -321,3 +321,58 @@ fn an_uploaded_tile_is_the_ground_of_the_update() {
     // Without the uploaded tile in force the periods would be far off the reference.
     assert!(f.worst_terrain > 10.0 * BUDGET, "{f:?}");
 }
+
+/// The roll slew of [`an_uploaded_tile_is_the_ground_of_the_update`] on a tile twice as
+/// coarse (120 x 120 nodes at 0.04 deg, 4.76 deg wide). The row's far end looks within
+/// a degree of the vertical, at 50 deg of latitude: where the route's incidence once
+/// came out below zero and the march stalled (1.85e-3 off, docs/controller.md).
+#[test]
+fn roll_slew_over_a_wide_tile_matches_the_dem_reference() {
+    let bus = bus(15.0, 0.0, [0.012, -0.002, 0.001]);
+    let tile = tile_at(boresight_ground_deg(&bus), 120, 0.04, smooth);
+    let f = fly(&bus, tile, Ground::Given);
+    report("roll slew, wide tile", &f);
+    let s = f.stats.unwrap();
+    assert!(f.updates >= 90);
+    assert!(s.searched >= 500 && s.outside > 100, "{s:?}");
+    assert!(f.worst_terrain > 10.0 * BUDGET, "{f:?}");
+}
+
+/// The same roll slew over the widest uploadable tile of the bus pass's kind (128 x
+/// 128 nodes at 0.039 deg, 4.95 deg wide) sent through the uplink.
+#[test]
+fn roll_slew_over_a_wide_uploaded_tile_matches_the_dem_reference() {
+    let bus = bus(15.0, 0.0, [0.012, -0.002, 0.001]);
+    let tile = tile_at(boresight_ground_deg(&bus), 128, 0.039, smooth);
+    let f = fly(&bus, tile, Ground::Uploaded);
+    report("roll slew, wide uploaded tile", &f);
+    let s = f.stats.unwrap();
+    assert!(f.updates >= 90);
+    assert!(s.searched >= 500, "{s:?}");
+    assert!(f.worst_terrain > 10.0 * BUDGET, "{f:?}");
+}
+
+/// The stereo pitch of [`stereo_pitch_over_mountains_matches_the_dem_reference`] over
+/// the wide tile.
+#[test]
+fn stereo_pitch_over_a_wide_tile_matches_the_dem_reference() {
+    let bus = bus(5.0, -20.0, [0.002, 0.007, 0.0]);
+    let tile = tile_at(boresight_ground_deg(&bus), 128, 0.039, smooth);
+    let f = fly(&bus, tile, Ground::Given);
+    report("stereo pitch, wide tile", &f);
+    let s = f.stats.unwrap();
+    assert!(s.searched >= 500, "{s:?}");
+    assert!(f.worst_terrain > 10.0 * BUDGET, "{f:?}");
+}
+
+/// Ridges and cliffs on the wide tile in the roll slew of
+/// [`ridges_and_cliffs_go_to_the_march_in_height_and_match_the_dem_reference`].
+#[test]
+fn ridges_and_cliffs_on_a_wide_tile_match_the_dem_reference() {
+    let bus = bus(10.0, -5.0, [0.010, 0.003, 0.0]);
+    let tile = tile_at(boresight_ground_deg(&bus), 128, 0.039, rugged);
+    let f = fly(&bus, tile, Ground::Given);
+    report("roll slew, ridges and cliffs, wide tile", &f);
+    let s = f.stats.unwrap();
+    assert!(s.traced > 100 && s.searched > 100, "{s:?}");
+}

@@ -50,6 +50,12 @@ const EDGE_SHARE: f32 = 0.1;
 pub const TRACE_TOLERANCE_M: f32 = 1.0;
 /// Most evaluations of the march in height.
 pub const MAX_TRACE: u32 = 128;
+/// Share of sec^2(theta) added to the incidence [`DemGround::locate`] finds, for its
+/// f32 rounding (a few units in the last place): tan^2(theta), and so q, then bounds
+/// the true one above, and stays above zero for a vertical ray (whose q's square root
+/// would otherwise be NaN, stalling the march at its 1 cm floor: docs/controller.md,
+/// "The DEM ground").
+const TAN2_ROUNDING: f32 = 1e-5;
 /// Largest tan^2(theta) for which the tile-edge tests extrapolate along the ray (72 deg
 /// from the vertical; beyond, the march).
 const MAX_TAN2: f32 = 9.0;

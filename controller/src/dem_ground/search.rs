@@ -281,7 +281,14 @@ impl DemGround {
         let s = c / (sq - beta);
         let ds_dh = -big_a / sq;
         let x: [f32; 3] = core::array::from_fn(|i| r[i] + s * d[i]);
-        let (row, col) = self.grid_at(big_a / big_b, x)?;
+        let kappa = big_a / big_b;
+        let (row, col) = self.grid_at(kappa, x)?;
+        // The raised ellipsoid's normal at X, (x, y, kappa^2 z): the incidence from the
+        // quadratic's discriminant would be the sphere's in coordinates stretched along
+        // z, short of the true one by up to 0.05 of sec^2, below zero near the vertical.
+        let nz = kappa * kappa * x[2];
+        let dn = d[0] * x[0] + d[1] * x[1] + d[2] * nz;
+        let nn = x[0] * x[0] + x[1] * x[1] + nz * nz;
         Some(Located {
             s,
             ds_dh,
@@ -289,9 +296,8 @@ impl DemGround {
             col,
             drow_dh: ray.jr * ds_dh,
             dcol_dh: ray.jc * ds_dh,
-            // tan^2(theta) = |d|^2 A^2 / disc - 1 (the incidence on the raised
-            // ellipsoid).
-            tan2: ray.uu * big_a * big_a / disc - 1.0,
+            // tan^2(theta) = |d|^2 |n|^2 / (d.n)^2 - 1, raised by its rounding.
+            tan2: ray.uu * nn * (1.0 + TAN2_ROUNDING) / (dn * dn) - 1.0,
         })
     }
 
