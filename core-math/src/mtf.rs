@@ -136,6 +136,30 @@ pub const MAX_STAGE_LIMIT: u32 = 1 << 23;
 /// every count up to a few hundred stages.
 const GUESS_STEPS: u32 = 3;
 
+/// The stage limit from a guess `m` (at most `limit`): down to a count that `meets` the
+/// floor (M = 0 always does: the product is 1), then up while the next count meets it
+/// too, at most [`GUESS_STEPS`] each way; None when that does not settle it (the
+/// bisection then answers).
+#[inline(always)]
+fn settle_guess(mut m: u32, limit: u32, meets: impl Fn(u32) -> bool) -> Option<u32> {
+    let mut ok = m == 0 || meets(m);
+    let mut steps = 0;
+    while !ok && steps < GUESS_STEPS {
+        m -= 1;
+        ok = m == 0 || meets(m);
+        steps += 1;
+    }
+    if ok {
+        for _ in 0..GUESS_STEPS {
+            if m == limit || !meets(m + 1) {
+                return Some(m);
+            }
+            m += 1;
+        }
+    }
+    None
+}
+
 /// The TDI stage limit for one MTF floor: computed once (per scene), used per update.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct StageRule<T> {
@@ -281,31 +305,16 @@ impl<T: Real> StageRule<T> {
         }
         let r = smaller / larger;
         let guess = self.mismatch_budget / (larger * (T::ONE + self.pair_kappa * r * r).sqrt());
-        let mut m = if guess >= T::from_u32(limit) {
+        let m = if guess >= T::from_u32(limit) {
             limit
         } else {
             // guess >= 0: truncation is the floor.
             guess.to_u32()
         };
-        let meets = self.meets_pair(e, t);
-        // Down to a count that meets the floor (M = 0 always does: the product is 1).
-        let mut ok = m == 0 || meets(m);
-        let mut steps = 0;
-        while !ok && steps < GUESS_STEPS {
-            m -= 1;
-            ok = m == 0 || meets(m);
-            steps += 1;
+        match settle_guess(m, limit, self.meets_pair(e, t)) {
+            Some(m) => Ok(m),
+            None => self.max_stages_with_drift_by_bisection(rel_mismatch, tan_drift, stage_limit),
         }
-        if ok {
-            // Up while the next count meets it too.
-            for _ in 0..GUESS_STEPS {
-                if m == limit || !meets(m + 1) {
-                    return Ok(m);
-                }
-                m += 1;
-            }
-        }
-        self.max_stages_with_drift_by_bisection(rel_mismatch, tan_drift, stage_limit)
     }
 
     /// Whether M stages meet the floor under mismatch e and drift tangent t (both >= 0).
@@ -377,7 +386,7 @@ impl<T: Real> StageRule<T> {
 /// main lobe every sinc in Q30 integers instead of soft float, within 5e-9 of
 /// sin(x)/x (docs/fixed-point.md, "The update on the Cortex-M3").
 pub mod int {
-    use super::{smear_mtf, StageRule, GUESS_STEPS, HALF_PI, MAX_STAGE_LIMIT};
+    use super::{settle_guess, smear_mtf, StageRule, HALF_PI, MAX_STAGE_LIMIT};
     use crate::error::ModelError;
     use crate::real::Real;
 
@@ -574,7 +583,7 @@ pub mod int {
             }
             let r = smaller / larger;
             let guess = self.mismatch_budget / (larger * Real::sqrt(1.0 + self.pair_kappa * r * r));
-            let mut m = if guess >= limit as f32 {
+            let m = if guess >= limit as f32 {
                 limit
             } else {
                 guess as u32
@@ -585,22 +594,12 @@ pub mod int {
                 // Past either factor's first zero the product is under every floor.
                 _ => false,
             };
-            let mut ok = m == 0 || meets(m);
-            let mut steps = 0;
-            while !ok && steps < GUESS_STEPS {
-                m -= 1;
-                ok = m == 0 || meets(m);
-                steps += 1;
-            }
-            if ok {
-                for _ in 0..GUESS_STEPS {
-                    if m == limit || !meets(m + 1) {
-                        return Ok(m);
-                    }
-                    m += 1;
+            match settle_guess(m, limit, meets) {
+                Some(m) => Ok(m),
+                None => {
+                    self.max_stages_with_drift_by_bisection(rel_mismatch, tan_drift, stage_limit)
                 }
             }
-            self.max_stages_with_drift_by_bisection(rel_mismatch, tan_drift, stage_limit)
         }
     }
 }
