@@ -8,6 +8,7 @@ use super::{DemGround, Ray, SampleGround, SegmentRays, MAX_TAN2};
 use crate::config::EARTH;
 use crate::track::ItrfFrame;
 use core_math::earth::dem::{DemGrid, DemTile};
+use core_math::vector::{cross, unit};
 use core_math::ModelError;
 
 /// ITRF point of geodetic (lat, lon, h) on WGS 84 (deg, deg, m).
@@ -19,19 +20,6 @@ fn itrf(lat_deg: f64, lon_deg: f64, h_m: f64) -> [f64; 3] {
         (n + h_m) * lat.cos() * lon.cos(),
         (n + h_m) * lat.cos() * lon.sin(),
         (n * (1.0 - e2) + h_m) * lat.sin(),
-    ]
-}
-
-fn unit(x: [f64; 3]) -> [f64; 3] {
-    let n = (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
-    x.map(|v| v / n)
-}
-
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
     ]
 }
 
