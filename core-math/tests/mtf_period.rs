@@ -270,30 +270,37 @@ fn dual_numbers_differentiate_exactly() {
     assert!((f.re - num / (2.0 + t0)).abs() < 1e-16);
 }
 
+/// The combined MTF (mismatch x drift smear) at `m` stages in f64 with libm's sine:
+/// each factor the modulus |sin(x)/x|.
+fn product(m: u32, e: f64, t: f64) -> f64 {
+    let s = |x: f64| {
+        if x == 0.0 {
+            1.0
+        } else {
+            libm::fabs(libm::sin(x) / x)
+        }
+    };
+    let h = std::f64::consts::FRAC_PI_2 * m as f64;
+    s(h * e) * s(h * t)
+}
+
+/// Uniform draws in [0, 1) from a 64-bit LCG seeded with `state` (Knuth's MMIX
+/// constants; the top 53 bits).
+fn uniform(mut state: u64) -> impl FnMut() -> f64 {
+    move || {
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
 /// The stage limit of the combined MTF (mismatch x drift smear) against a brute-force
 /// search in f64 with libm's sine: the count returned meets the floor and the next one
 /// does not (or the limit is reached), over mismatches and drifts from none to large.
 #[test]
 fn stage_limit_with_drift_is_the_largest_count_meeting_the_floor() {
-    // The combined MTF: each factor the modulus |sin(x)/x|.
-    let product = |m: u32, e: f64, t: f64| {
-        let s = |x: f64| {
-            if x == 0.0 {
-                1.0
-            } else {
-                libm::fabs(libm::sin(x) / x)
-            }
-        };
-        let h = std::f64::consts::FRAC_PI_2 * m as f64;
-        s(h * e) * s(h * t)
-    };
-    let mut state = 0x5EED_u64;
-    let mut next = || {
-        state = state
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (state >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut next = uniform(0x5EED_u64);
     let mut checked = 0;
     for floor in [0.25, 0.5, 0.8, 0.9, 0.95, 0.99] {
         let rule = StageRule::<f64>::new(floor).unwrap();
@@ -411,24 +418,7 @@ fn fixed_point_sinc_matches_libm() {
 #[test]
 fn fixed_point_mtf_and_stage_limit_match_libm() {
     use core_math::mtf::int::smear_mtf_pair;
-    let product = |m: u32, e: f64, t: f64| {
-        let s = |x: f64| {
-            if x == 0.0 {
-                1.0
-            } else {
-                libm::fabs(libm::sin(x) / x)
-            }
-        };
-        let h = std::f64::consts::FRAC_PI_2 * m as f64;
-        s(h * e) * s(h * t)
-    };
-    let mut state = 0x5EED_2024_u64;
-    let mut next = || {
-        state = state
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (state >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut next = uniform(0x5EED_2024_u64);
     let (mut worst_mtf, mut differ) = (0f64, 0);
     for floor in [0.25, 0.5, 0.8, 0.9, 0.95, 0.99] {
         let rule32 = StageRule::<f32>::new(floor).unwrap();
