@@ -395,14 +395,7 @@ impl EarthFixedUpdate {
         let n3 = i64::from(self.n[2]);
         let nn30 = ((n3 * n3) as u64 >> 30) as u32;
         let alpha = (1u32 << 30) + ((self.k2m1 as u64 * nn30 as u64) >> 36) as u32;
-        let bb = b31 as u64 * b31 as u64;
-        let ac = alpha as u64 * self.c as u64;
-        if ac > bb {
-            return Err(ModelError::LineOfSightMissesEarth);
-        }
-        let root = sqrt_u64(bb - ac);
-        let num = ((root + b31 as u64) >> 1) as u32;
-        let inv_s = ((num as u64 * self.inv_c as u64) >> 32) as u32;
+        let inv_s = inv_sigma(b31, alpha, self)?;
         let e = |vk: i32| ((vk as i64 * inv_s as i64 + (1 << 30)) >> 31) as i32;
         let [w1, w2, _] = self.w;
         let vf1 = (i64::from(w2) << 30) - (i64::from(e(self.v[0])) << 30);
@@ -546,18 +539,8 @@ impl Backend<Earth> for EarthFixed {
         let nn30 = ((nu30 as i64 * nu30 as i64) as u64 >> 30) as u32;
         // alpha = |u'|^2 + (kappa^2 - 1)(n.u')^2, Q30, < 3.08.
         let alpha = px.uu + ((up.k2m1 as u64 * nn30 as u64) >> 36) as u32;
-        // beta^2 and alpha C, Q62, < 2^63.7 and 2^62.7.
-        let bb = b31 as u64 * b31 as u64;
-        let ac = alpha as u64 * up.c as u64;
-        if ac > bb {
-            return Err(ModelError::LineOfSightMissesEarth);
-        }
-        // sqrt(disc), Q31, <= |beta| + 2 units.
-        let root = sqrt_u64(bb - ac);
-        // (sqrt(disc) + |beta|) / 2 ... as Q30: the numerator of 1/sigma, < 3.56.
-        let num = ((root + b31 as u64) >> 1) as u32;
-        // 1/sigma = num |r|^2/C: Q57 (< 71.2 = 2^63.2), then Q25 (< 2^31.2).
-        let inv_s = ((num as u64 * up.inv_c as u64) >> 32) as u32;
+        // 1/sigma, Q25 (< 2^31.2).
+        let inv_s = inv_sigma(b31, alpha, up)?;
         // V_k / sigma, Q39 x Q25 = Q64 (< 2^61.2), rounded to Q33 (< 0.139 = 2^30.2).
         let e = |vk: i32| ((vk as i64 * inv_s as i64 + (1 << 30)) >> 31) as i32;
         let (e1, e2, e3) = (e(up.v[0]), e(up.v[1]), e(up.v[2]));
@@ -580,6 +563,24 @@ impl Backend<Earth> for EarthFixed {
             v2_mps: I24F40::from_bits(times_focal(vf2, px)),
         })
     }
+}
+
+/// 1/sigma, the near root's reciprocal, in Q25 from |beta| (Q31) and alpha (Q30), with
+/// the update's C and |r|^2/C; a ray whose discriminant is negative misses.
+#[inline(always)]
+fn inv_sigma(b31: u32, alpha: u32, up: &EarthFixedUpdate) -> Result<u32, ModelError> {
+    // beta^2 and alpha C, Q62, < 2^63.7 and 2^62.7.
+    let bb = b31 as u64 * b31 as u64;
+    let ac = alpha as u64 * up.c as u64;
+    if ac > bb {
+        return Err(ModelError::LineOfSightMissesEarth);
+    }
+    // sqrt(disc), Q31, <= |beta| + 2 units.
+    let root = sqrt_u64(bb - ac);
+    // (sqrt(disc) + |beta|) / 2 ... as Q30: the numerator of 1/sigma, < 3.56.
+    let num = ((root + b31 as u64) >> 1) as u32;
+    // 1/sigma = num |r|^2/C: Q57 (< 71.2 = 2^63.2), then Q25 (< 2^31.2).
+    Ok(((num as u64 * up.inv_c as u64) >> 32) as u32)
 }
 
 /// (v/f in Q63) x f as I24F40 bits: x f_mant 2^-e 2^-23, by two 32x32 -> 64 products
