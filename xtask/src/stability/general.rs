@@ -587,18 +587,12 @@ pub fn figures(maps: &[GMap], secs: f64) -> std::collections::BTreeMap<String, S
 
     // Map E by limb-margin band.
     if let Some(e) = maps.iter().find(|m| m.spec.letter == "E") {
-        let bands = [
-            (-2.0, -1.0, "0.01 - 0.1 deg"),
-            (-1.0, 0.0, "0.1 - 1 deg"),
-            (0.0, 1.0, "1 - 10 deg"),
-        ];
-        let rows: Vec<Vec<String>> = bands
-            .iter()
-            .map(|&(lo, hi, name)| row(name, &e.aggregate(|_, y| y >= lo && y < hi)))
-            .collect();
-        let mut header = TABLE_HEADER;
-        header[0] = "limb margin";
-        put("E.band_table", table(&header, &rows));
+        put(
+            "E.band_table",
+            band_table(TABLE_HEADER, |name, lo, hi| {
+                row(name, &e.aggregate(|_, y| y >= lo && y < hi))
+            }),
+        );
         put(
             "E.mid_kappa_min",
             sig(e.aggregate(|_, y| y < 0.0).kappa_min),
@@ -672,4 +666,23 @@ pub fn figures(maps: &[GMap], secs: f64) -> std::collections::BTreeMap<String, S
         }
     }
     v
+}
+
+/// Map E's table by limb-margin band (log10 of the margin in deg, the map's y): the
+/// `row` of each band (its name, y from, y to) under `header`, first column renamed.
+pub fn band_table<const N: usize>(
+    mut header: [&str; N],
+    row: impl Fn(&str, f64, f64) -> Vec<String>,
+) -> String {
+    let bands = [
+        (-2.0, -1.0, "0.01 - 0.1 deg"),
+        (-1.0, 0.0, "0.1 - 1 deg"),
+        (0.0, 1.0, "1 - 10 deg"),
+    ];
+    let rows: Vec<Vec<String>> = bands
+        .iter()
+        .map(|&(lo, hi, name)| row(name, lo, hi))
+        .collect();
+    header[0] = "limb margin";
+    table(&header, &rows)
 }

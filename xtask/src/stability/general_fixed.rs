@@ -354,18 +354,12 @@ pub fn figures(maps: &[FMap], secs: f64) -> std::collections::BTreeMap<String, S
     );
     // Map E by limb-margin band.
     if let Some(e) = maps.iter().find(|m| m.spec.letter == "E") {
-        let bands = [
-            (-2.0, -1.0, "0.01 - 0.1 deg"),
-            (-1.0, 0.0, "0.1 - 1 deg"),
-            (0.0, 1.0, "1 - 10 deg"),
-        ];
-        let rows: Vec<Vec<String>> = bands
-            .iter()
-            .map(|&(lo, hi, name)| row(name, &e.aggregate(|_, y| y >= lo && y < hi)))
-            .collect();
-        let mut header = TABLE_HEADER;
-        header[0] = "limb margin";
-        put("XE.band_table", table(&header, &rows));
+        put(
+            "XE.band_table",
+            super::general::band_table(TABLE_HEADER, |name, lo, hi| {
+                row(name, &e.aggregate(|_, y| y >= lo && y < hi))
+            }),
+        );
     }
     v
 }
