@@ -413,6 +413,9 @@ fn finite3(x: [f64; 3]) -> bool {
 
 impl EarthCamera {
     /// Checks the optics and returns the pixel's focal-plane position (p1, p2) (m).
+    // Out of line: inlined into the plan build and the pixel beside this copy
+    // (docs/target.md, flash).
+    #[inline(never)]
     pub fn focal_plane_m(&self, n_px: f64) -> Result<(f64, f64), ModelError> {
         for (x, p) in [
             (self.focal_m, Param::FocalLength),
