@@ -345,6 +345,12 @@ impl<T: Real> StageRule<T> {
         }
     }
 
+    /// [`StageRule::meets_pair`] at `m`, as a call.
+    #[inline(never)]
+    fn meets_pair_out_of_line(&self, e: T, t: T, m: u32) -> bool {
+        self.meets_pair(e, t)(m)
+    }
+
     /// Whether M stages meet the floor under mismatch e and drift tangent t (both >= 0).
     #[inline(always)]
     fn meets_pair(&self, e: T, t: T) -> impl Fn(u32) -> bool + '_ {
@@ -364,6 +370,9 @@ impl<T: Real> StageRule<T> {
     /// inside the main lobe, where the product falls strictly, so bisection finds the
     /// largest M that meets the floor. Every M returned is checked against the product
     /// itself.
+    // Out of line: the fallback, rarely taken, was inlined with its sincs into the
+    // update (docs/target.md, flash).
+    #[inline(never)]
     pub fn max_stages_with_drift_by_bisection(
         &self,
         rel_mismatch: T,
@@ -376,7 +385,9 @@ impl<T: Real> StageRule<T> {
         let mut lo = self
             .max_stages((e * e + t * t).sqrt(), stage_limit)?
             .min(hi);
-        let meets = self.meets_pair(e, t);
+        // Each test a call: inlined, the unrolled checks and the loop were six copies of
+        // the two sincs (docs/target.md, flash).
+        let meets = |m: u32| self.meets_pair_out_of_line(e, t, m);
         // The lower end's own check (rounding may put it a stage over); M = 0 always
         // meets (the product is 1), the fallback should the bound ever fail.
         for _ in 0..2 {
