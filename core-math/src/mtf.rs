@@ -512,7 +512,13 @@ pub mod int {
     /// in 32 x 32 -> 64 products, within 5e-9 of the exact value (truncation 1.7e-10,
     /// ten roundings of 2^-31, the constants' 2^-31 each; measured:
     /// `core-math/tests/mtf_period.rs`).
-    #[inline(always)]
+    // Out of line on the M3, whose update it is for: two copies inlined there, against
+    // a call per sinc in an update of ~95 000 instructions (docs/target.md, flash).
+    #[cfg_attr(all(target_arch = "arm", not(target_abi = "eabihf")), inline(never))]
+    #[cfg_attr(
+        not(all(target_arch = "arm", not(target_abi = "eabihf"))),
+        inline(always)
+    )]
     pub fn sinc_pi_q30(y_q30: u32) -> i32 {
         let y2 = ((u64::from(y_q30) * u64::from(y_q30)) >> 30) as i32;
         let mut acc = SINC_PI_Q30[9];
