@@ -635,7 +635,7 @@ pub fn check_altitude<S: Real>(c_m2: S, r2: S, eq_m: S) -> Result<(), ModelError
 pub fn circular_state(radius_m: f64, inclination_rad: f64, arg_latitude_rad: f64) -> StateVector {
     let (si, ci) = crate::trig_f64::sin_cos(inclination_rad);
     let (su, cu) = crate::trig_f64::sin_cos(arg_latitude_rad);
-    let speed = libm::sqrt(crate::model::GM_M3_S2 / radius_m);
+    let speed = crate::sqrt::sqrt_f64(crate::model::GM_M3_S2 / radius_m);
     StateVector {
         position_m: [radius_m * cu, radius_m * su * ci, radius_m * su * si],
         velocity_mps: [-speed * su, speed * cu * ci, speed * cu * si],
