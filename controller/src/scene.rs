@@ -96,6 +96,9 @@ impl Scene {
     /// 35 deg half field the far pixel then looks 60 deg off nadir, 4 deg inside the limb
     /// from 800 km), rates up to 1.5 deg/s (an agile imager's stereo and strip
     /// manoeuvres).
+    // Out of line: the boot builds it in two places, and inlined each wrote the whole
+    // table field by field (docs/target.md, flash).
+    #[inline(never)]
     pub fn paper_default() -> Scene {
         let mut segments = [SegmentSpec::default(); MAX_SEGMENTS];
         for (k, s) in segments.iter_mut().take(10).enumerate() {
