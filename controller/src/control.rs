@@ -336,6 +336,9 @@ impl Controller {
         self.update_mode
     }
 
+    // Out of line: inlined into the update, the STATUS report and the firmware's loop
+    // (docs/target.md, flash).
+    #[inline(never)]
     pub(crate) fn mode_at(&self, t_us: u64) -> Mode {
         match (&self.nav, &self.gnss, &self.attitude) {
             (Some(n), _, _) if t_us.saturating_sub(n.time_us) > self.config.stale_after_us => {
