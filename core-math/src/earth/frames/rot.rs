@@ -36,7 +36,9 @@ pub(crate) fn rx(phi: f64, m: &Mat3) -> Mat3 {
     mul(&r, m)
 }
 
-/// R3(psi) m: the frame turned by psi about z (`iauRz`).
+/// R3(psi) m: the frame turned by psi about z (`iauRz`). Out of line: the pole and the
+/// ATTITUDE frame's C2T each inlined it (docs/target.md, flash).
+#[inline(never)]
 pub(crate) fn rz(psi: f64, m: &Mat3) -> Mat3 {
     let (s, c) = crate::trig_f64::sin_cos(psi);
     let r = [[c, s, 0.0], [-s, c, 0.0], [0.0, 0.0, 1.0]];
