@@ -383,6 +383,9 @@ impl Controller {
     /// Segment `index` keeps the output it has in force, flagged held; one with none
     /// (no period under its geometry yet) gets [`SegmentOutput::no_period`], so that
     /// every active segment has a record from the first update with NAV on.
+    // Out of line: a fault's path, inlined at each of its callers in the update
+    // (docs/target.md, flash).
+    #[inline(never)]
     pub(crate) fn hold(&mut self, index: u8) {
         let slot = usize::from(index);
         if let (Some(o), Some(h)) = (self.outputs.get_mut(slot), self.has_output.get_mut(slot)) {
