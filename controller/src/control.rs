@@ -252,6 +252,9 @@ impl Controller {
 
     /// The attitude in force derived again after the mounting or the time scales
     /// changed; dropped (until the next ATTITUDE frame) should it no longer derive.
+    // Out of line: inlined into both its callers, the frame intake and a scene's
+    // install (docs/target.md, flash).
+    #[inline(never)]
     pub(crate) fn rederive_attitude(&mut self) {
         let Some(a) = self.attitude else { return };
         let derived = pole_for(self.pole.as_ref(), a.received.valid_us, &self.time_scales)
