@@ -138,6 +138,9 @@ pub fn encode_time_scales(gps_utc_s: i16, dut1_s: f32, out: &mut [u8]) -> Option
 
 /// Seconds of GPS time of a clock instant (us): whole seconds and the rest apart, so
 /// that nothing beyond the f64's own rounding of the sum is lost.
+// Out of line: its 64-bit split was inlined into three cold callers (docs/target.md,
+// flash).
+#[inline(never)]
 pub fn gps_s(t_us: u64) -> f64 {
     (t_us / 1_000_000) as f64 + (t_us % 1_000_000) as f64 * 1e-6
 }

@@ -252,6 +252,9 @@ impl Controller {
 
     /// The attitude in force derived again after the mounting or the time scales
     /// changed; dropped (until the next ATTITUDE frame) should it no longer derive.
+    // Out of line: inlined into both its callers, the frame intake and a scene's
+    // install (docs/target.md, flash).
+    #[inline(never)]
     pub(crate) fn rederive_attitude(&mut self) {
         let Some(a) = self.attitude else { return };
         let derived = pole_for(self.pole.as_ref(), a.received.valid_us, &self.time_scales)
@@ -336,6 +339,9 @@ impl Controller {
         self.update_mode
     }
 
+    // Out of line: inlined into the update, the STATUS report and the firmware's loop
+    // (docs/target.md, flash).
+    #[inline(never)]
     pub(crate) fn mode_at(&self, t_us: u64) -> Mode {
         match (&self.nav, &self.gnss, &self.attitude) {
             (Some(n), _, _) if t_us.saturating_sub(n.time_us) > self.config.stale_after_us => {
@@ -380,6 +386,9 @@ impl Controller {
     /// Segment `index` keeps the output it has in force, flagged held; one with none
     /// (no period under its geometry yet) gets [`SegmentOutput::no_period`], so that
     /// every active segment has a record from the first update with NAV on.
+    // Out of line: a fault's path, inlined at each of its callers in the update
+    // (docs/target.md, flash).
+    #[inline(never)]
     pub(crate) fn hold(&mut self, index: u8) {
         let slot = usize::from(index);
         if let (Some(o), Some(h)) = (self.outputs.get_mut(slot), self.has_output.get_mut(slot)) {

@@ -422,7 +422,7 @@ pub fn period_bounds_s(scene: &Scene, config: &Config) -> (f32, f32) {
     let r_min = EARTH.b_m() + h_lo;
     let r_max = EARTH.a_m + h_hi;
     let w = EARTH_RATE_RAD_S;
-    let v_max = libm::sqrt(MAX_SPEED2_RATIO * mu / r_min);
+    let v_max = core_math::sqrt_f64(MAX_SPEED2_RATIO * mu / r_min);
     let nu_max = v_max / r_min;
     let rates = 3.0 * f64::from(scene.envelope.max_rate_rad_s);
     let d_min = r_min - (EARTH.a_m + f64::from(MAX_GROUND_H_M));
@@ -433,12 +433,12 @@ pub fn period_bounds_s(scene: &Scene, config: &Config) -> (f32, f32) {
         for n in [s.first_px, s.last_px] {
             let p1 = f64::from(s.p1_m);
             let p2 = f64::from(n) * scene.camera.pixel_m;
-            u_max = u_max.max(libm::sqrt(p1 * p1 + p2 * p2 + f * f));
+            u_max = u_max.max(core_math::sqrt_f64(p1 * p1 + p2 * p2 + f * f));
             t1_max = t1_max.max(libm::fabs(p1 / f));
         }
     }
     let g_max = (nu_max + w + rates) * u_max + (v_max + w * r_max) * u_max / d_min;
-    let v_fast = g_max * libm::sqrt(1.0 + t1_max * t1_max);
+    let v_fast = g_max * core_math::sqrt_f64(1.0 + t1_max * t1_max);
     let fastest = scene.camera.pixel_m / v_fast;
     let slowest = f64::from(u32::MAX) / scene.line_clock_hz;
     (fastest as f32, slowest as f32)

@@ -96,6 +96,9 @@ impl Scene {
     /// 35 deg half field the far pixel then looks 60 deg off nadir, 4 deg inside the limb
     /// from 800 km), rates up to 1.5 deg/s (an agile imager's stereo and strip
     /// manoeuvres).
+    // Out of line: the boot builds it in two places, and inlined each wrote the whole
+    // table field by field (docs/target.md, flash).
+    #[inline(never)]
     pub fn paper_default() -> Scene {
         let mut segments = [SegmentSpec::default(); MAX_SEGMENTS];
         for (k, s) in segments.iter_mut().take(10).enumerate() {
@@ -187,7 +190,7 @@ impl Scene {
             && e.max_rate_rad_s.is_finite()
             && (0.0..=MAX_ENVELOPE_RATE_RAD_S).contains(&e.max_rate_rad_s);
         let q = self.mounting_q.map(f64::from);
-        let norm = libm::sqrt(q.iter().map(|x| x * x).sum::<f64>());
+        let norm = core_math::sqrt_f64(q.iter().map(|x| x * x).sum::<f64>());
         if !(libm::fabs(norm - 1.0) <= core_math::earth::bus::MAX_QUATERNION_NORM_ERROR) {
             return Err(Fault::BadQuaternion);
         }
@@ -206,7 +209,7 @@ impl Scene {
         // tangent b / sqrt(S^2 - b^2), S = a + h, that the off-axis angles' tangents are
         // compared with (no arc sine or arctangent: docs/target.md, flash).
         let (b, big_s) = (ellipsoid.b_m(), ellipsoid.a_m + altitude_max_m);
-        let tan_limb = b / libm::sqrt((big_s - b) * (big_s + b));
+        let tan_limb = b / core_math::sqrt_f64((big_s - b) * (big_s + b));
         let f = self.camera.focal_m;
         // Segments are chips of one array: in order along it, none overlapping another.
         let mut previous_last: Option<i32> = None;
@@ -227,7 +230,7 @@ impl Scene {
                 let (p1, p2) = camera
                     .focal_plane_m(f64::from(n))
                     .map_err(|_| Fault::InvalidScene)?;
-                let tan_off_axis = libm::sqrt(p1 * p1 + p2 * p2) / f;
+                let tan_off_axis = core_math::sqrt_f64(p1 * p1 + p2 * p2) / f;
                 if !(tan_off_axis < tan_limb) {
                     return Err(Fault::InvalidScene);
                 }

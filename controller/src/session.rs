@@ -225,6 +225,9 @@ impl Out<'_> {
     /// Encodes one frame of `payload` (None: it could not be encoded) with the next
     /// sequence number and hands it to `send`; counts a frame that could not be encoded,
     /// and one that `send` refused.
+    // Out of line: inlined into the firmware's loop beside this copy (docs/target.md,
+    // flash).
+    #[inline(never)]
     fn send<R: Sent>(
         self,
         kind: u8,

@@ -66,6 +66,9 @@ pub struct AttitudeState {
 /// The pole to use at `t_us`: `pole` when it is within [`POLE_MAX_AGE_S`] of it, else
 /// a new one (kept by the caller once the frame is accepted). Refusals: a time outside
 /// C2T's domain (`fix_time`).
+// Out of line: the ATTITUDE check and the re-derivation after a new pole each
+// inlined it (docs/target.md, flash).
+#[inline(never)]
 pub fn pole_for(
     pole: Option<&CelestialPole>,
     t_us: u64,

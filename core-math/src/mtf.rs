@@ -141,23 +141,51 @@ const GUESS_STEPS: u32 = 3;
 /// too, at most [`GUESS_STEPS`] each way; None when that does not settle it (the
 /// bisection then answers).
 #[inline(always)]
-fn settle_guess(mut m: u32, limit: u32, meets: impl Fn(u32) -> bool) -> Option<u32> {
-    let mut ok = m == 0 || meets(m);
-    let mut steps = 0;
-    while !ok && steps < GUESS_STEPS {
-        m -= 1;
-        ok = m == 0 || meets(m);
-        steps += 1;
+fn settle_guess(m: u32, limit: u32, meets: impl Fn(u32) -> bool) -> Option<u32> {
+    // The usual case inline: the guess meets the floor and one stage more does not.
+    // The steps either way out of line: `meets` is inlined (two sincs), and unrolled
+    // they were six more copies of it in the update (docs/target.md, flash).
+    if (m == 0 || meets(m)) && (m == limit || !meets(m + 1)) {
+        return Some(m);
     }
-    if ok {
-        for _ in 0..GUESS_STEPS {
-            if m == limit || !meets(m + 1) {
+    settle_guess_by_steps(m, limit, meets)
+}
+
+/// [`settle_guess`] from the start, a step at a time.
+#[inline(never)]
+fn settle_guess_by_steps(mut m: u32, limit: u32, meets: impl Fn(u32) -> bool) -> Option<u32> {
+    // Down while m fails, then up while m + 1 meets, in one loop with one call of
+    // `meets`, which is inlined.
+    let (mut down, mut steps) = (true, 0);
+    loop {
+        let probe = if down {
+            m
+        } else if m == limit {
+            return Some(m);
+        } else {
+            m + 1
+        };
+        let ok = probe == 0 || meets(probe);
+        if down {
+            if ok {
+                (down, steps) = (false, 0);
+                continue;
+            }
+            if steps == GUESS_STEPS {
+                return None;
+            }
+            m -= 1;
+        } else {
+            if !ok {
                 return Some(m);
             }
             m += 1;
         }
+        steps += 1;
+        if !down && steps == GUESS_STEPS {
+            return None;
+        }
     }
-    None
 }
 
 /// The TDI stage limit for one MTF floor: computed once (per scene), used per update.
@@ -317,6 +345,12 @@ impl<T: Real> StageRule<T> {
         }
     }
 
+    /// [`StageRule::meets_pair`] at `m`, as a call.
+    #[inline(never)]
+    fn meets_pair_out_of_line(&self, e: T, t: T, m: u32) -> bool {
+        self.meets_pair(e, t)(m)
+    }
+
     /// Whether M stages meet the floor under mismatch e and drift tangent t (both >= 0).
     #[inline(always)]
     fn meets_pair(&self, e: T, t: T) -> impl Fn(u32) -> bool + '_ {
@@ -336,6 +370,9 @@ impl<T: Real> StageRule<T> {
     /// inside the main lobe, where the product falls strictly, so bisection finds the
     /// largest M that meets the floor. Every M returned is checked against the product
     /// itself.
+    // Out of line: the fallback, rarely taken, was inlined with its sincs into the
+    // update (docs/target.md, flash).
+    #[inline(never)]
     pub fn max_stages_with_drift_by_bisection(
         &self,
         rel_mismatch: T,
@@ -348,7 +385,9 @@ impl<T: Real> StageRule<T> {
         let mut lo = self
             .max_stages((e * e + t * t).sqrt(), stage_limit)?
             .min(hi);
-        let meets = self.meets_pair(e, t);
+        // Each test a call: inlined, the unrolled checks and the loop were six copies of
+        // the two sincs (docs/target.md, flash).
+        let meets = |m: u32| self.meets_pair_out_of_line(e, t, m);
         // The lower end's own check (rounding may put it a stage over); M = 0 always
         // meets (the product is 1), the fallback should the bound ever fail.
         for _ in 0..2 {
@@ -473,7 +512,13 @@ pub mod int {
     /// in 32 x 32 -> 64 products, within 5e-9 of the exact value (truncation 1.7e-10,
     /// ten roundings of 2^-31, the constants' 2^-31 each; measured:
     /// `core-math/tests/mtf_period.rs`).
-    #[inline(always)]
+    // Out of line on the M3, whose update it is for: two copies inlined there, against
+    // a call per sinc in an update of ~95 000 instructions (docs/target.md, flash).
+    #[cfg_attr(all(target_arch = "arm", not(target_abi = "eabihf")), inline(never))]
+    #[cfg_attr(
+        not(all(target_arch = "arm", not(target_abi = "eabihf"))),
+        inline(always)
+    )]
     pub fn sinc_pi_q30(y_q30: u32) -> i32 {
         let y2 = ((u64::from(y_q30) * u64::from(y_q30)) >> 30) as i32;
         let mut acc = SINC_PI_Q30[9];
@@ -598,6 +643,37 @@ pub mod int {
                 Some(m) => Ok(m),
                 None => {
                     self.max_stages_with_drift_by_bisection(rel_mismatch, tan_drift, stage_limit)
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{settle_guess, GUESS_STEPS};
+
+    /// The guess settled for a floor met by the counts 0..=k exactly, every guess and
+    /// limit up to 12, against the rule in words: the answer min(k, limit) when the
+    /// guess is at most GUESS_STEPS above k or at most GUESS_STEPS - 1 below the
+    /// answer, None otherwise. Both the inline usual case and the stepwise rest.
+    #[test]
+    fn settle_guess_follows_its_rule() {
+        for k in 0..=12u32 {
+            for limit in 0..=12u32 {
+                for m in 0..=limit {
+                    let answer = k.min(limit);
+                    let expect = if m > k {
+                        (m - k <= GUESS_STEPS).then_some(answer)
+                    } else {
+                        (answer - m < GUESS_STEPS).then_some(answer)
+                    };
+                    let meets = |n: u32| n <= k;
+                    assert_eq!(
+                        settle_guess(m, limit, meets),
+                        expect,
+                        "k {k}, limit {limit}, guess {m}"
+                    );
                 }
             }
         }

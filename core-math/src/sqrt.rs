@@ -41,8 +41,18 @@ pub fn sqrt_f32(x: f32) -> f32 {
 }
 
 /// sqrt(x), correctly rounded; NaN for x < 0 as IEEE 754 says (callers check first).
+/// Without the FPU a call: inlined, libm's software loop was one more copy in each
+/// caller (docs/target.md, flash).
 #[cfg(not(all(target_arch = "arm", target_abi = "eabihf")))]
-#[inline(always)]
+#[inline(never)]
 pub fn sqrt_f32(x: f32) -> f32 {
     libm::sqrtf(x)
+}
+
+/// sqrt(x) in f64, libm's (correctly rounded), as a call: the cold paths that take
+/// square roots in f64 (the plan build, the scene's checks) share one copy instead of
+/// fat LTO inlining the soft-float routine into each (docs/target.md, flash).
+#[inline(never)]
+pub fn sqrt_f64(x: f64) -> f64 {
+    libm::sqrt(x)
 }

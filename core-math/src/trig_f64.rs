@@ -148,6 +148,9 @@ fn reduce(x: f64, ix: u32) -> Option<(i32, f64, f64)> {
 
 /// (sin x, cos x), bit for bit libm's `sincos` for |x| < [`SIN_COS_LIMIT_RAD`]; NaN
 /// beyond, for infinities and for NaN.
+// Out of line: fat LTO inlined it into the plan build and the pole beside this copy
+// (docs/target.md, flash); soft-float f64 dwarfs the call.
+#[inline(never)]
 pub fn sin_cos(x: f64) -> (f64, f64) {
     let ix = high_word(x) & 0x7fff_ffff;
     if ix <= 0x3fe9_21fb {

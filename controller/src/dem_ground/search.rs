@@ -361,8 +361,13 @@ impl DemGround {
     }
 
     /// The bilinear height at grid coordinates in the tile, and its derivatives per row
-    /// and per column.
-    #[inline(always)]
+    /// and per column. Out of line without an FPU: there a call is lost in the soft
+    /// float of the route, and inlined it was three copies (docs/target.md, flash).
+    #[cfg_attr(all(target_arch = "arm", not(target_abi = "eabihf")), inline(never))]
+    #[cfg_attr(
+        not(all(target_arch = "arm", not(target_abi = "eabihf"))),
+        inline(always)
+    )]
     pub(super) fn bilinear(&self, heights: &[i16], row: f32, col: f32) -> (f32, f32, f32) {
         let t = &self.frame;
         let i = (row as u32).min(t.last_row_cell);

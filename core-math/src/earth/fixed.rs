@@ -99,6 +99,9 @@ pub struct EarthFixedUpdate {
 
 /// x 2^frac rounded to nearest, refused as `err` unless |x| <= max. The caller's `max`
 /// keeps the result within i32 (checked in debug builds).
+// Out of line: with its soft-float rounding it was inlined into the plan build
+// (docs/target.md, flash).
+#[inline(never)]
 fn to_q(x: f64, frac: i32, max: f64, err: ModelError) -> Result<i32, ModelError> {
     if !(x.abs() <= max) {
         return Err(err);
@@ -109,6 +112,8 @@ fn to_q(x: f64, frac: i32, max: f64, err: ModelError) -> Result<i32, ModelError>
 }
 
 /// As [`to_q`] for a value known to lie in [0, max] with max 2^frac < 2^32.
+/// Out of line as [`to_q`].
+#[inline(never)]
 fn to_uq(x: f64, frac: i32) -> u32 {
     let q = libm::round(x * libm::ldexp(1.0, frac));
     debug_assert!((0.0..4_294_967_296.0).contains(&q), "{x} UQ{frac}");

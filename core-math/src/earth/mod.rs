@@ -413,6 +413,9 @@ fn finite3(x: [f64; 3]) -> bool {
 
 impl EarthCamera {
     /// Checks the optics and returns the pixel's focal-plane position (p1, p2) (m).
+    // Out of line: inlined into the plan build and the pixel beside this copy
+    // (docs/target.md, flash).
+    #[inline(never)]
     pub fn focal_plane_m(&self, n_px: f64) -> Result<(f64, f64), ModelError> {
         for (x, p) in [
             (self.focal_m, Param::FocalLength),
@@ -590,6 +593,9 @@ impl<A: AttitudeChecks> GeometryParts<'_, A> {
 /// plane (r x v not below 1e-6 |r| |v|: a flight path within a microradian of the
 /// vertical is degenerate for every scalar, so f32 and f64 agree on it). Returns |r|^2
 /// and the angular momentum r x v (never zero after the check).
+// Out of line on a core without an FPU only: on the M4F inlined it measured smaller
+// and faster (docs/target.md, flash).
+#[cfg_attr(all(target_arch = "arm", not(target_abi = "eabihf")), inline(never))]
 pub fn check_state<S: Real>(r: [S; 3], v: [S; 3]) -> Result<(S, [S; 3]), ModelError> {
     let (r2, v2) = (dot(r, r), dot(v, v));
     // Squared bounds: no square root.
@@ -629,7 +635,7 @@ pub fn check_altitude<S: Real>(c_m2: S, r2: S, eq_m: S) -> Result<(), ModelError
 pub fn circular_state(radius_m: f64, inclination_rad: f64, arg_latitude_rad: f64) -> StateVector {
     let (si, ci) = crate::trig_f64::sin_cos(inclination_rad);
     let (su, cu) = crate::trig_f64::sin_cos(arg_latitude_rad);
-    let speed = libm::sqrt(crate::model::GM_M3_S2 / radius_m);
+    let speed = crate::sqrt::sqrt_f64(crate::model::GM_M3_S2 / radius_m);
     StateVector {
         position_m: [radius_m * cu, radius_m * su * ci, radius_m * su * si],
         velocity_mps: [-speed * su, speed * cu * ci, speed * cu * si],

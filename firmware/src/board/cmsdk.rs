@@ -458,6 +458,9 @@ impl<const ADDR: usize, const PCLK_HZ: u32> FreeRunning<ADDR, PCLK_HZ> {
 }
 
 impl<const ADDR: usize, const PCLK_HZ: u32> Monotonic for FreeRunning<ADDR, PCLK_HZ> {
+    // Out of line: the loop reads the clock in several places, and inlined each was a
+    // copy of the 64-bit extension (docs/target.md, flash).
+    #[inline(never)]
     fn now_us(&mut self) -> u64 {
         let ticks = self.ticks.update(Self::elapsed(&self.regs));
         ticks / Self::TICKS_PER_US

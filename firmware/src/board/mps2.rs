@@ -125,9 +125,27 @@ unsafe fn NonMaskableInt() {
     cortex_m::peripheral::SCB::sys_reset()
 }
 
+/// The number of device interrupt lines of the board's NVIC (QEMU 7.2: `info qtree`
+/// gives the `armv7m_nvic` of both machines `num-irq = 48`).
+const NVIC_LINES: usize = 48;
+
+extern "C" {
+    /// cortex-m-rt's name for the handler below.
+    fn DefaultHandler();
+}
+
+/// The device part of the vector table, one entry per NVIC line, all to
+/// [`DefaultHandler`] (cortex-m-rt's feature `device`, which the board features enable,
+/// takes it from here): without it cortex-m-rt puts 240, 768 bytes of flash more for
+/// lines this board does not have (docs/target.md, flash).
+#[link_section = ".vector_table.interrupts"]
+#[no_mangle]
+#[used]
+static __INTERRUPTS: [unsafe extern "C" fn(); NVIC_LINES] = [DefaultHandler; NVIC_LINES];
+
 /// Every device interrupt. The MPS2 has no peripheral access crate to name its
-/// vectors, so cortex-m-rt's default vector table sends them all here with their
-/// number; only UART0's receive and transmit interrupts are ever unmasked. (`unsafe` because
+/// vectors, so the vector table above sends them all here with their number; only
+/// UART0's receive and transmit interrupts are ever unmasked. (`unsafe` because
 /// cortex-m-rt asks it of a `DefaultHandler`; nothing in it is.)
 #[cortex_m_rt::exception]
 unsafe fn DefaultHandler(irqn: i16) {

@@ -213,6 +213,9 @@ pub struct Tim5Clock {
 }
 
 impl Monotonic for Tim5Clock {
+    // Out of line: the loop reads the clock in several places, and inlined each was a
+    // copy of the 64-bit extension (docs/target.md, flash).
+    #[inline(never)]
     fn now_us(&mut self) -> u64 {
         self.ticks.update(self.counter.now().ticks())
     }

@@ -8,7 +8,8 @@
 //! P03 adjustments), s from `iauS06` (truncated), ERA from `iauEra00` and s' from
 //! `iauSp00`. Against `iauC2t06a` (IAU 2000A nutation, full s) its error, the angle of
 //! the rotation C2T^T C2T_sofa, stays below [`C2T_TOLERANCE_RAD`] over 2000-2050:
-//! IAU 2000B's 1 mas (5e-9 rad) dominates, the truncation of s adds 5e-11 rad at most.
+//! IAU 2000B's 1 mas (5e-9 rad) dominates, the truncation of s adds 3.5e-10 rad at
+//! most.
 
 use super::cio::s06;
 use super::era::{era00, sp00};

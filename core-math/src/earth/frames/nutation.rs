@@ -21,7 +21,9 @@ const DEPLAN: f64 = 0.388 * ARCSEC_TO_RAD / 1.0e3;
 /// f64 table bit for bit.
 type Term = ([i8; 5], [i32; 4], [i16; 2]);
 
-/// The 77 luni-solar terms of `iauNut00b`, in SOFA's order.
+/// The 77 luni-solar terms of `iauNut00b`, in SOFA's order: the transcription. The
+/// flight binary holds them as [`PACKED`] (and [`TERM1`]), 18 bytes a term instead of 28
+/// (docs/target.md, flash); [`unpack`] gives them back.
 #[rustfmt::skip]
 pub const TERMS: [Term; 77] = [
     // 1-10
@@ -111,6 +113,57 @@ pub const TERMS: [Term; 77] = [
     ([ 1, 1, 2,-2, 2], [1_290, 0, 0, -556], [0, 0]),
 ];
 
+/// Terms 2-77 by columns: each multiplier plus 2 in three bits (l in bits 0-2, l' 3-5,
+/// F 6-8, D 9-11, Om 12-14: SOFA's multipliers here lie in -2..=4); the two large
+/// coefficients (longitude sin, obliquity cos) as i32; the other four as i16. Term 1
+/// alone needs more than 16 bits for two of those four: it is [`TERM1`].
+pub struct Packed {
+    multipliers: [u16; 76],
+    large: [[i32; 2]; 76],
+    small: [[i16; 4]; 76],
+}
+
+/// Term 1 of [`TERMS`], as transcribed.
+const TERM1: Term = TERMS[0];
+
+/// [`TERMS`] 2-77 packed at compile time; a value that does not fit stops the build.
+pub static PACKED: Packed = pack(&TERMS);
+
+const fn pack(terms: &[Term; 77]) -> Packed {
+    let mut p = Packed {
+        multipliers: [0; 76],
+        large: [[0; 2]; 76],
+        small: [[0; 4]; 76],
+    };
+    let mut i = 0;
+    while i < 76 {
+        let (n, c, d) = terms[i + 1];
+        let mut m = 0u16;
+        let mut j = 0;
+        while j < 5 {
+            assert!(n[j] >= -2 && n[j] <= 5, "a multiplier outside three bits");
+            m |= ((n[j] + 2) as u16) << (3 * j);
+            j += 1;
+        }
+        p.multipliers[i] = m;
+        p.large[i] = [c[0], c[3]];
+        assert!(
+            c[1] as i16 as i32 == c[1] && c[2] as i16 as i32 == c[2],
+            "beyond i16"
+        );
+        p.small[i] = [c[1] as i16, c[2] as i16, d[0], d[1]];
+        i += 1;
+    }
+    p
+}
+
+/// A term of [`PACKED`] unpacked: the integers of [`TERMS`].
+#[inline(always)]
+fn unpack(m: u16, [c0, c3]: [i32; 2], [c1, c2, d0, d1]: [i16; 4]) -> Term {
+    let n = [0, 1, 2, 3, 4].map(|j| ((m >> (3 * j)) & 7) as i8 - 2);
+    (n, [c0, i32::from(c1), i32::from(c2), c3], [d0, d1])
+}
+
 /// The five Delaunay arguments l, l', F, D, Om (rad) at `t` Julian centuries TT since
 /// J2000.0, linear in t (Simon et al. 1994), as `iauNut00b` computes them.
 pub fn delaunay(t: f64) -> [f64; 5] {
@@ -144,14 +197,27 @@ pub(crate) fn argument(n: &[i8; 5], fa: &[f64; 5]) -> f64 {
 pub fn nut00b(t: f64) -> (f64, f64) {
     let fa = delaunay(t);
     let (mut dp, mut de) = (0.0, 0.0);
-    for (n, c, d) in TERMS.iter().rev() {
-        let (sarg, carg) = crate::trig_f64::sin_cos(argument(n, &fa));
-        let [c0, c1, c2, c3] = c.map(f64::from);
-        let [c4, c5] = d.map(f64::from);
-        dp += (c0 + c1 * t) * sarg + c2 * carg;
-        de += (c3 + c4 * t) * carg + c5 * sarg;
+    let packed = PACKED
+        .multipliers
+        .iter()
+        .zip(&PACKED.large)
+        .zip(&PACKED.small);
+    for ((m, large), small) in packed.rev() {
+        add_term(&unpack(*m, *large, *small), t, &fa, &mut dp, &mut de);
     }
+    add_term(&TERM1, t, &fa, &mut dp, &mut de);
     (dp * U2R + DPPLAN, de * U2R + DEPLAN)
+}
+
+/// One term's part of (dpsi, deps) added, in 0.1 microarcsecond. Out of line, so that
+/// the loop's last iteration (term 1, from [`TERM1`]) is not a second copy of it.
+#[inline(never)]
+fn add_term((n, c, d): &Term, t: f64, fa: &[f64; 5], dp: &mut f64, de: &mut f64) {
+    let (sarg, carg) = crate::trig_f64::sin_cos(argument(n, fa));
+    let [c0, c1, c2, c3] = c.map(f64::from);
+    let [c4, c5] = d.map(f64::from);
+    *dp += (c0 + c1 * t) * sarg + c2 * carg;
+    *de += (c3 + c4 * t) * carg + c5 * sarg;
 }
 
 /// IAU 2000B nutation with the P03 adjustments of `iauNut06a` (J2's secular variation
@@ -161,4 +227,26 @@ pub fn nut06b(t: f64) -> (f64, f64) {
     let (dp, de) = nut00b(t);
     let fj2 = -2.7774e-6 * t;
     (dp + dp * (0.4697e-6 + fj2), de + de * fj2)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The packed table gives back every term of the transcription.
+    #[test]
+    fn packed_terms_are_the_transcription() {
+        assert_eq!(TERM1, TERMS[0]);
+        let packed = PACKED
+            .multipliers
+            .iter()
+            .zip(&PACKED.large)
+            .zip(&PACKED.small);
+        let mut k = 1;
+        for ((m, large), small) in packed {
+            assert_eq!(unpack(*m, *large, *small), TERMS[k], "term {}", k + 1);
+            k += 1;
+        }
+        assert_eq!(k, TERMS.len());
+    }
 }

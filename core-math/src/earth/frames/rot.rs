@@ -12,10 +12,21 @@ pub(crate) const IDENTITY: Mat3 = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 
 /// controller's attitude chain), kept out of line so that it stays one copy.
 #[inline(never)]
 pub fn mul(a: &Mat3, b: &Mat3) -> Mat3 {
-    let col = |j: usize| [b[0][j], b[1][j], b[2][j]];
-    let (c0, c1, c2) = (col(0), col(1), col(2));
-    let row = |r: [f64; 3]| [dot(r, c0), dot(r, c1), dot(r, c2)];
-    [row(a[0]), row(a[1]), row(a[2])]
+    let mut m = [[0.0; 3]; 3];
+    for (m_row, a_row) in m.iter_mut().zip(a) {
+        for (j, m_ij) in m_row.iter_mut().enumerate() {
+            *m_ij = row_dot_column(a_row, b, j);
+        }
+    }
+    m
+}
+
+/// Row `r` times column `j` of `b`, the same sum as [`dot`]. Out of line: inlined, the
+/// nine soft-float dot products were most of [`mul`]'s size (docs/target.md, flash),
+/// and no controller update multiplies matrices.
+#[inline(never)]
+fn row_dot_column(r: &[f64; 3], b: &Mat3, j: usize) -> f64 {
+    dot(*r, [b[0][j], b[1][j], b[2][j]])
 }
 
 /// R1(phi) m: the frame turned by phi about x (`iauRx`).
@@ -25,7 +36,9 @@ pub(crate) fn rx(phi: f64, m: &Mat3) -> Mat3 {
     mul(&r, m)
 }
 
-/// R3(psi) m: the frame turned by psi about z (`iauRz`).
+/// R3(psi) m: the frame turned by psi about z (`iauRz`). Out of line: the pole and the
+/// ATTITUDE frame's C2T each inlined it (docs/target.md, flash).
+#[inline(never)]
 pub(crate) fn rz(psi: f64, m: &Mat3) -> Mat3 {
     let (s, c) = crate::trig_f64::sin_cos(psi);
     let r = [[c, s, 0.0], [-s, c, 0.0], [0.0, 0.0, 1.0]];

@@ -82,6 +82,8 @@ impl TimeScales {
     /// `gps_utc_s` outside 0..=[`MAX_GPS_UTC_S`], [`ModelError::OutOfDomain`]`(LeapSeconds)`;
     /// |`dut1_s`| >= 0.9 s, [`ModelError::InvalidInput`]`(Dut1)` (UTC is defined within
     /// 0.9 s of UT1).
+    // Out of line: a cold check inlined into four callers (docs/target.md, flash).
+    #[inline(never)]
     pub fn validate(&self) -> Result<(), ModelError> {
         if !self.gps_utc_s.is_finite() {
             return Err(ModelError::NonFinite(Param::LeapSeconds));
