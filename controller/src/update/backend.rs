@@ -14,15 +14,12 @@ impl Controller {
         extremes(update, seg)
     }
 
-    /// The segment's [`Extremes`] by the configured backend.
+    /// The segment's [`Extremes`] in f32: with fixed-point pixels, only the DEM's route
+    /// comes here (the others take [`Controller::segment_fixed`]).
     #[cfg(feature = "earth-fixed")]
     #[inline(always)]
     pub(super) fn extremes(&self, update: &Ground, seg: &SegmentPlan) -> Result<Extremes, Fault> {
-        if self.fixed_pixels() {
-            extremes_fixed(update, seg)
-        } else {
-            extremes(&update.float, seg)
-        }
+        extremes(&update.float, seg)
     }
 
     /// The MTF at `stages` under the mismatch `worst` and the drift tangent `tan_max`,
@@ -136,7 +133,8 @@ impl Controller {
             // The pair in I24F40 units: only its ratio is used.
             (Some(up), Some(px)) => {
                 let m = core_math::EARTH_FIXED.motion(up, px)?;
-                Ok((m.v2_mps.to_bits() as f32, m.v1_mps.to_bits() as f32))
+                let f = |bits: i64| super::fixed::i64_to_f32(bits, 0);
+                Ok((f(m.v2_mps.to_bits()), f(m.v1_mps.to_bits())))
             }
             _ => {
                 let m = steered_centre(&update.float, seg, sin, cos)?;
@@ -176,7 +174,10 @@ impl Controller {
             Ok(Ground { fixed: Some(f), .. }) => {
                 f.boresight_over_focal().ok().and_then(|(vf1, vf2)| {
                     // Q63 rad/s, below 2^63: their squares stay inside f32's range.
-                    let (v1, v2) = (vf1 as f32, vf2 as f32);
+                    let (v1, v2) = (
+                        super::fixed::i64_to_f32(vf1, 0),
+                        super::fixed::i64_to_f32(vf2, 0),
+                    );
                     steer_from(v1, v2, atan_pair_rad(v2, v1))
                 })
             }

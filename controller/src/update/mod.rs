@@ -191,6 +191,10 @@ impl Controller {
         steer: Option<(f32, f32, f32)>,
         dem: Option<&Extremes>,
     ) -> Result<SegmentOutput, Fault> {
+        #[cfg(feature = "earth-fixed")]
+        if dem.is_none() && self.fixed_pixels() {
+            return self.segment_fixed(update, seg, steer);
+        }
         // |v1| extremes and the largest |v2/v1| over the samples and the centre; every
         // one must move the same way along P1 (one transfer direction per segment). In
         // forward flight the image moves towards -P1 (the ground runs backwards under
@@ -291,11 +295,17 @@ fn i64_to_f32(x: i64) -> f32 {
 
 mod backend;
 mod dem;
+#[cfg(feature = "earth-fixed")]
+mod fixed;
 mod sweep;
 
 use backend::*;
+#[cfg(feature = "earth-fixed")]
+use fixed::*;
 pub use sweep::drift_angle_rad;
 use sweep::*;
 
+#[cfg(all(test, feature = "earth-fixed"))]
+mod fixed_tests;
 #[cfg(test)]
 mod tests;

@@ -86,14 +86,13 @@ pub(super) fn sweep(
     Ok(e)
 }
 
-/// The [`Extremes`] of the centre and the samples by the fixed-point backend
+/// The extremes of the centre and the samples by the fixed-point backend
 /// (`SegmentPlan::fixed`: the centre first), integer only per pixel: v1's extremes
 /// compared as I24F40 bits, the largest |v2/v1| by cross-multiplying the bits' magnitudes
-/// (exact in u128). Widened to f32 once, at the end: the per-segment work after it is
-/// the f32 path's.
+/// (exact in u128).
 #[cfg(feature = "earth-fixed")]
 #[inline(never)]
-pub(super) fn extremes_fixed(g: &Ground, seg: &SegmentPlan) -> Result<Extremes, Fault> {
+pub(super) fn extremes_fixed(g: &Ground, seg: &SegmentPlan) -> Result<ExtremesBits, Fault> {
     use core_math::EARTH_FIXED;
     let Some(up) = &g.fixed else {
         return Err(Fault::InvalidScene);
@@ -115,18 +114,13 @@ pub(super) fn extremes_fixed(g: &Ground, seg: &SegmentPlan) -> Result<Extremes, 
             (d2, d1) = (a2, a1);
         }
     }
-    // I24F40 bits to m/s: exact to f32's rounding (|v| < 2^23 m/s).
-    const LSB_MPS: f32 = 1.0 / (1u64 << 40) as f32;
-    let mps = |bits: i64| bits as f32 * LSB_MPS;
-    Ok(Extremes {
-        centre: ImageMotion {
-            v1_mps: mps(c1),
-            v2_mps: mps(c2),
-        },
-        lo: mps(lo),
-        hi: mps(hi),
-        drift_v2: d2 as f32 * LSB_MPS,
-        drift_v1: d1 as f32 * LSB_MPS,
+    Ok(ExtremesBits {
+        c1,
+        c2,
+        lo,
+        hi,
+        d2,
+        d1,
     })
 }
 

@@ -1,0 +1,239 @@
+//! The fixed route's period arithmetic against u64/u128 and f64 computations.
+extern crate std;
+use super::fixed::*;
+use core_math::sample::SplitMix64;
+
+/// x 2^e, drawn over every magnitude a caller may pass.
+fn draw_u64(rng: &mut SplitMix64) -> u64 {
+    let x = rng.next_u64();
+    x >> (rng.next_u64() % 64)
+}
+
+fn value(w: Wide) -> f64 {
+    let (m, e) = w.parts();
+    m as f64 * libm::exp2(f64::from(e))
+}
+
+/// The hand conversions give exactly what the software conversion and the product by
+/// the power of two give.
+#[test]
+fn integer_to_f32_is_the_rounded_conversion() {
+    let mut rng = SplitMix64(0x5EED_2026_1127_0001);
+    let lsb = 1.0 / (1u64 << 40) as f32;
+    let check = |x: i64| {
+        assert_eq!(i64_to_f32(x, 0).to_bits(), (x as f32).to_bits(), "{x}");
+        assert_eq!(
+            i64_to_f32(x, -40).to_bits(),
+            (x as f32 * lsb).to_bits(),
+            "{x}"
+        );
+        let u = x.unsigned_abs();
+        assert_eq!(u64_to_f32(u, -40).to_bits(), (u as f32 * lsb).to_bits());
+    };
+    for _ in 0..1_000_000 {
+        let x = draw_u64(&mut rng) as i64;
+        check(x);
+        check(x.wrapping_neg());
+        // Ties: 24 significant bits and a half.
+        let lz = (rng.next_u64() % 39) as u32;
+        let tie = (((rng.next_u64() >> 40) | (1 << 23)) << 1 | 1) << (39 - lz);
+        check(tie as i64);
+    }
+    for x in [
+        0,
+        1,
+        -1,
+        i64::MAX,
+        i64::MIN,
+        1 << 40,
+        (1 << 24) - 1,
+        (1 << 25) - 1,
+    ] {
+        check(x);
+    }
+}
+
+/// Each operation against the same on the exact values in f64 (or u128): within one
+/// truncation of 2^-31 relative, two for the sum and the difference.
+#[test]
+fn wide_operations_match_f64() {
+    let mut rng = SplitMix64(0x5EED_2026_1127_0002);
+    let ulp = libm::exp2(-31.0);
+    for _ in 0..300_000 {
+        let (x, y) = (draw_u64(&mut rng).max(1), draw_u64(&mut rng).max(1));
+        let (ex, ey) = (
+            (rng.next_u64() % 81) as i32 - 40,
+            (rng.next_u64() % 81) as i32 - 40,
+        );
+        let (a, b) = (Wide::from_u64(x, ex), Wide::from_u64(y, ey));
+        let (va, vb) = (
+            x as f64 * libm::exp2(f64::from(ex)),
+            y as f64 * libm::exp2(f64::from(ey)),
+        );
+        let close = |got: Wide, want: f64, k: f64, what: &str| {
+            let g = value(got);
+            assert!(
+                libm::fabs(g - want) <= k * ulp * want,
+                "{what}: {g:e} vs {want:e} ({x} 2^{ex}, {y} 2^{ey})"
+            );
+        };
+        close(a, va, 1.0, "from_u64");
+        // Each input's truncation, then the operation's.
+        close(a.mul(b), va * vb, 3.0, "mul");
+        close(a.div(b), va / vb, 3.0, "div");
+        close(a.recip(), 1.0 / va, 2.0, "recip");
+        close(a.add(b), va + vb, 4.0, "add");
+        assert_eq!(a.gt(b), value(a) > value(b));
+        let d = a.abs_diff(b);
+        let want = libm::fabs(value(a) - value(b));
+        assert!(
+            libm::fabs(value(d) - want) <= 2.0 * ulp * value(a).max(value(b)),
+            "abs_diff {} vs {want}",
+            value(d)
+        );
+        // To f32: the exact value (32 bits, exact in f64) rounded once.
+        assert_eq!(a.to_f32().to_bits(), (value(a) as f32).to_bits());
+        // 2^32 times, truncated, saturating.
+        let q = value(a) * libm::exp2(32.0);
+        let want_q = if q >= libm::exp2(64.0) {
+            u64::MAX
+        } else {
+            q as u64
+        };
+        assert_eq!(a.q32(), want_q);
+    }
+    for x in [1.0f32, 0.5, 3.0, 1e-30, 1.5e30, f32::MAX, f32::MIN_POSITIVE] {
+        let w = Wide::from_f32(x).unwrap();
+        assert_eq!(value(w), f64::from(x));
+        assert_eq!(w.to_f32(), x);
+        let bits = f32_to_i24f40(x);
+        let want = f64::from(x) * libm::exp2(40.0);
+        let want = if want >= libm::exp2(64.0) {
+            u64::MAX
+        } else {
+            want as u64
+        };
+        assert_eq!(bits, want, "{x}");
+    }
+    assert_eq!(Wide::from_f32(-1.0), None);
+    assert_eq!(Wide::from_f32(f32::NAN), None);
+    assert_eq!(Wide::from_f32(0.0), Some(Wide::ZERO));
+    assert_eq!(f32_to_i24f40(f32::INFINITY), 0);
+    assert_eq!(Wide::ZERO.to_f32(), 0.0);
+}
+
+/// The 64 / 32 division against u64's, at random and at the edges of its domain.
+#[test]
+fn division_by_32_bits_is_exact() {
+    let mut rng = SplitMix64(0x5EED_2026_1127_0003);
+    let check = |hi: u32, lo: u32, d: u32| {
+        let n = (u64::from(hi) << 32) | u64::from(lo);
+        assert_eq!(
+            u64::from(div_64_32(hi, lo, d)),
+            n / u64::from(d),
+            "{n} / {d}"
+        );
+    };
+    for _ in 0..2_000_000 {
+        let d = (rng.next_u64() as u32) | (1 << 31);
+        let hi = (rng.next_u64() as u32) % d;
+        check(hi, rng.next_u64() as u32, d);
+        // Quotient digits at their corrections' edges.
+        check(d - 1, u32::MAX, d);
+        check(hi, 0, d);
+    }
+    for d in [1 << 31, u32::MAX, 0x8000_ffff, 0xffff_0000] {
+        for hi in [0, d - 1, d >> 1] {
+            for lo in [0, u32::MAX, 1 << 31] {
+                check(hi, lo, d);
+            }
+        }
+    }
+}
+
+/// The period, its ticks and the worst mismatch against the f32 route's formulas
+/// evaluated in f64 on the same extremes: the ticks the nearest to the f64 count (half
+/// up), except where its fraction lies within 1e-8 relative of a half; the mismatch
+/// within 4e-9 of the speed ratio (five truncations of 2^-31) plus its f32 rounding.
+#[test]
+fn period_and_mismatch_match_f64() {
+    let mut rng = SplitMix64(0x5EED_2026_1127_0004);
+    let mut worst = 0f64;
+    let mut cases = (0, 0, 0);
+    for _ in 0..300_000 {
+        let pixel = (libm::exp(rng.uniform(-13.0, -9.0))) as f32;
+        let clock = (libm::exp(rng.uniform(12.0, 20.0))) as f32;
+        let v_max = libm::exp(rng.uniform(-12.0, 3.0));
+        let v_min = v_max * rng.uniform(0.2, 1.0);
+        let (min_bits, max_bits) = (
+            (v_min * libm::exp2(40.0)) as u64,
+            (v_max * libm::exp2(40.0)) as u64,
+        );
+        if min_bits == 0 {
+            continue;
+        }
+        let interp = (v_min * libm::exp(rng.uniform(-16.0, 0.5))) as f32;
+        let interp_bits = f32_to_i24f40(interp);
+        let (lo_s, hi_s) = (
+            (rng.uniform(1e-7, 1e-4)) as f32,
+            (rng.uniform(1e-3, 100.0)) as f32,
+        );
+        let w = |x: f32| Wide::from_f32(x).unwrap();
+        let got = period_fixed(
+            min_bits,
+            max_bits,
+            interp_bits,
+            w(pixel).mul(w(clock)),
+            (w(lo_s).mul(w(clock)), w(hi_s).mul(w(clock))),
+        );
+        let (vmin, vmax) = (
+            min_bits as f64 * libm::exp2(-40.0),
+            max_bits as f64 * libm::exp2(-40.0),
+        );
+        let line = f64::from(pixel) * f64::from(clock);
+        let exact = 0.5 * line * (1.0 / vmin + 1.0 / vmax);
+        let (lo_t, hi_t) = (
+            f64::from(lo_s) * f64::from(clock),
+            f64::from(hi_s) * f64::from(clock),
+        );
+        let margin = 1e-8 * exact;
+        if exact < lo_t - margin || exact > hi_t + margin || exact + 0.5 >= 4_294_967_296.0 {
+            assert!(got.is_err(), "{exact} outside [{lo_t}, {hi_t}]: {got:?}");
+            cases.0 += 1;
+            continue;
+        }
+        if exact < lo_t + margin || exact > hi_t - margin || exact < 0.5 {
+            continue;
+        }
+        let p = got.expect("inside the bounds");
+        let frac = exact - libm::floor(exact);
+        if libm::fabs(frac - 0.5) > margin {
+            assert_eq!(f64::from(p.ticks), libm::floor(exact + 0.5), "{exact}");
+        }
+        let ticks = f64::from(p.ticks);
+        let interp_v = interp_bits as f64 * libm::exp2(-40.0);
+        let (v_lo, v_hi) = (vmin - interp_v, vmax + interp_v);
+        match p.worst_mismatch {
+            Some(m) => {
+                assert!(v_lo > 0.0);
+                let (r_lo, r_hi) = (line / (ticks * v_lo), line / (ticks * v_hi));
+                let want = libm::fabs(r_lo - 1.0).max(libm::fabs(1.0 - r_hi));
+                let got = f64::from(m.to_f32());
+                let bound = 4e-9 * r_lo.max(1.0) + 0.5 * f64::from(f32::EPSILON) * want;
+                let err = libm::fabs(got - want);
+                assert!(err <= bound, "mismatch {got:e} vs {want:e}");
+                worst = worst.max(err / bound);
+                cases.1 += 1;
+            }
+            None => {
+                assert!(v_lo <= 0.0, "{v_lo}");
+                cases.2 += 1;
+            }
+        }
+    }
+    assert!(
+        cases.0 > 1_000 && cases.1 > 100_000 && cases.2 > 1_000,
+        "{cases:?}"
+    );
+    std::eprintln!("period_fixed: {cases:?} (refused, checked, unbounded); worst mismatch error / bound {worst:.3}");
+}
