@@ -517,7 +517,9 @@ pub mod int {
         let s = sinc_pi_q30(f as u32).max(0) as u64;
         // f s in Q60 (< 2^60) over y in Q30: Q30, below 1/pi. For y below 2^32 (4),
         // both shifted until y's leading one is at bit 31, for the 64 / 32 division in
-        // the core's divide (a 64-bit division is a software call).
+        // the core's divide (a 64-bit division is a software call): the exact floor.
+        // Beyond, in [`Wide`]: a quotient below 2^28 within three truncations of 2^-31,
+        // under one unit.
         let fs = f * s;
         match u32::try_from(y) {
             Ok(y32) => {
@@ -525,7 +527,11 @@ pub mod int {
                 let n = fs << lz;
                 Some(div_64_32((n >> 32) as u32, n as u32, y32 << lz) as i32)
             }
-            Err(_) => Some(fs.checked_div(y).unwrap_or(0) as i32),
+            Err(_) => Some(
+                Wide::from_u64(fs, 0)
+                    .div(Wide::from_u64(y, 0))
+                    .to_u64_scaled(0) as i32,
+            ),
         }
     }
 
