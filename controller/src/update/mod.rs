@@ -29,6 +29,17 @@ impl Controller {
         cfg!(feature = "fixed-only") || self.config.fixed_point_pixels
     }
 
+    /// The attitude's sine and cosine: in integers with fixed-point pixels (a core
+    /// without an FPU, where each f32 operation is a software call), else in f32.
+    #[inline(always)]
+    fn sin_cos(&self, x: f32) -> (f32, f32) {
+        #[cfg(feature = "earth-fixed")]
+        if self.fixed_pixels() {
+            return core_math::trig::sin_cos_int(x);
+        }
+        core_math::trig::sin_cos_f32(x)
+    }
+
     /// Moves the clock to `now_us` (from the time source) and runs the update that is due,
     /// if any, writing periods to `sink`. Returns true when an update ran.
     pub fn advance<S: LinePeriodSink>(&mut self, now_us: u64, sink: &mut S) -> bool {
@@ -76,12 +87,13 @@ impl Controller {
                 let dt_s = seconds_since(t_us, nav.time_us);
                 let state = nav.propagator.parts_at(dt_s);
                 let attitude = attitude_at(&nav.attitude, dt_s);
-                GENERAL_F32.instant_parts(
+                GENERAL_F32.instant_parts_by(
                     state.position_m,
                     state.velocity_mps,
                     state.r2_minus_a2_m2,
                     &attitude,
                     EARTH_RATE_RAD_S as f32,
+                    |x| self.sin_cos(x),
                 )
             }
             (None, Some(gnss), Some(attitude)) if self.update_mode != Mode::Stale => {
