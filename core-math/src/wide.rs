@@ -99,10 +99,12 @@ impl Wide {
         Wide::ONE.div(self)
     }
 
-    /// The larger of the two first, by exponent then mantissa (both normalised).
+    /// `self` > `o`: by exponent then mantissa (both normalised; zero's exponent is
+    /// below every other), as one 64-bit comparison of e 2^32 + m.
     #[inline(always)]
     pub fn gt(self, o: Wide) -> bool {
-        (self.e, self.m) > (o.e, o.m)
+        let key = |w: Wide| (i64::from(w.e) << 32) | i64::from(w.m);
+        key(self) > key(o)
     }
 
     #[inline(always)]
@@ -187,26 +189,26 @@ impl Wide {
 
 /// (`hi` 2^32 + `lo`) / `d`, truncated, for `d` >= 2^31 and `hi` < `d` (so the quotient
 /// fits 32 bits): two 16-bit digits by the core's 32-bit divide (Knuth's algorithm D,
-/// as Hacker's Delight's `divlu`), where a 64-bit division is a software call.
+/// with the remainder in i64), where a 64-bit division is a software call.
 #[inline(always)]
 pub fn div_64_32(hi: u32, lo: u32, d: u32) -> u32 {
-    let (d1, d0) = (d >> 16, d & 0xffff);
+    let d1 = d >> 16;
     // One quotient digit of (`top` 2^16 + `next`) / d, and the remainder; `top` < d.
+    // The estimate from d's top half, capped at 2^16 - 1, is at most 2 above the digit
+    // (d normalised: Knuth's theorem B); the remainder then corrects it, in i64.
     let digit = |top: u32, next: u32| -> (u32, u32) {
-        let mut q = top.checked_div(d1).unwrap_or(0);
-        let mut r = top - q * d1;
-        while q >= 1 << 16 || q * d0 > (r << 16) + next {
+        let mut q = top.checked_div(d1).unwrap_or(0).min(0xffff);
+        let n = (i64::from(top) << 16) | i64::from(next);
+        let mut rem = n - i64::from(q) * i64::from(d);
+        if rem < 0 {
             q -= 1;
-            r += d1;
-            if r >= 1 << 16 {
-                break;
+            rem += i64::from(d);
+            if rem < 0 {
+                q -= 1;
+                rem += i64::from(d);
             }
         }
-        // The remainder is below d: exact modulo 2^32.
-        let rem = (top << 16)
-            .wrapping_add(next)
-            .wrapping_sub(q.wrapping_mul(d));
-        (q, rem)
+        (q, rem as u32)
     };
     let (q1, rem) = digit(hi, lo >> 16);
     let (q0, _) = digit(rem, lo & 0xffff);
