@@ -102,7 +102,9 @@ impl Controller {
         if self.fixed_pixels() {
             let centre_rad = atan_pair_rad(centre.v2_mps, centre.v1_mps);
             let worst_rad = atan_pair_rad(drift.0, drift.1);
-            let worst_rad = if worst_rad < centre_rad.abs() {
+            // Both >= 0 (or NaN): their bits order as their values, without the
+            // software comparison.
+            let worst_rad = if worst_rad.to_bits() < centre_rad.abs().to_bits() {
                 centre_rad.abs()
             } else {
                 worst_rad
@@ -277,7 +279,10 @@ pub(super) struct Ground {
     pub(super) fixed: Option<core_math::earth::fixed::EarthFixedUpdate>,
     /// `fixed` turned by the yaw request, for the steered centres; None without a
     /// request, or where the turn leaves the fixed formats' envelope.
-    yawed: Option<core_math::earth::fixed::EarthFixedUpdate>,
+    pub(super) yawed: Option<core_math::earth::fixed::EarthFixedUpdate>,
+    /// The plan's line speed (pixel x clock, m/s) and period bounds in ticks, for
+    /// [`Controller::segment_fixed`]: once per ground, not per segment.
+    pub(super) period: PeriodConsts,
 }
 
 impl Controller {
@@ -317,6 +322,7 @@ impl Controller {
             float,
             fixed,
             yawed,
+            period: PeriodConsts::of(&self.plan),
         })
     }
 }

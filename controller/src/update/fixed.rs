@@ -39,6 +39,28 @@ pub(super) fn f32_to_i24f40(x: f32) -> u64 {
     Wide::from_f32(x).map_or(0, |w| w.to_u64_scaled(40))
 }
 
+/// The plan's constants of [`period_fixed`].
+#[derive(Clone, Copy)]
+pub(super) struct PeriodConsts {
+    /// pixel x clock (m/s).
+    line_speed: Wide,
+    /// The physical period bounds times the clock (ticks).
+    bounds_ticks: (Wide, Wide),
+}
+
+impl PeriodConsts {
+    #[inline(always)]
+    pub(super) fn of(plan: &crate::plan::Plan) -> PeriodConsts {
+        let wide = |x: f32| Wide::from_f32(x).unwrap_or(Wide::ZERO);
+        let clock = wide(plan.line_clock_hz);
+        let (lo_s, hi_s) = plan.period_bounds_s;
+        PeriodConsts {
+            line_speed: wide(plan.pixel_m).mul(clock),
+            bounds_ticks: (wide(lo_s).mul(clock), wide(hi_s).mul(clock)),
+        }
+    }
+}
+
 /// What the period and the mismatch come out as: the ticks and the worst relative
 /// mismatch, None when the image is slower than the interpolation bound.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -131,16 +153,12 @@ impl Controller {
         if v_min <= 0 {
             return Err(Fault::PeriodOutOfRange);
         }
-        let plan = &self.plan;
-        let wide = |x: f32| Wide::from_f32(x).unwrap_or(Wide::ZERO);
-        let clock = wide(plan.line_clock_hz);
-        let (lo_s, hi_s) = plan.period_bounds_s;
         let p = period_fixed(
             v_min as u64,
             v_max as u64,
             f32_to_i24f40(seg.interpolation_mps),
-            wide(plan.pixel_m).mul(clock),
-            (wide(lo_s).mul(clock), wide(hi_s).mul(clock)),
+            update.period.line_speed,
+            update.period.bounds_ticks,
         )?;
         // |v2| / |v1| (|v1| >= v_min > 0).
         let tan_max = Wide::from_u64(e.d2, 0)
@@ -155,17 +173,30 @@ impl Controller {
             }
             None => (f32::MAX, 0.0, 0),
         };
-        let residual = match steer {
-            Some((sin, cos, _)) => Some(self.steered_centre(update, seg, sin, cos)?),
-            None => None,
+        // The drift angles from the integer pairs; the worst never below the centre's
+        // magnitude (both >= 0: their bits order as their values).
+        let signed = |v2: i64, v1: i64| {
+            atan_ratio_rad(v2.unsigned_abs(), v1.unsigned_abs(), (v2 < 0) != (v1 < 0))
         };
-        let centre = ImageMotion {
-            v1_mps: i64_to_f32(e.c1, -40),
-            v2_mps: i64_to_f32(e.c2, -40),
+        let drift_rad = signed(e.c2, e.c1);
+        let worst_drift_rad = atan_ratio_rad(e.d2, e.d1, false);
+        let worst_drift_rad = if worst_drift_rad.to_bits() < drift_rad.abs().to_bits() {
+            drift_rad.abs()
+        } else {
+            worst_drift_rad
         };
-        let drift = (u64_to_f32(e.d2, -40), u64_to_f32(e.d1, -40));
-        let [drift_rad, worst_drift_rad, residual_drift_rad] =
-            self.drift_angles(&centre, drift, tan_max, residual);
+        let residual_drift_rad = match (steer, &update.yawed, seg.fixed.first()) {
+            (None, _, _) => drift_rad,
+            // The centre on the turned fixed-point update, in integers.
+            (Some(_), Some(up), Some(px)) => {
+                let m = core_math::EARTH_FIXED.motion(up, px)?;
+                signed(m.v2_mps.to_bits(), m.v1_mps.to_bits())
+            }
+            (Some((sin, cos, _)), _, _) => {
+                let m = steered_centre(&update.float, seg, sin, cos)?;
+                atan_pair_rad(m.v2_mps, m.v1_mps)
+            }
+        };
         Ok(SegmentOutput {
             index: seg.index,
             ticks: p.ticks,

@@ -143,8 +143,11 @@ impl Controller {
             };
             let index = seg.index;
             let height_m = self.height(index);
-            // NaN never equals: the first segment makes the first ground.
-            if height_m != ground_h_m {
+            // NaN never equals: the first segment makes the first ground. Compared as
+            // bits (no software comparison on a core without an FPU): a NaN has no
+            // height's bits, and -0 against 0 only makes the same ground again.
+            let bits = ground_h_m.to_bits();
+            if height_m.to_bits() != bits || bits & 0x7fff_ffff > 0x7f80_0000 {
                 ground = self.make_ground(&instant, height_m, steer);
                 ground_h_m = height_m;
             }

@@ -210,6 +210,38 @@ pub(super) fn atan_pair_rad(num: f32, den: f32) -> f32 {
     }
 }
 
+/// atan(`num` / `den`) (rad) of two integer magnitudes, negated when `negative`: the
+/// ratio of the smaller over the larger in [`Wide`], truncated to Q30, then
+/// [`atan_pair_rad`]'s polynomial and rounding (docs/fixed-point.md, "The update on the
+/// Cortex-M3"). A zero `den`: [`atan_pair_rad`] of the two as f32.
+#[cfg(feature = "earth-fixed")]
+#[inline(never)]
+pub(super) fn atan_ratio_rad(num: u64, den: u64, negative: bool) -> f32 {
+    use core_math::wide::Wide;
+    if den == 0 {
+        let sign = if negative { -1.0 } else { 1.0 };
+        return atan_pair_rad(u64_to_f32(num, 0), sign * u64_to_f32(den, 0));
+    }
+    let (small, big, past_one) = if num <= den {
+        (num, den, false)
+    } else {
+        (den, num, true)
+    };
+    // <= 1 in Q30.
+    let r = Wide::from_u64(small, 0)
+        .div(Wide::from_u64(big, 0))
+        .to_u64_scaled(30)
+        .min(1 << 30) as i32;
+    let at = atan_unit_q30(r);
+    let q = if past_one { HALF_PI_Q30 - at } else { at };
+    let rad = q30_to_f32(q.max(0) as u32);
+    if negative {
+        -rad
+    } else {
+        rad
+    }
+}
+
 #[cfg(feature = "earth-fixed")]
 #[cold]
 #[inline(never)]
