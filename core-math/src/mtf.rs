@@ -527,11 +527,7 @@ pub mod int {
                 let n = fs << lz;
                 Some(div_64_32((n >> 32) as u32, n as u32, y32 << lz) as i32)
             }
-            Err(_) => Some(
-                Wide::from_u64(fs, 0)
-                    .div(Wide::from_u64(y, 0))
-                    .to_u64_scaled(0) as i32,
-            ),
+            Err(_) => Some((Wide::from_u64(fs, 0) / Wide::from_u64(y, 0)).to_u64_scaled(0) as i32),
         }
     }
 
@@ -701,13 +697,13 @@ pub mod int {
         fn guess_int(&self, larger: f32, smaller: f32, limit: u32) -> u32 {
             let w = |x: f32| Wide::from_f32(x).unwrap_or(Wide::ZERO);
             let (l, s) = (w(larger), w(smaller));
-            let den = l.mul(l).add(w(self.pair_kappa).mul(s.mul(s)));
+            let den = l * l + w(self.pair_kappa) * (s * s);
             if den.is_zero() {
                 // L below f32's normals: the f32 guess is infinite.
                 return limit;
             }
             let b = w(self.mismatch_budget);
-            let q = b.mul(b).div(den).to_u64_scaled(0);
+            let q = (b * b / den).to_u64_scaled(0);
             let lim = u64::from(limit);
             if q >= lim * lim {
                 limit

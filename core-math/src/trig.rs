@@ -124,9 +124,7 @@ pub fn sin_cos_int(x: f32) -> (f32, f32) {
         acc
     };
     // S and C in [0.7, 1]: positive.
-    let s_r = Wide::from_u64(r_abs, -60)
-        .mul(Wide::from_u64(horner(&SIN_Q30) as u64, -30))
-        .to_f32();
+    let s_r = (Wide::from_u64(r_abs, -60) * Wide::from_u64(horner(&SIN_Q30) as u64, -30)).to_f32();
     let s_r = if r < 0 { -s_r } else { s_r };
     let c_r = Wide::from_u64(horner(&COS_Q30) as u64, -30).to_f32();
     let (s, c) = match k {

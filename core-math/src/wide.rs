@@ -60,43 +60,8 @@ impl Wide {
     }
 
     #[inline(always)]
-    pub fn mul(self, o: Wide) -> Wide {
-        if self.m == 0 || o.m == 0 {
-            return Wide::ZERO;
-        }
-        // In [2^62, 2^64).
-        let p = u64::from(self.m) * u64::from(o.m);
-        let top = (p >> 63) as u32;
-        Wide {
-            m: (p >> (31 + top)) as u32,
-            e: self.e + o.e + 31 + top as i32,
-        }
-    }
-
-    /// `self` / `o`; `o` not 0 (0 for a 0 divisor, which no caller passes).
-    #[inline(always)]
-    pub fn div(self, o: Wide) -> Wide {
-        if self.m == 0 || o.m == 0 {
-            return Wide::ZERO;
-        }
-        // The quotient of the mantissas scaled into [2^31, 2^32): m 2^32 / o.m when
-        // m < o.m, else m 2^31 / o.m (the high word then below o.m either way).
-        if self.m < o.m {
-            Wide {
-                m: div_64_32(self.m, 0, o.m),
-                e: self.e - o.e - 32,
-            }
-        } else {
-            Wide {
-                m: div_64_32(self.m >> 1, self.m << 31, o.m),
-                e: self.e - o.e - 31,
-            }
-        }
-    }
-
-    #[inline(always)]
     pub fn recip(self) -> Wide {
-        Wide::ONE.div(self)
+        Wide::ONE / self
     }
 
     /// `self` > `o`: by exponent then mantissa (both normalised; zero's exponent is
@@ -105,15 +70,6 @@ impl Wide {
     pub fn gt(self, o: Wide) -> bool {
         let key = |w: Wide| (i64::from(w.e) << 32) | i64::from(w.m);
         key(self) > key(o)
-    }
-
-    #[inline(always)]
-    pub fn add(self, o: Wide) -> Wide {
-        let (a, b) = if o.gt(self) { (o, self) } else { (self, o) };
-        let d = (a.e - b.e) as u32;
-        // The larger's leading one at bit 62: the sum stays below 2^64.
-        let sum = (u64::from(a.m) << 31) + (u64::from(b.m) << 31).checked_shr(d).unwrap_or(0);
-        Wide::from_u64(sum, a.e - 31)
     }
 
     /// |`self` - `o`|.
@@ -184,6 +140,61 @@ impl Wide {
                 f32::from_bits(bits)
             }
         }
+    }
+}
+impl core::ops::Mul for Wide {
+    type Output = Wide;
+
+    #[inline(always)]
+    fn mul(self, o: Wide) -> Wide {
+        if self.m == 0 || o.m == 0 {
+            return Wide::ZERO;
+        }
+        // In [2^62, 2^64).
+        let p = u64::from(self.m) * u64::from(o.m);
+        let top = (p >> 63) as u32;
+        Wide {
+            m: (p >> (31 + top)) as u32,
+            e: self.e + o.e + 31 + top as i32,
+        }
+    }
+}
+
+impl core::ops::Div for Wide {
+    type Output = Wide;
+
+    /// `self` / `o`; `o` not 0 (0 for a 0 divisor, which no caller passes).
+    #[inline(always)]
+    fn div(self, o: Wide) -> Wide {
+        if self.m == 0 || o.m == 0 {
+            return Wide::ZERO;
+        }
+        // The quotient of the mantissas scaled into [2^31, 2^32): m 2^32 / o.m when
+        // m < o.m, else m 2^31 / o.m (the high word then below o.m either way).
+        if self.m < o.m {
+            Wide {
+                m: div_64_32(self.m, 0, o.m),
+                e: self.e - o.e - 32,
+            }
+        } else {
+            Wide {
+                m: div_64_32(self.m >> 1, self.m << 31, o.m),
+                e: self.e - o.e - 31,
+            }
+        }
+    }
+}
+
+impl core::ops::Add for Wide {
+    type Output = Wide;
+
+    #[inline(always)]
+    fn add(self, o: Wide) -> Wide {
+        let (a, b) = if o.gt(self) { (o, self) } else { (self, o) };
+        let d = (a.e - b.e) as u32;
+        // The larger's leading one at bit 62: the sum stays below 2^64.
+        let sum = (u64::from(a.m) << 31) + (u64::from(b.m) << 31).checked_shr(d).unwrap_or(0);
+        Wide::from_u64(sum, a.e - 31)
     }
 }
 

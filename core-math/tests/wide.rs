@@ -39,10 +39,10 @@ fn wide_operations_match_f64() {
         };
         close(a, va, 1.0, "from_u64");
         // Each input's truncation, then the operation's.
-        close(a.mul(b), va * vb, 3.0, "mul");
-        close(a.div(b), va / vb, 3.0, "div");
+        close(a * b, va * vb, 3.0, "mul");
+        close(a / b, va / vb, 3.0, "div");
         close(a.recip(), 1.0 / va, 2.0, "recip");
-        close(a.add(b), va + vb, 4.0, "add");
+        close(a + b, va + vb, 4.0, "add");
         assert_eq!(a.gt(b), value(a) > value(b));
         let d = a.abs_diff(b);
         let want = libm::fabs(value(a) - value(b));

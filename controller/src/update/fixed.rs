@@ -55,8 +55,8 @@ impl PeriodConsts {
         let clock = wide(plan.line_clock_hz);
         let (lo_s, hi_s) = plan.period_bounds_s;
         PeriodConsts {
-            line_speed: wide(plan.pixel_m).mul(clock),
-            bounds_ticks: (wide(lo_s).mul(clock), wide(hi_s).mul(clock)),
+            line_speed: wide(plan.pixel_m) * clock,
+            bounds_ticks: (wide(lo_s) * clock, wide(hi_s) * clock),
         }
     }
 }
@@ -86,7 +86,7 @@ pub(super) fn period_fixed(
     let v_min = Wide::from_u64(v_min_bits, -40);
     let v_max = Wide::from_u64(v_max_bits, -40);
     // The mean of the extremes' periods, in ticks.
-    let exact = line_speed.scale(-1).mul(v_min.recip().add(v_max.recip()));
+    let exact = line_speed.scale(-1) * (v_min.recip() + v_max.recip());
     let (lo, hi) = bounds_ticks;
     if line_speed.is_zero() || v_min.is_zero() || lo.gt(exact) || exact.gt(hi) {
         return Err(Fault::PeriodOutOfRange);
@@ -104,7 +104,7 @@ pub(super) fn period_fixed(
         Some(v_lo) if v_lo > 0 => {
             let v_hi = v_max_bits.saturating_add(interpolation_bits);
             let t = Wide::from_u64(u64::from(ticks), 0);
-            let ratio = |v: u64| line_speed.div(t.mul(Wide::from_u64(v, -40)));
+            let ratio = |v: u64| line_speed / (t * Wide::from_u64(v, -40));
             let below = ratio(v_lo).abs_diff(Wide::ONE);
             let above = ratio(v_hi).abs_diff(Wide::ONE);
             Some(if below.gt(above) { below } else { above })
@@ -161,9 +161,7 @@ impl Controller {
             update.period.bounds_ticks,
         )?;
         // |v2| / |v1| (|v1| >= v_min > 0).
-        let tan_max = Wide::from_u64(e.d2, 0)
-            .div(Wide::from_u64(e.d1, 0))
-            .to_f32();
+        let tan_max = (Wide::from_u64(e.d2, 0) / Wide::from_u64(e.d1, 0)).to_f32();
         let stages = u32::from(seg.tdi_stages);
         let (worst_mismatch, mtf, max_stages) = match p.worst_mismatch {
             Some(w) => {

@@ -98,8 +98,8 @@ fn period_and_mismatch_match_f64() {
             min_bits,
             max_bits,
             interp_bits,
-            w(pixel).mul(w(clock)),
-            (w(lo_s).mul(w(clock)), w(hi_s).mul(w(clock))),
+            w(pixel) * w(clock),
+            (w(lo_s) * w(clock), w(hi_s) * w(clock)),
         );
         let (vmin, vmax) = (
             min_bits as f64 * libm::exp2(-40.0),

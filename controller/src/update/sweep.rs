@@ -228,8 +228,7 @@ pub(super) fn atan_ratio_rad(num: u64, den: u64, negative: bool) -> f32 {
         (den, num, true)
     };
     // <= 1 in Q30.
-    let r = Wide::from_u64(small, 0)
-        .div(Wide::from_u64(big, 0))
+    let r = (Wide::from_u64(small, 0) / Wide::from_u64(big, 0))
         .to_u64_scaled(30)
         .min(1 << 30) as i32;
     let at = atan_unit_q30(r);
