@@ -58,6 +58,7 @@ mod sqrt;
 pub mod trig;
 pub mod trig_f64;
 pub mod vector;
+pub mod wide;
 
 #[cfg(feature = "reference")]
 pub use earth::EarthReference;

@@ -426,8 +426,8 @@ impl<T: Real> StageRule<T> {
 /// sin(x)/x (docs/fixed-point.md, "The update on the Cortex-M3").
 pub mod int {
     use super::{settle_guess, smear_mtf, StageRule, HALF_PI, MAX_STAGE_LIMIT};
-    use crate::error::ModelError;
-    use crate::real::Real;
+    use crate::error::{ModelError, Param};
+    use crate::wide::{div_64_32, Wide};
 
     /// 1 in Q30.
     const ONE_Q30: u64 = 1 << 30;
@@ -491,7 +491,7 @@ pub mod int {
             }
         }
 
-        /// y = M x / 2 in Q30, truncated, or `None` from 2^32 on.
+        /// y = M x / 2 in Q30, truncated, or `None` from 2^62 on.
         #[inline(always)]
         fn y_wide_q30(self, m: u32) -> Option<u64> {
             // < 2^47: exact.
@@ -560,8 +560,20 @@ pub mod int {
         }
         let f = y & (ONE_Q30 - 1);
         let s = sinc_pi_q30(f as u32).max(0) as u64;
-        // f s in Q60 (< 2^60) over y in Q30: Q30, below 1/pi.
-        Some((f * s).checked_div(y).unwrap_or(0) as i32)
+        // f s in Q60 (< 2^60) over y in Q30: Q30, below 1/pi. For y below 2^32 (4),
+        // both shifted until y's leading one is at bit 31, for the 64 / 32 division in
+        // the core's divide (a 64-bit division is a software call): the exact floor.
+        // Beyond, in [`Wide`]: a quotient below 2^28 within three truncations of 2^-31,
+        // under one unit.
+        let fs = f * s;
+        match u32::try_from(y) {
+            Ok(y32) => {
+                let lz = y32.leading_zeros();
+                let n = fs << lz;
+                Some(div_64_32((n >> 32) as u32, n as u32, y32 << lz) as i32)
+            }
+            Err(_) => Some((Wide::from_u64(fs, 0) / Wide::from_u64(y, 0)).to_u64_scaled(0) as i32),
+        }
     }
 
     /// The smear MTF of `stages` TDI stages under a relative mismatch `e` and a drift
@@ -576,10 +588,79 @@ pub mod int {
         ) {
             (Some(a), Some(b)) => {
                 let p = (i64::from(a) * i64::from(b)).max(0) >> 30;
-                p as f32 * (1.0 / ONE_Q30 as f32)
+                // Exact in Wide (p < 2^31), rounded once: what `p as f32 * 2^-30` gives.
+                Wide::from_u64(p as u64, -30).to_f32()
             }
             _ => beyond_main_lobe(stages, e, t),
         }
+    }
+
+    /// floor(sqrt(x)), bit by bit (core's `isqrt` divides: a software call here).
+    #[inline(always)]
+    fn isqrt_u64(x: u64) -> u64 {
+        if x == 0 {
+            return 0;
+        }
+        let (mut x, mut r) = (x, 0u64);
+        let mut bit = 1u64 << ((63 - x.leading_zeros()) & !1);
+        while bit != 0 {
+            if x >= r + bit {
+                x -= r + bit;
+                r = (r >> 1) + bit;
+            } else {
+                r >>= 1;
+            }
+            bit >>= 2;
+        }
+        r
+    }
+
+    /// The integer guess against the f32 form's formula in f64: the floor of the same
+    /// quotient, except within 1e-6 of an integer (the Wide's truncations are 1e-9), over
+    /// magnitudes 1e-7 to 3 and floors 0.25 to 0.99.
+    #[test]
+    fn guess_int_is_the_floor_of_the_guess() {
+        extern crate std;
+        let mut rng = crate::sample::SplitMix64(0x5EED_2026_1127_0005);
+        for floor in [0.25, 0.5, 0.8, 0.9, 0.99] {
+            let rule = StageRule::<f32>::new(floor).unwrap();
+            for _ in 0..20_000 {
+                let a = libm::pow(10.0, rng.uniform(-7.0, 0.5)) as f32;
+                let b = (f64::from(a) * rng.uniform(0.0, 1.0)) as f32;
+                let limit = 1 + (rng.next_u64() % (1 << 23)) as u32;
+                let (l, s) = (f64::from(a), f64::from(b));
+                let kappa = f64::from(rule.pair_kappa);
+                let want = f64::from(rule.mismatch_budget) / libm::sqrt(l * l + kappa * s * s);
+                let got = rule.guess_int(a, b, limit);
+                if want >= f64::from(limit) * (1.0 + 1e-6) {
+                    assert_eq!(got, limit);
+                } else if libm::fabs(want - libm::round(want)) > 1e-6 * want.max(1.0) {
+                    assert_eq!(
+                        f64::from(got),
+                        libm::floor(want).min(f64::from(limit)),
+                        "{a} {b}"
+                    );
+                }
+            }
+        }
+    }
+
+    /// Against the exact root (u128's `isqrt`) at random magnitudes and around squares.
+    #[test]
+    fn isqrt_u64_is_the_floor_root() {
+        let mut x: u64 = 0x9E37_79B9_7F4A_7C15;
+        for i in 0..1_000_000u32 {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            let v = x >> (i % 64);
+            assert_eq!(isqrt_u64(v), (v as u128).isqrt() as u64, "{v}");
+            let r = v >> 32;
+            for sq in [r * r, (r * r).wrapping_sub(1), r * r + 1] {
+                assert_eq!(isqrt_u64(sq), (sq as u128).isqrt() as u64, "{sq}");
+            }
+        }
+        assert_eq!(isqrt_u64(u64::MAX), u64::from(u32::MAX));
     }
 
     #[cold]
@@ -600,10 +681,22 @@ pub mod int {
             tan_drift: f32,
             stage_limit: u32,
         ) -> Result<u32, ModelError> {
-            let (e, t) = super::magnitudes(rel_mismatch, tan_drift)?;
+            // `magnitudes` on the bits: its checks, in its order, without the software
+            // comparisons (for f32s >= 0 the bits order as the values).
+            let (e_bits, t_bits) = (
+                rel_mismatch.to_bits() & 0x7fff_ffff,
+                tan_drift.to_bits() & 0x7fff_ffff,
+            );
+            if t_bits >= 0x7f80_0000 {
+                return Err(ModelError::NonFinite(Param::Drift));
+            }
+            if e_bits >= 0x7f80_0000 {
+                return Err(ModelError::NonFinite(Param::RelativeMismatch));
+            }
+            let (e, t) = (f32::from_bits(e_bits), f32::from_bits(t_bits));
             let limit = stage_limit.min(MAX_STAGE_LIMIT);
-            let (larger, smaller) = if e > t { (e, t) } else { (t, e) };
-            if larger == 0.0 {
+            let (larger, smaller) = if e_bits > t_bits { (e, t) } else { (t, e) };
+            if e_bits.max(t_bits) == 0 {
                 return Ok(limit);
             }
             // Both finite (`magnitudes`).
@@ -626,13 +719,7 @@ pub mod int {
                     return Ok(limit);
                 }
             }
-            let r = smaller / larger;
-            let guess = self.mismatch_budget / (larger * Real::sqrt(1.0 + self.pair_kappa * r * r));
-            let m = if guess >= limit as f32 {
-                limit
-            } else {
-                guess as u32
-            };
+            let m = self.guess_int(larger, smaller, limit);
             let floor = (u64::from(floor_q30) << 30) as i64;
             let meets = |m: u32| match (factor_q30(xe, m), factor_q30(xt, m)) {
                 (Some(a), Some(b)) => i64::from(a) * i64::from(b) >= floor,
@@ -644,6 +731,29 @@ pub mod int {
                 None => {
                     self.max_stages_with_drift_by_bisection(rel_mismatch, tan_drift, stage_limit)
                 }
+            }
+        }
+
+        /// The search's start, the f32 form's guess budget / (L sqrt(1 + kappa (S/L)^2))
+        /// as floor(sqrt(budget^2 / (L^2 + kappa S^2))) in [`Wide`] (L > 0 the larger
+        /// magnitude, S the smaller), at most `limit`. Within a count of the f32 guess:
+        /// the search settles from either on the same count.
+        #[inline(always)]
+        fn guess_int(&self, larger: f32, smaller: f32, limit: u32) -> u32 {
+            let w = |x: f32| Wide::from_f32(x).unwrap_or(Wide::ZERO);
+            let (l, s) = (w(larger), w(smaller));
+            let den = l * l + w(self.pair_kappa) * (s * s);
+            if den.is_zero() {
+                // L below f32's normals: the f32 guess is infinite.
+                return limit;
+            }
+            let b = w(self.mismatch_budget);
+            let q = (b * b / den).to_u64_scaled(0);
+            let lim = u64::from(limit);
+            if q >= lim * lim {
+                limit
+            } else {
+                isqrt_u64(q) as u32
             }
         }
     }

@@ -9,6 +9,8 @@
 //! the model never produces, fall back to the f64 `sincos` of [`crate::trig_f64`],
 //! rounded (NaN from 2^20 pi/2 rad on).
 
+use crate::wide::Wide;
+
 /// pi/2 = P1 + P2 + P3, P1 and P2 with trailing zero bits (Cephes' DP1..DP3, doubled).
 const P1: f32 = 1.570_312_5;
 const P2: f32 = 4.837_513e-4;
@@ -85,6 +87,75 @@ pub fn sin_cos_f32(x: f32) -> (f32, f32) {
         _ => (-c, s),
     }
 }
+
+/// (sin x, cos x) in integers, rounded once to f32, for a core without an FPU (the
+/// Cortex-M3's per-update attitude: docs/fixed-point.md, "The update on the Cortex-M3"):
+/// |x| in Q60, reduced by pi/2 in Q60 to r, then sin r = r S(r^2) and cos r = C(r^2),
+/// the Taylor polynomials (degrees 5 and 6 in r^2) by Horner's rule in Q30 and 32 x 32
+/// products, r's product by S in [`Wide`]. Within 1e-8 relative before the rounding to
+/// f32 (`core-math/tests/trig.rs`); |x| >= 4 rad and non-finite arguments: [`sin_cos_f32`].
+pub fn sin_cos_int(x: f32) -> (f32, f32) {
+    let bits = x.to_bits();
+    let biased = (bits >> 23) & 0xff;
+    // |x| < 2^-20: sin x = x and cos x = 1 to f32's rounding (x^2 / 6 < 2^-42).
+    if biased < 107 {
+        return (x, 1.0);
+    }
+    // |x| >= 4, NaN, infinities.
+    if biased >= 129 {
+        return sin_cos_f32(x);
+    }
+    // |x| = mant 2^(biased - 150), in Q60: a left shift of 17 to 38, below 2^62.
+    let a = u64::from((bits & 0x7f_ffff) | 0x80_0000) << (biased - 90);
+    // The nearest quadrant k (|x| < 4 < 7 pi / 4: k <= 3) and r = |x| - k pi / 2.
+    let k = (a > QUARTER_PI_Q60) as u64
+        + (a > 3 * QUARTER_PI_Q60) as u64
+        + (a > 5 * QUARTER_PI_Q60) as u64;
+    let r = a as i64 - (k * HALF_PI_Q60) as i64;
+    let r_abs = r.unsigned_abs();
+    // r^2 in Q30 (|r| <= pi / 4: r in Q30 below 2^30), truncated.
+    let r30 = (r_abs >> 30) as u32;
+    let z = ((u64::from(r30) * u64::from(r30)) >> 30) as i32;
+    let horner = |c: &[i32]| {
+        let mut acc = c[c.len() - 1];
+        for &ck in c[..c.len() - 1].iter().rev() {
+            acc = ((i64::from(acc) * i64::from(z) + (1 << 29)) >> 30) as i32 + ck;
+        }
+        acc
+    };
+    // S and C in [0.7, 1]: positive.
+    let s_r = (Wide::from_u64(r_abs, -60) * Wide::from_u64(horner(&SIN_Q30) as u64, -30)).to_f32();
+    let s_r = if r < 0 { -s_r } else { s_r };
+    let c_r = Wide::from_u64(horner(&COS_Q30) as u64, -30).to_f32();
+    let (s, c) = match k {
+        0 => (s_r, c_r),
+        1 => (c_r, -s_r),
+        2 => (-s_r, -c_r),
+        _ => (-c_r, s_r),
+    };
+    if bits >> 31 != 0 {
+        (-s, c)
+    } else {
+        (s, c)
+    }
+}
+
+/// pi/4 and pi/2 in Q60, rounded.
+const QUARTER_PI_Q60: u64 = 905_502_432_259_640_355;
+const HALF_PI_Q60: u64 = 1_811_004_864_519_280_711;
+/// sin(r) / r = sum (-1)^k r^(2k) / (2k+1)!, k = 0..=5, in Q30 (the next term is below
+/// 9e-12 on |r| <= pi/4).
+const SIN_Q30: [i32; 6] = [1_073_741_824, -178_956_971, 8_947_849, -213_044, 2_959, -27];
+/// cos(r) = sum (-1)^k r^(2k) / (2k)!, k = 0..=6, in Q30 (the next term below 7e-13).
+const COS_Q30: [i32; 7] = [
+    1_073_741_824,
+    -536_870_912,
+    44_739_243,
+    -1_491_308,
+    26_631,
+    -296,
+    2,
+];
 
 /// (sin x, cos x) for the arguments the reduction cannot take (|x| >= 12 800 rad, and
 /// NaN, infinities): the f64 `sincos` of the exact argument, rounded to f32 (libm's

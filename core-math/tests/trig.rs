@@ -1,6 +1,6 @@
 //! The f32 sine/cosine against f64 libm, and the f64 sine/cosine against libm's.
 
-use core_math::trig::{atan_f32, sin_cos_f32};
+use core_math::trig::{atan_f32, sin_cos_f32, sin_cos_int};
 use core_math::trig_f64;
 
 fn ulp_err(got: f32, exact: f64) -> f64 {
@@ -175,4 +175,73 @@ fn atan_special_arguments() {
     assert_eq!(atan_f32(f32::NEG_INFINITY), -core::f32::consts::FRAC_PI_2);
     assert!(atan_f32(f32::NAN).is_nan());
     assert_eq!(atan_f32(1e-40), 1e-40, "subnormal: atan x = x");
+}
+
+/// The integer sine and cosine (the Cortex-M3's) against libm in f64: within 1e-8 of the
+/// exact value relative, plus its rounding to f32 (half a spacing), at every magnitude
+/// below 4 rad including the zeros of the cosine (relative there too: r is exact);
+/// beyond, and for special arguments, the f32 form's values.
+#[test]
+fn integer_sin_cos_within_1e8_and_the_rounding() {
+    // xorshift64: uniform in [0, 1).
+    let mut state = 0x5EED_2026_1127_0006u64;
+    let mut unit = move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let mut worst = 0f64;
+    let mut check = |x: f32| {
+        let (s, c) = sin_cos_int(x);
+        for (g, e) in [(s, libm::sin(f64::from(x))), (c, libm::cos(f64::from(x)))] {
+            let spacing = f64::from(f32::EPSILON) * e.abs().log2().floor().exp2();
+            let err = (f64::from(g) - e).abs();
+            let rel = (err - 0.5 * spacing).max(0.0) / e.abs();
+            assert!(rel <= 1e-8, "x = {x:e}: {g:e} vs {e:e}");
+            worst = worst.max(rel);
+        }
+    };
+    for i in 0..2_000_000 {
+        let x = if i % 2 == 0 {
+            (8.0 * unit() - 4.0) as f32
+        } else {
+            (libm::exp2(32.0 * unit() - 30.0) * if i % 4 == 1 { 1.0 } else { -1.0 }) as f32
+        };
+        check(x);
+    }
+    // The f32s nearest each multiple of pi/4 and their neighbours.
+    for k in -5i32..=5 {
+        let x = (f64::from(k) * std::f64::consts::FRAC_PI_4) as f32;
+        for d in -3i32..=3 {
+            let y = f32::from_bits((x.to_bits() as i32 + d) as u32);
+            if y != 0.0 && y.abs() < 4.0 {
+                check(y);
+            }
+        }
+    }
+    eprintln!("integer sin/cos: worst error beyond the f32 rounding {worst:.2e} relative");
+    for x in [
+        0.0f32,
+        -0.0,
+        1e-30,
+        -3.0e-39,
+        4.0,
+        -7.5,
+        1e4,
+        f32::NAN,
+        f32::INFINITY,
+    ] {
+        let (s, c) = sin_cos_int(x);
+        let (fs, fc) = if x.abs() < 1e-6 {
+            (x, 1.0)
+        } else {
+            sin_cos_f32(x)
+        };
+        assert_eq!(
+            (s.to_bits(), c.to_bits()),
+            (fs.to_bits(), fc.to_bits()),
+            "{x}"
+        );
+    }
 }

@@ -14,15 +14,12 @@ impl Controller {
         extremes(update, seg)
     }
 
-    /// The segment's [`Extremes`] by the configured backend.
+    /// The segment's [`Extremes`] in f32: with fixed-point pixels, only the DEM's route
+    /// comes here (the others take [`Controller::segment_fixed`]).
     #[cfg(feature = "earth-fixed")]
     #[inline(always)]
     pub(super) fn extremes(&self, update: &Ground, seg: &SegmentPlan) -> Result<Extremes, Fault> {
-        if self.fixed_pixels() {
-            extremes_fixed(update, seg)
-        } else {
-            extremes(&update.float, seg)
-        }
+        extremes(&update.float, seg)
     }
 
     /// The MTF at `stages` under the mismatch `worst` and the drift tangent `tan_max`,
@@ -105,7 +102,9 @@ impl Controller {
         if self.fixed_pixels() {
             let centre_rad = atan_pair_rad(centre.v2_mps, centre.v1_mps);
             let worst_rad = atan_pair_rad(drift.0, drift.1);
-            let worst_rad = if worst_rad < centre_rad.abs() {
+            // Both >= 0 (or NaN): their bits order as their values, without the
+            // software comparison.
+            let worst_rad = if worst_rad.to_bits() < centre_rad.abs().to_bits() {
                 centre_rad.abs()
             } else {
                 worst_rad
@@ -136,7 +135,8 @@ impl Controller {
             // The pair in I24F40 units: only its ratio is used.
             (Some(up), Some(px)) => {
                 let m = core_math::EARTH_FIXED.motion(up, px)?;
-                Ok((m.v2_mps.to_bits() as f32, m.v1_mps.to_bits() as f32))
+                let f = |bits: i64| super::fixed::i64_to_f32(bits, 0);
+                Ok((f(m.v2_mps.to_bits()), f(m.v1_mps.to_bits())))
             }
             _ => {
                 let m = steered_centre(&update.float, seg, sin, cos)?;
@@ -176,7 +176,10 @@ impl Controller {
             Ok(Ground { fixed: Some(f), .. }) => {
                 f.boresight_over_focal().ok().and_then(|(vf1, vf2)| {
                     // Q63 rad/s, below 2^63: their squares stay inside f32's range.
-                    let (v1, v2) = (vf1 as f32, vf2 as f32);
+                    let (v1, v2) = (
+                        super::fixed::i64_to_f32(vf1, 0),
+                        super::fixed::i64_to_f32(vf2, 0),
+                    );
                     steer_from(v1, v2, atan_pair_rad(v2, v1))
                 })
             }
@@ -276,7 +279,10 @@ pub(super) struct Ground {
     pub(super) fixed: Option<core_math::earth::fixed::EarthFixedUpdate>,
     /// `fixed` turned by the yaw request, for the steered centres; None without a
     /// request, or where the turn leaves the fixed formats' envelope.
-    yawed: Option<core_math::earth::fixed::EarthFixedUpdate>,
+    pub(super) yawed: Option<core_math::earth::fixed::EarthFixedUpdate>,
+    /// The plan's line speed (pixel x clock, m/s) and period bounds in ticks, for
+    /// [`Controller::segment_fixed`]: once per ground, not per segment.
+    pub(super) period: PeriodConsts,
 }
 
 impl Controller {
@@ -316,6 +322,7 @@ impl Controller {
             float,
             fixed,
             yawed,
+            period: PeriodConsts::of(&self.plan),
         })
     }
 }

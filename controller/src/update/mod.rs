@@ -29,6 +29,17 @@ impl Controller {
         cfg!(feature = "fixed-only") || self.config.fixed_point_pixels
     }
 
+    /// The attitude's sine and cosine: in integers with fixed-point pixels (a core
+    /// without an FPU, where each f32 operation is a software call), else in f32.
+    #[inline(always)]
+    fn sin_cos(&self, x: f32) -> (f32, f32) {
+        #[cfg(feature = "earth-fixed")]
+        if self.fixed_pixels() {
+            return core_math::trig::sin_cos_int(x);
+        }
+        core_math::trig::sin_cos_f32(x)
+    }
+
     /// Moves the clock to `now_us` (from the time source) and runs the update that is due,
     /// if any, writing periods to `sink`. Returns true when an update ran.
     pub fn advance<S: LinePeriodSink>(&mut self, now_us: u64, sink: &mut S) -> bool {
@@ -76,12 +87,13 @@ impl Controller {
                 let dt_s = seconds_since(t_us, nav.time_us);
                 let state = nav.propagator.parts_at(dt_s);
                 let attitude = attitude_at(&nav.attitude, dt_s);
-                GENERAL_F32.instant_parts(
+                GENERAL_F32.instant_parts_by(
                     state.position_m,
                     state.velocity_mps,
                     state.r2_minus_a2_m2,
                     &attitude,
                     EARTH_RATE_RAD_S as f32,
+                    |x| self.sin_cos(x),
                 )
             }
             (None, Some(gnss), Some(attitude)) if self.update_mode != Mode::Stale => {
@@ -131,8 +143,11 @@ impl Controller {
             };
             let index = seg.index;
             let height_m = self.height(index);
-            // NaN never equals: the first segment makes the first ground.
-            if height_m != ground_h_m {
+            // NaN never equals: the first segment makes the first ground. Compared as
+            // bits (no software comparison on a core without an FPU): a NaN has no
+            // height's bits, and -0 against 0 only makes the same ground again.
+            let bits = ground_h_m.to_bits();
+            if height_m.to_bits() != bits || bits & 0x7fff_ffff > 0x7f80_0000 {
                 ground = self.make_ground(&instant, height_m, steer);
                 ground_h_m = height_m;
             }
@@ -191,6 +206,10 @@ impl Controller {
         steer: Option<(f32, f32, f32)>,
         dem: Option<&Extremes>,
     ) -> Result<SegmentOutput, Fault> {
+        #[cfg(feature = "earth-fixed")]
+        if dem.is_none() && self.fixed_pixels() {
+            return self.segment_fixed(update, seg, steer);
+        }
         // |v1| extremes and the largest |v2/v1| over the samples and the centre; every
         // one must move the same way along P1 (one transfer direction per segment). In
         // forward flight the image moves towards -P1 (the ground runs backwards under
@@ -291,11 +310,17 @@ fn i64_to_f32(x: i64) -> f32 {
 
 mod backend;
 mod dem;
+#[cfg(feature = "earth-fixed")]
+mod fixed;
 mod sweep;
 
 use backend::*;
+#[cfg(feature = "earth-fixed")]
+use fixed::*;
 pub use sweep::drift_angle_rad;
 use sweep::*;
 
+#[cfg(all(test, feature = "earth-fixed"))]
+mod fixed_tests;
 #[cfg(test)]
 mod tests;

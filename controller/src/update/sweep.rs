@@ -86,14 +86,13 @@ pub(super) fn sweep(
     Ok(e)
 }
 
-/// The [`Extremes`] of the centre and the samples by the fixed-point backend
+/// The extremes of the centre and the samples by the fixed-point backend
 /// (`SegmentPlan::fixed`: the centre first), integer only per pixel: v1's extremes
 /// compared as I24F40 bits, the largest |v2/v1| by cross-multiplying the bits' magnitudes
-/// (exact in u128). Widened to f32 once, at the end: the per-segment work after it is
-/// the f32 path's.
+/// (exact in u128).
 #[cfg(feature = "earth-fixed")]
 #[inline(never)]
-pub(super) fn extremes_fixed(g: &Ground, seg: &SegmentPlan) -> Result<Extremes, Fault> {
+pub(super) fn extremes_fixed(g: &Ground, seg: &SegmentPlan) -> Result<ExtremesBits, Fault> {
     use core_math::EARTH_FIXED;
     let Some(up) = &g.fixed else {
         return Err(Fault::InvalidScene);
@@ -115,18 +114,13 @@ pub(super) fn extremes_fixed(g: &Ground, seg: &SegmentPlan) -> Result<Extremes, 
             (d2, d1) = (a2, a1);
         }
     }
-    // I24F40 bits to m/s: exact to f32's rounding (|v| < 2^23 m/s).
-    const LSB_MPS: f32 = 1.0 / (1u64 << 40) as f32;
-    let mps = |bits: i64| bits as f32 * LSB_MPS;
-    Ok(Extremes {
-        centre: ImageMotion {
-            v1_mps: mps(c1),
-            v2_mps: mps(c2),
-        },
-        lo: mps(lo),
-        hi: mps(hi),
-        drift_v2: d2 as f32 * LSB_MPS,
-        drift_v1: d1 as f32 * LSB_MPS,
+    Ok(ExtremesBits {
+        c1,
+        c2,
+        lo,
+        hi,
+        d2,
+        d1,
     })
 }
 
@@ -210,6 +204,37 @@ pub(super) fn atan_pair_rad(num: f32, den: f32) -> f32 {
     let q = if past_one { HALF_PI_Q30 - at } else { at };
     let rad = q30_to_f32(q.max(0) as u32);
     if (num.to_bits() ^ den.to_bits()) >> 31 != 0 {
+        -rad
+    } else {
+        rad
+    }
+}
+
+/// atan(`num` / `den`) (rad) of two integer magnitudes, negated when `negative`: the
+/// ratio of the smaller over the larger in [`Wide`], truncated to Q30, then
+/// [`atan_pair_rad`]'s polynomial and rounding (docs/fixed-point.md, "The update on the
+/// Cortex-M3"). A zero `den`: [`atan_pair_rad`] of the two as f32.
+#[cfg(feature = "earth-fixed")]
+#[inline(never)]
+pub(super) fn atan_ratio_rad(num: u64, den: u64, negative: bool) -> f32 {
+    use core_math::wide::Wide;
+    if den == 0 {
+        let sign = if negative { -1.0 } else { 1.0 };
+        return atan_pair_rad(u64_to_f32(num, 0), sign * u64_to_f32(den, 0));
+    }
+    let (small, big, past_one) = if num <= den {
+        (num, den, false)
+    } else {
+        (den, num, true)
+    };
+    // <= 1 in Q30.
+    let r = (Wide::from_u64(small, 0) / Wide::from_u64(big, 0))
+        .to_u64_scaled(30)
+        .min(1 << 30) as i32;
+    let at = atan_unit_q30(r);
+    let q = if past_one { HALF_PI_Q30 - at } else { at };
+    let rad = q30_to_f32(q.max(0) as u32);
+    if negative {
         -rad
     } else {
         rad

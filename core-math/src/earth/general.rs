@@ -150,6 +150,21 @@ impl<T: Real> General<T> {
         attitude: &Attitude<T>,
         earth_rate_rad_s: T,
     ) -> Result<GeneralInstant<T>, ModelError> {
+        self.instant_parts_by(r, v, r2_minus_a2, attitude, earth_rate_rad_s, T::sin_cos)
+    }
+
+    /// [`General::instant_parts`] with the attitude's sines and cosines by `sin_cos`
+    /// (a core without an FPU passes `trig::sin_cos_int`).
+    #[inline(always)]
+    pub fn instant_parts_by(
+        &self,
+        r: [T; 3],
+        v: [T; 3],
+        r2_minus_a2: T,
+        attitude: &Attitude<T>,
+        earth_rate_rad_s: T,
+        sin_cos: impl Fn(T) -> (T, T),
+    ) -> Result<GeneralInstant<T>, ModelError> {
         let (r2, h) = check_state(r, v)?;
         let w = earth_rate_rad_s;
 
@@ -173,9 +188,9 @@ impl<T: Real> General<T> {
         let w_l = [-w * n_l[0], nu - w * n_l[1], -w * n_l[2]];
 
         let at = attitude;
-        let (sp, cp) = at.roll_rad.sin_cos();
-        let (st, ct) = at.pitch_rad.sin_cos();
-        let (sy, cy) = at.yaw_rad.sin_cos();
+        let (sp, cp) = sin_cos(at.roll_rad);
+        let (st, ct) = sin_cos(at.pitch_rad);
+        let (sy, cy) = sin_cos(at.yaw_rad);
         // Columns of A = Rx(roll) Ry(pitch) Rz(yaw).
         let cols = [
             [ct * cy, cp * sy + sp * st * cy, sp * sy - cp * st * cy],

@@ -68,12 +68,17 @@ pub fn bench(args: &BenchArgs) -> Result<()> {
         println!("{:>8} {:>8}  {label}", raw.saturating_sub(overhead), raw);
     }
     if let Some(text) = &args.profile {
-        let matching: Vec<usize> = (0..counts.regions.len())
+        // A label equal to the text wins: some labels are contained in others.
+        let exact = |i: &usize| counts.regions[*i].0 == *text;
+        let mut matching: Vec<usize> = (0..counts.regions.len())
             .filter(|&i| counts.regions[i].0.contains(text.as_str()))
             .collect();
+        if matching.iter().any(exact) {
+            matching.retain(exact);
+        }
         let [region] = matching[..] else {
             bail!(
-                "--profile `{text}` matches {} regions; give text that one label alone contains",
+                "--profile `{text}` matches {} regions; give text that one label alone contains or equals",
                 matching.len()
             );
         };
