@@ -58,10 +58,10 @@ pub fn run(args: &Args) -> Result<()> {
     let maps = grid::sweep_all(&MAPS, div, sub);
     let secs = t0.elapsed().as_secs_f64();
     let t1 = Instant::now();
-    let gmaps = grid::sweep_all(&general::GMAPS, div, None);
+    let gmaps: Vec<general::GMap> = grid::sweep_all(&general::GMAPS, div, None);
     let gsecs = t1.elapsed().as_secs_f64();
     let t2 = Instant::now();
-    let xmaps = grid::sweep_all::<general_fixed::FCell>(&general::GMAPS, div, None);
+    let xmaps: Vec<general_fixed::FMap> = grid::sweep_all(&general::GMAPS, div, None);
     let xsecs = t2.elapsed().as_secs_f64();
     let mut values = figures(&maps, secs);
     values.extend(general::figures(&gmaps, gsecs));
@@ -464,7 +464,7 @@ mod tests {
         let maps: Vec<general_fixed::FMap> = grid::sweep_all(&general::GMAPS, 4, None);
         let bad = grid::broken(&maps);
         assert!(bad.is_empty(), "{}", bad.join("\n"));
-        let mut a = general_fixed::FCell::empty();
+        let mut a = general::GCell::<general_fixed::Fixed>::empty();
         for m in &maps {
             a.merge(&m.aggregate(|_, _| true));
         }
@@ -472,8 +472,8 @@ mod tests {
         assert_eq!((a.refused, a.non_finite), (0, 0));
         assert!(a.min_margin_rad.to_degrees() < 0.02, "{}", a.min_margin_rad);
         assert!(a.err.max > 1e-8, "fixed err {}", a.err.max);
-        assert!(a.near.at.is_some() && a.far_tame.at.is_some());
-        assert!(a.far_tame.max > 1e-9, "far err {}", a.far_tame.max);
+        assert!(a.near.at.is_some() && a.tame.at.is_some());
+        assert!(a.tame.max > 1e-9, "far err {}", a.tame.max);
     }
 
     /// |v_P| = f x (angular rate) x a function of h = H/R and the angles: scaling H and R
