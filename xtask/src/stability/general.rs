@@ -619,14 +619,7 @@ pub fn figures(maps: &[GMap], secs: f64) -> std::collections::BTreeMap<String, S
             ("tame", &a.tame),
             ("max_err_v1", &a.err_v1),
         ] {
-            if let Some((c, o)) = &w.at {
-                put(&format!("{what}.at"), describe::<F32>(c, o));
-                put(&format!("{what}.kappa"), sig(o.kappa));
-                put(&format!("{what}.err"), e2(o.err));
-                put(&format!("{what}.ratio"), format!("{:.2}", o.ratio()));
-                put(&format!("{what}.err_v1"), e2(o.err_v1));
-                put(&format!("{what}.v"), e2(o.v));
-            }
+            case_figures::<F32>(&mut put, what, w);
         }
         rows.push(row(&format!("{}: {}", m.spec.letter, m.spec.title), &a));
         all.merge(&a);
@@ -649,16 +642,7 @@ pub fn figures(maps: &[GMap], secs: f64) -> std::collections::BTreeMap<String, S
         ("max_err_v1", &all.err_v1),
         ("steady", &all.steady),
     ] {
-        if let Some((c, o)) = &w.at {
-            let mut put = |x: &str, s: String| put(&format!("G.{what}.{x}"), s);
-            put("at", describe::<F32>(c, o));
-            put("kappa", sig(o.kappa));
-            put("err", e2(o.err));
-            put("err_v1", e2(o.err_v1));
-            put("v", e2(o.v));
-            put("v1", e2(o.v1));
-            put("period_ms", sig(1e3 * CAMERA.pixel_m / o.v1.abs()));
-        }
+        case_figures::<F32>(&mut put, &format!("G.{what}"), w);
     }
     put("G.table", table(&TABLE_HEADER, &rows));
     put(
@@ -771,6 +755,26 @@ pub fn figures(maps: &[GMap], secs: f64) -> std::collections::BTreeMap<String, S
         }
     }
     v
+}
+
+/// The values the document may quote about one case (a map's worst, largest-kappa, ...),
+/// as (`{prefix}.<what>`, text). Every such case gets the same set, so that the template
+/// can quote any of them the same way; the keys it does not use are ignored.
+pub fn case_figures<B: Tested>(
+    put: &mut impl FnMut(&str, String),
+    prefix: &str,
+    w: &Worst<GSample>,
+) {
+    let Some((c, o)) = &w.at else { return };
+    put(&format!("{prefix}.at"), describe::<B>(c, o));
+    put(&format!("{prefix}.kappa"), sig(o.kappa));
+    put(&format!("{prefix}.err"), e2(o.err));
+    put(&format!("{prefix}.ratio"), format!("{:.2}", o.ratio()));
+    put(&format!("{prefix}.err_v1"), e2(o.err_v1));
+    put(&format!("{prefix}.v"), e2(o.v));
+    put(&format!("{prefix}.v1"), e2(o.v1));
+    let period_ms = 1e3 * CAMERA.pixel_m / o.v1.abs();
+    put(&format!("{prefix}.period_ms"), sig(period_ms));
 }
 
 /// Map E's table by limb-margin band (log10 of the margin in deg, the map's y): the

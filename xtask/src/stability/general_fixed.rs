@@ -22,7 +22,9 @@ use std::path::Path;
 use crate::markdown::{e2, sig, table};
 
 use super::doc::lg;
-use super::general::{describe, GCell, GMap, GOutcome, GSample, Tested, MIN_MARGIN_DEG};
+use super::general::{
+    case_figures, describe, GCell, GMap, GOutcome, GSample, Tested, MIN_MARGIN_DEG,
+};
 use super::grid::{Cell as _, Panel, Worst};
 
 /// The targets (relative |dv| / |v|) from 1 deg and from 0.01 deg inside the limb.
@@ -156,9 +158,7 @@ pub fn figures(maps: &[FMap], secs: f64) -> std::collections::BTreeMap<String, S
         let mut put = |what: &str, s: String| put(&format!("X{l}.{what}"), s);
         put("err", e2(a.err.max));
         put("refused", a.refused.to_string());
-        if let Some((c, o)) = &a.err.at {
-            put("max_err.at", describe::<Fixed>(c, o));
-        }
+        case_figures::<Fixed>(&mut put, "max_err", &a.err);
         rows.push(row(&format!("{}: {}", m.spec.letter, m.spec.title), &a));
         all.merge(&a);
     }
@@ -183,11 +183,7 @@ pub fn figures(maps: &[FMap], secs: f64) -> std::collections::BTreeMap<String, S
         ("near", &all.near),
         ("of_target", &all.of_target),
     ] {
-        if let Some((c, o)) = &w.at {
-            put(&format!("X.{what}.at"), describe::<Fixed>(c, o));
-            put(&format!("X.{what}.err"), e2(o.err));
-            put(&format!("X.{what}.kappa"), sig(o.kappa));
-        }
+        case_figures::<Fixed>(&mut put, &format!("X.{what}"), w);
     }
     put("X.table", table(&TABLE_HEADER, &rows));
     put(
