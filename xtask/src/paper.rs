@@ -695,7 +695,7 @@ fn hypotheses(out: &mut Out) -> Result<()> {
                 Some(r) => [
                     format!("{:.3}", r.min),
                     format!("{:.3}", r.max),
-                    format!("{:.2}", r.change_over_min_pct()),
+                    f2(r.change_over_min_pct()),
                 ],
                 None => Default::default(),
             });

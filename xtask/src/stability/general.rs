@@ -21,7 +21,7 @@ use core_math::{
 
 use std::path::Path;
 
-use crate::markdown::{e2, sig, table};
+use crate::markdown::{e2, f2, sig, sig_range, table};
 
 use super::doc::lg;
 use super::general_fixed::{FAR_TARGET, NEAR_TARGET};
@@ -562,7 +562,7 @@ fn row(name: &str, a: &GCell) -> Vec<String> {
     vec![
         name.to_string(),
         a.n.to_string(),
-        format!("{} - {}", sig(a.kappa_min), sig(a.kappa.max)),
+        sig_range(a.kappa_min, a.kappa.max),
         e2(a.err.max),
         e2(a.err_v1.max),
         if a.tame.max > 0.0 {
@@ -576,7 +576,7 @@ fn row(name: &str, a: &GCell) -> Vec<String> {
         } else {
             "-".into()
         },
-        format!("{:.2}", a.ratio.max),
+        f2(a.ratio.max),
         sig(a.min_margin_rad.to_degrees()),
         a.refused.to_string(),
     ]
@@ -605,7 +605,7 @@ pub fn figures(maps: &[GMap], secs: f64) -> std::collections::BTreeMap<String, S
             ),
         );
         put("others", m.spec.others.into());
-        put("ratio", format!("{:.2}", a.ratio.max));
+        put("ratio", f2(a.ratio.max));
         put("kappa_max", sig(a.kappa.max));
         put("err", e2(a.err.max));
         put("err_v1", e2(a.err_v1.max));
@@ -626,14 +626,14 @@ pub fn figures(maps: &[GMap], secs: f64) -> std::collections::BTreeMap<String, S
     }
     rows.push(row("all general maps", &all));
     put("G.samples", all.n.to_string());
-    put("G.ratio", format!("{:.2}", all.ratio.max));
+    put("G.ratio", f2(all.ratio.max));
     put("G.kappa_max", sig(all.kappa.max));
     put("G.err", e2(all.err.max));
     put("G.err_v1", e2(all.err_v1.max));
     put("G.err_v1_steady", e2(all.steady.max));
     put(
         "G.err_v1_steady_pct",
-        format!("{:.2}", 100.0 * all.steady.max / SEGMENT_BUDGET),
+        f2(100.0 * all.steady.max / SEGMENT_BUDGET),
     );
     put("G.err_tame", format!("{:.3e}", all.tame.max));
     put("G.over_tol_kappa", sig(all.over_tol_kappa_min));
@@ -658,10 +658,7 @@ pub fn figures(maps: &[GMap], secs: f64) -> std::collections::BTreeMap<String, S
     );
     // The line period against a 96-stage segment's budget.
     put("G.budget", format!("{SEGMENT_BUDGET:.2e}"));
-    put(
-        "G.budget_pct",
-        format!("{:.2}", 100.0 * all.err_v1.max / SEGMENT_BUDGET),
-    );
+    put("G.budget_pct", f2(100.0 * all.err_v1.max / SEGMENT_BUDGET));
     put(
         "G.budget_kappa",
         sig(SEGMENT_BUDGET / (EARTH_F32_KAPPA_C * U_F32)),
@@ -690,10 +687,7 @@ pub fn figures(maps: &[GMap], secs: f64) -> std::collections::BTreeMap<String, S
         put("E.far_over_tol", far.over_tol.to_string());
         put("E.far_over_tol_kappa", sig(far.over_tol_kappa_min));
         let near = e.aggregate(|_, y| y < -1.0);
-        put(
-            "E.near_kappa",
-            format!("{} - {}", sig(near.kappa_min), sig(near.kappa.max)),
-        );
+        put("E.near_kappa", sig_range(near.kappa_min, near.kappa.max));
         // kappa x margin over each cell's largest-kappa case: kappa ~ 1/q ~ 1/sqrt(margin).
         let km: Vec<f64> = e
             .cells
@@ -704,7 +698,7 @@ pub fn figures(maps: &[GMap], secs: f64) -> std::collections::BTreeMap<String, S
         let (lo, hi) = km
             .iter()
             .fold((f64::INFINITY, 0.0f64), |(l, h), &x| (l.min(x), h.max(x)));
-        put("E.ksqrtm", format!("{} - {}", sig(lo), sig(hi)));
+        put("E.ksqrtm", sig_range(lo, hi));
     }
     // Maps D: kappa at least 1 deg inside the limb.
     for l in ["D", "D'"] {
@@ -718,7 +712,7 @@ pub fn figures(maps: &[GMap], secs: f64) -> std::collections::BTreeMap<String, S
             let l = l.replace('\'', "y");
             put(
                 &format!("{l}.far_kappa"),
-                format!("{} - {}", sig(a.kappa_min), sig(a.kappa.max)),
+                sig_range(a.kappa_min, a.kappa.max),
             );
             put(&format!("{l}.far_err"), e2(a.err.max));
         }
@@ -748,10 +742,7 @@ pub fn figures(maps: &[GMap], secs: f64) -> std::collections::BTreeMap<String, S
             );
             put("F.kappa0", sig(o.kappa));
             // The pitch rate whose rotational term f w matches |v| at nadir.
-            put(
-                "F.cancel_rate",
-                format!("{:.2}", (o.v / CAMERA.focal_m).to_degrees()),
-            );
+            put("F.cancel_rate", f2((o.v / CAMERA.focal_m).to_degrees()));
         }
     }
     v
@@ -769,7 +760,7 @@ pub fn case_figures<B: Tested>(
     put(&format!("{prefix}.at"), describe::<B>(c, o));
     put(&format!("{prefix}.kappa"), sig(o.kappa));
     put(&format!("{prefix}.err"), e2(o.err));
-    put(&format!("{prefix}.ratio"), format!("{:.2}", o.ratio()));
+    put(&format!("{prefix}.ratio"), f2(o.ratio()));
     put(&format!("{prefix}.err_v1"), e2(o.err_v1));
     put(&format!("{prefix}.v"), e2(o.v));
     put(&format!("{prefix}.v1"), e2(o.v1));
