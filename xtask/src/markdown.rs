@@ -33,6 +33,11 @@ pub fn sig(x: f64) -> String {
     }
 }
 
+/// `lo - hi`, each to three significant digits.
+pub fn sig_range(lo: f64, hi: f64) -> String {
+    format!("{} - {}", sig(lo), sig(hi))
+}
+
 /// A markdown table.
 pub fn table<R: AsRef<[String]>>(header: &[&str], rows: &[R]) -> String {
     let mut s = format!(

@@ -48,12 +48,9 @@ const STAGE_LIMIT: u32 = 512;
 
 /// The paper's numbers (Section 5).
 mod published {
-    pub const NEAR_MIN: f64 = 5.81;
-    pub const NEAR_MAX: f64 = 7.26;
-    pub const NEAR_CHANGE_PCT: f64 = 24.9;
-    pub const FAR_MIN: f64 = 3.65;
-    pub const FAR_MAX: f64 = 5.97;
-    pub const FAR_CHANGE_PCT: f64 = 63.5;
+    /// Min and max |v| (mm/s) and (max - min) / min (%), at the near and the far point.
+    pub const NEAR: (f64, f64, f64) = (5.81, 7.26, 24.9);
+    pub const FAR: (f64, f64, f64) = (3.65, 5.97, 63.5);
     pub const MTF_M48: f64 = 0.681;
     pub const MAX_STAGES: u32 = 16;
 }
@@ -576,88 +573,58 @@ fn summary(
         ),
         &["quantity", "paper", "ours", "unit", "definition"],
     )?;
-    let rows: Vec<(&str, String, String, &str, &str)> = vec![
-        (
-            "near_min",
-            f2(published::NEAR_MIN),
-            format!("{:.3}", near.min),
+    let mut row = |q: &str, p: String, o: String, u: &str, d: &str| csv.row(&[q, &p, &o, u, d]);
+    for (side, r, (min, max, change), pixel) in [
+        ("near", near, published::NEAR, 0),
+        ("far", far, published::FAR, 60000),
+    ] {
+        let over = format!("pixel {pixel}, phi 0..25, gamma0 0..90");
+        row(
+            &format!("{side}_min"),
+            f2(min),
+            format!("{:.3}", r.min),
             "mm/s",
-            "min |v|, pixel 0, phi 0..25, gamma0 0..90",
-        ),
-        (
-            "near_max",
-            f2(published::NEAR_MAX),
-            format!("{:.3}", near.max),
+            &format!("min |v|, {over}"),
+        )?;
+        row(
+            &format!("{side}_max"),
+            f2(max),
+            format!("{:.3}", r.max),
             "mm/s",
-            "max |v|, pixel 0, phi 0..25, gamma0 0..90",
-        ),
-        (
-            "near_change",
-            format!("{:.1}", published::NEAR_CHANGE_PCT),
-            format!("{:.2}", near.change_over_min_pct()),
-            "%",
-            "(max - min) / min",
-        ),
-        (
-            "near_change_over_max",
-            "".into(),
-            format!("{:.2}", near.change_over_max_pct()),
+            &format!("max |v|, {over}"),
+        )?;
+        let (p, o) = (format!("{change:.1}"), f2(r.change_over_min_pct()));
+        row(&format!("{side}_change"), p, o, "%", "(max - min) / min")?;
+        let o = f2(r.change_over_max_pct());
+        row(
+            &format!("{side}_change_over_max"),
+            String::new(),
+            o,
             "%",
             "(max - min) / max (not the paper's)",
-        ),
-        (
-            "far_min",
-            f2(published::FAR_MIN),
-            format!("{:.3}", far.min),
-            "mm/s",
-            "min |v|, pixel 60000, phi 0..25, gamma0 0..90",
-        ),
-        (
-            "far_max",
-            f2(published::FAR_MAX),
-            format!("{:.3}", far.max),
-            "mm/s",
-            "max |v|, pixel 60000, phi 0..25, gamma0 0..90",
-        ),
-        (
-            "far_change",
-            format!("{:.1}", published::FAR_CHANGE_PCT),
-            format!("{:.2}", far.change_over_min_pct()),
-            "%",
-            "(max - min) / min",
-        ),
-        (
-            "far_change_over_max",
-            "".into(),
-            format!("{:.2}", far.change_over_max_pct()),
-            "%",
-            "(max - min) / max (not the paper's)",
-        ),
-        (
-            "far_phi25_worst_rel_mismatch",
-            format!("{:.3}", 100.0 * implied_rel(published::MTF_M48, 48)?),
-            format!("{:.3}", 100.0 * worst),
-            "%",
-            "max |v(g0) - v(0)| / v(0), g0 0..90; paper's value implied by its 0.681 at M = 48",
-        ),
-        (
-            "mtf_mismatch_M48",
-            format!("{:.3}", published::MTF_M48),
-            format!("{mtf48:.4}"),
-            "",
-            "min over g0 0..90, far point, phi 25, line period held at g0 = 0",
-        ),
-        (
-            "max_stages_mtf_0.95",
-            published::MAX_STAGES.to_string(),
-            max_m.to_string(),
-            "stages",
-            "largest M with MTF_mismatch >= 0.95 over g0 0..90 (any M)",
-        ),
-    ];
-    for (q, p, o, u, d) in rows {
-        csv.row(&[q, &p, &o, u, d])?;
+        )?;
     }
+    row(
+        "far_phi25_worst_rel_mismatch",
+        format!("{:.3}", 100.0 * implied_rel(published::MTF_M48, 48)?),
+        format!("{:.3}", 100.0 * worst),
+        "%",
+        "max |v(g0) - v(0)| / v(0), g0 0..90; paper's value implied by its 0.681 at M = 48",
+    )?;
+    row(
+        "mtf_mismatch_M48",
+        format!("{:.3}", published::MTF_M48),
+        format!("{mtf48:.4}"),
+        "",
+        "min over g0 0..90, far point, phi 25, line period held at g0 = 0",
+    )?;
+    row(
+        "max_stages_mtf_0.95",
+        published::MAX_STAGES.to_string(),
+        max_m.to_string(),
+        "stages",
+        "largest M with MTF_mismatch >= 0.95 over g0 0..90 (any M)",
+    )?;
     out.write("summary.csv", &csv.into_bytes()?)?;
     println!(
         "near [{:.3}, {:.3}] mm/s, {:.2} %; far [{:.3}, {:.3}] mm/s, {:.2} %; MTF(M=48) {:.4}; max M {}",
@@ -697,14 +664,15 @@ fn hypotheses(out: &mut Out) -> Result<()> {
             "max_stages",
         ],
     )?;
+    let (near, far) = (published::NEAR, published::FAR);
     csv.row(&[
         "paper".to_string(),
-        f2(published::NEAR_MIN),
-        f2(published::NEAR_MAX),
-        format!("{:.1}", published::NEAR_CHANGE_PCT),
-        f2(published::FAR_MIN),
-        f2(published::FAR_MAX),
-        format!("{:.1}", published::FAR_CHANGE_PCT),
+        f2(near.0),
+        f2(near.1),
+        format!("{:.1}", near.2),
+        f2(far.0),
+        f2(far.1),
+        format!("{:.1}", far.2),
         format!("{:.3}", 100.0 * implied_rel(published::MTF_M48, 48)?),
         format!("{:.3}", published::MTF_M48),
         published::MAX_STAGES.to_string(),
@@ -727,7 +695,7 @@ fn hypotheses(out: &mut Out) -> Result<()> {
                 Some(r) => [
                     format!("{:.3}", r.min),
                     format!("{:.3}", r.max),
-                    format!("{:.2}", r.change_over_min_pct()),
+                    f2(r.change_over_min_pct()),
                 ],
                 None => Default::default(),
             });

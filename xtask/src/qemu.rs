@@ -23,7 +23,7 @@ mod profile;
 mod runner;
 mod tools;
 
-use anyhow::{anyhow, bail, Context, Result};
+use anyhow::{bail, Context, Result};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
@@ -34,7 +34,7 @@ pub use board::{size, SizeArgs};
 pub use flash::{flash, FlashArgs};
 pub use pass::{e2e_test, run, RunArgs};
 pub use runner::qemu;
-pub use tools::{ensure_rust_target, ensure_target_tools};
+pub use tools::{ensure_rust_target, ensure_target_tools, status};
 
 /// The firmware's target on the Cortex-M4F boards: hard-float ABI.
 pub const TARGET: &str = "thumbv7em-none-eabihf";
@@ -157,15 +157,7 @@ pub(crate) fn cargo_command() -> Command {
 /// Runs cargo with `args` in the workspace root; an error if it fails.
 pub(crate) fn cargo(args: &[&str]) -> Result<()> {
     eprintln!("xtask: cargo {}", args.join(" "));
-    let status = cargo_command()
-        .args(args)
-        .status()
-        .context("cannot start cargo")?;
-    if status.success() {
-        Ok(())
-    } else {
-        Err(anyhow!("`cargo {}` failed ({status})", args.join(" ")))
-    }
+    tools::status(cargo_command().args(args))
 }
 
 /// `--config` arguments that make this very xtask binary the thumbv7em runner, so that

@@ -38,6 +38,7 @@ use core_math::{
 
 use crate::accuracy::{percentile, U_F32};
 use crate::markdown;
+use crate::plot::{Plot, Series};
 use crate::qemu::board::Board;
 use crate::qemu::{bench_counts, BenchCounts};
 
@@ -208,7 +209,7 @@ fn write_artefacts(rows: &[Row], trailer: &str) -> Result<()> {
     let new_doc = replace_table(&doc, rows, trailer)
         .with_context(|| format!("{DOC} lacks the report markers"))?;
     std::fs::write(&doc_path, new_doc).with_context(|| format!("writing {DOC}"))?;
-    let mut plot = crate::plot::Plot::new(
+    let mut plot = Plot::new(
         "Error against run time, per backend (Cortex-M4F; thin: Cortex-M3)",
         "log10 instructions per pixel",
         "max relative error of |v_P|",
@@ -221,34 +222,28 @@ fn write_artefacts(rows: &[Row], trailer: &str) -> Result<()> {
         let (Some(far), Some(near), Some(instr)) = (parse(1), parse(3), parse(4)) else {
             continue;
         };
+        // A cross at the M4F's count (named), a slash for the near-limb error (dashed), a
+        // thin cross at the M3's count.
+        let mark = |name: &str, pts: Vec<(f64, f64)>, width: f64| {
+            Series::line(name, pts).palette(i).width(width)
+        };
         let x = instr.log10();
-        let c = crate::plot::Series::line(&r[0], vec![(x - 0.06, far), (x + 0.06, far)]);
         plot = plot
-            .series(c.palette(i).width(3.0))
+            .series(mark(&r[0], vec![(x - 0.06, far), (x + 0.06, far)], 3.0))
+            .series(mark("", vec![(x, far / 1.6), (x, far * 1.6)], 3.0))
             .series(
-                crate::plot::Series::line("", vec![(x, far / 1.6), (x, far * 1.6)])
-                    .palette(i)
-                    .width(3.0),
-            )
-            .series(
-                crate::plot::Series::line("", vec![(x - 0.06, near / 1.6), (x + 0.06, near * 1.6)])
-                    .palette(i)
-                    .width(3.0)
-                    .dashed(),
+                mark(
+                    "",
+                    vec![(x - 0.06, near / 1.6), (x + 0.06, near * 1.6)],
+                    3.0,
+                )
+                .dashed(),
             );
         if let Some(m3) = parse(7) {
             let x = m3.log10();
             plot = plot
-                .series(
-                    crate::plot::Series::line("", vec![(x - 0.04, far), (x + 0.04, far)])
-                        .palette(i)
-                        .width(1.5),
-                )
-                .series(
-                    crate::plot::Series::line("", vec![(x, far / 1.4), (x, far * 1.4)])
-                        .palette(i)
-                        .width(1.5),
-                );
+                .series(mark("", vec![(x - 0.04, far), (x + 0.04, far)], 1.5))
+                .series(mark("", vec![(x, far / 1.4), (x, far * 1.4)], 1.5));
         }
     }
     plot.save(&root.join(PNG))?;

@@ -25,7 +25,7 @@ use std::time::Instant;
 // this document's split the margin the same way.
 use crate::accuracy::U_F32;
 use crate::accuracy::{bucket, BUCKETS_DEG};
-use crate::markdown::{e2, sig};
+use crate::markdown::{e2, f2, sig, sig_range};
 use doc::{agg_table, describe, parts};
 use grid::Cell as _;
 use maps::{Cell, Map, MAPS};
@@ -58,10 +58,10 @@ pub fn run(args: &Args) -> Result<()> {
     let maps = grid::sweep_all(&MAPS, div, sub);
     let secs = t0.elapsed().as_secs_f64();
     let t1 = Instant::now();
-    let gmaps = grid::sweep_all(&general::GMAPS, div, None);
+    let gmaps: Vec<general::GMap> = grid::sweep_all(&general::GMAPS, div, None);
     let gsecs = t1.elapsed().as_secs_f64();
     let t2 = Instant::now();
-    let xmaps = grid::sweep_all::<general_fixed::FCell>(&general::GMAPS, div, None);
+    let xmaps: Vec<general_fixed::FMap> = grid::sweep_all(&general::GMAPS, div, None);
     let xsecs = t2.elapsed().as_secs_f64();
     let mut values = figures(&maps, secs);
     values.extend(general::figures(&gmaps, gsecs));
@@ -168,9 +168,9 @@ fn figures(maps: &[Map], secs: f64) -> BTreeMap<String, String> {
                 }
             }
         }
-        put("ratio_f32", format!("{:.2}", a.ratio_f32.max));
-        put("ratio_f32_in", format!("{:.2}", a.ratio_f32_in.max));
-        put("ratio_fixed", format!("{:.2}", a.ratio_fixed.max));
+        put("ratio_f32", f2(a.ratio_f32.max));
+        put("ratio_f32_in", f2(a.ratio_f32_in.max));
+        put("ratio_fixed", f2(a.ratio_fixed.max));
         put("kappa_min", sig(a.kappa_min));
         put("kappa_max", sig(a.kappa.max));
         put("e_f32", e2(a.err.f32));
@@ -181,9 +181,9 @@ fn figures(maps: &[Map], secs: f64) -> BTreeMap<String, String> {
     }
     let whole = merge(&all);
     put("kappa_min", sig(whole.kappa_min));
-    put("ratio_f32", format!("{:.2}", whole.ratio_f32.max));
-    put("ratio_f32_in", format!("{:.2}", whole.ratio_f32_in.max));
-    put("ratio_fixed", format!("{:.2}", whole.ratio_fixed.max));
+    put("ratio_f32", f2(whole.ratio_f32.max));
+    put("ratio_f32_in", f2(whole.ratio_f32_in.max));
+    put("ratio_fixed", f2(whole.ratio_fixed.max));
     put("e_f32", e2(whole.err.f32));
     put("e_fixed", e2(whole.err.fixed_worst()));
     for (what, w) in [("f32", &whole.ratio_f32), ("fixed", &whole.ratio_fixed)] {
@@ -221,21 +221,15 @@ fn figures(maps: &[Map], secs: f64) -> BTreeMap<String, String> {
     put("limb.e_f32", e2(near.err.f32));
     put("limb.e_f32_in", e2(near.err.f32_in));
     put("limb.e_fixed", e2(near.err.fixed_worst()));
-    put("limb.ratio_f32_in", format!("{:.2}", near.ratio_f32_in.max));
-    put(
-        "limb.kq",
-        format!("{} - {}", sig(near.kq.0), sig(near.kq.1)),
-    );
+    put("limb.ratio_f32_in", f2(near.ratio_f32_in.max));
+    put("limb.kq", sig_range(near.kq.0, near.kq.1));
     if let Some((p, o)) = &near.kappa.at {
         for (k, s) in sample_figures("limb.max_kappa", p, o) {
             put(&k, s);
         }
     }
     let far = &band_rows[0].1;
-    put(
-        "far.kappa",
-        format!("{} - {}", sig(far.kappa_min), sig(far.kappa.max)),
-    );
+    put("far.kappa", sig_range(far.kappa_min, far.kappa.max));
     if let Some((slope, n)) = doc::limb_slope(a_map, 0.1) {
         put("limb.slope", format!("{slope:.3}"));
         put("limb.slope_n", n.to_string());
@@ -258,14 +252,8 @@ fn figures(maps: &[Map], secs: f64) -> BTreeMap<String, String> {
     put("alt.fixed_hi", e2(alt_hi.err.fixed_worst()));
     put("alt.f32_lo", e2(alt_lo.err.f32));
     put("alt.f32_hi", e2(alt_hi.err.f32));
-    put(
-        "alt.ratio_fixed_lo",
-        format!("{:.2}", alt_lo.ratio_fixed.max),
-    );
-    put(
-        "alt.ratio_fixed_hi",
-        format!("{:.2}", alt_hi.ratio_fixed.max),
-    );
+    put("alt.ratio_fixed_lo", f2(alt_lo.ratio_fixed.max));
+    put("alt.ratio_fixed_hi", f2(alt_hi.ratio_fixed.max));
     // The fixed backend's bracket scale: |b/c0| in its units of 2^-10 rad/s (i0 97.98 deg).
     for h_km in [200.0, 2000.0] {
         let g = Point::circular(0.0, 0.0, maps::I0_SSO_DEG, 0.0, h_km).g;
@@ -304,7 +292,7 @@ fn figures(maps: &[Map], secs: f64) -> BTreeMap<String, String> {
         .fold(f64::INFINITY, f64::min);
     put("B.min_margin_deg", sig(min_margin.to_degrees()));
     let b_limb = (point::EARTH_RADIUS_M / (point::EARTH_RADIUS_M + 645e3)).asin();
-    put("B.limb_deg", format!("{:.2}", b_limb.to_degrees()));
+    put("B.limb_deg", f2(b_limb.to_degrees()));
 
     // Map C: v1's two terms.
     let c_map = map_by_key(maps, "inclination-latitude");
@@ -464,7 +452,7 @@ mod tests {
         let maps: Vec<general_fixed::FMap> = grid::sweep_all(&general::GMAPS, 4, None);
         let bad = grid::broken(&maps);
         assert!(bad.is_empty(), "{}", bad.join("\n"));
-        let mut a = general_fixed::FCell::empty();
+        let mut a = general::GCell::<general_fixed::Fixed>::empty();
         for m in &maps {
             a.merge(&m.aggregate(|_, _| true));
         }
@@ -472,8 +460,8 @@ mod tests {
         assert_eq!((a.refused, a.non_finite), (0, 0));
         assert!(a.min_margin_rad.to_degrees() < 0.02, "{}", a.min_margin_rad);
         assert!(a.err.max > 1e-8, "fixed err {}", a.err.max);
-        assert!(a.near.at.is_some() && a.far_tame.at.is_some());
-        assert!(a.far_tame.max > 1e-9, "far err {}", a.far_tame.max);
+        assert!(a.near.at.is_some() && a.tame.at.is_some());
+        assert!(a.tame.max > 1e-9, "far err {}", a.tame.max);
     }
 
     /// |v_P| = f x (angular rate) x a function of h = H/R and the angles: scaling H and R

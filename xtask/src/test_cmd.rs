@@ -1,6 +1,6 @@
 //! `cargo xtask test`: every check CI runs, in the order a failure is cheapest to see.
 
-use anyhow::{anyhow, Context, Result};
+use anyhow::{Context, Result};
 use std::process::Command;
 
 use crate::qemu::cargo;
@@ -8,15 +8,7 @@ use crate::qemu::cargo;
 /// Runs a command with inherited output; an error names it and its status.
 pub fn run_step(program: &str, args: &[&str]) -> Result<()> {
     eprintln!("\n==> {program} {}", args.join(" "));
-    let status = Command::new(program)
-        .args(args)
-        .status()
-        .with_context(|| format!("cannot start `{program}`"))?;
-    if status.success() {
-        Ok(())
-    } else {
-        Err(anyhow!("`{program} {}` failed ({status})", args.join(" ")))
-    }
+    crate::qemu::status(Command::new(program).args(args))
 }
 
 pub fn run() -> Result<()> {

@@ -30,15 +30,7 @@ pub fn ensure_rust_target(target: &str) -> Result<()> {
                 return Ok(());
             }
             eprintln!("xtask: rustup target add {target}");
-            let status = Command::new("rustup")
-                .args(["target", "add", target])
-                .status()
-                .context("cannot run rustup")?;
-            if status.success() {
-                Ok(())
-            } else {
-                Err(anyhow!("`rustup target add {target}` failed ({status})"))
-            }
+            status(Command::new("rustup").args(["target", "add", target]))
         }
         _ => {
             // No rustup: accept a toolchain that already has the target's core library.
@@ -59,6 +51,24 @@ pub fn ensure_rust_target(target: &str) -> Result<()> {
             }
         }
     }
+}
+
+/// Runs `cmd` with inherited output; an error names it (the program's file name and the
+/// arguments) and its exit status.
+pub fn status(cmd: &mut Command) -> Result<()> {
+    let program = std::path::Path::new(cmd.get_program()).file_name();
+    let program = program.unwrap_or_default().to_string_lossy().into_owned();
+    let line = std::iter::once(program.clone())
+        .chain(cmd.get_args().map(|a| a.to_string_lossy().into_owned()))
+        .collect::<Vec<_>>()
+        .join(" ");
+    let status = cmd
+        .status()
+        .with_context(|| format!("cannot start `{program}`"))?;
+    if !status.success() {
+        bail!("`{line}` failed ({status})");
+    }
+    Ok(())
 }
 
 /// True when `program --version` runs.
@@ -87,24 +97,13 @@ pub(super) fn apt_install(packages: &[&str], why: &str) -> Result<()> {
         );
     }
     eprintln!("xtask: {why} is missing; apt-get update && apt-get install -y {list}");
-    let update = Command::new("apt-get")
-        .args(["update"])
-        .status()
-        .context("cannot run apt-get")?;
-    if !update.success() {
-        bail!("`apt-get update` failed ({update})");
-    }
-    let install = Command::new("apt-get")
-        .args(["install", "-y"])
-        .args(packages)
-        .env("DEBIAN_FRONTEND", "noninteractive")
-        .status()
-        .context("cannot run apt-get")?;
-    if install.success() {
-        Ok(())
-    } else {
-        Err(anyhow!("`apt-get install -y {list}` failed ({install})"))
-    }
+    status(Command::new("apt-get").arg("update"))?;
+    status(
+        Command::new("apt-get")
+            .args(["install", "-y"])
+            .args(packages)
+            .env("DEBIAN_FRONTEND", "noninteractive"),
+    )
 }
 
 fn ensure_qemu() -> Result<()> {

@@ -4,7 +4,7 @@ use anyhow::{Context, Result};
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use crate::markdown::{e2, f2, sig, table};
+use crate::markdown::{e2, f2, sig, sig_range, table};
 
 use super::grid;
 use super::maps::{Cell, Map};
@@ -159,7 +159,7 @@ fn agg_row(first: String, a: &Cell) -> Vec<String> {
     vec![
         first,
         a.n.to_string(),
-        format!("{} - {}", sig(a.kappa_min), sig(a.kappa.max)),
+        sig_range(a.kappa_min, a.kappa.max),
         e2(a.err.f32),
         e2(a.err.f32_v1),
         e2(a.err.f32_in),
@@ -168,7 +168,7 @@ fn agg_row(first: String, a: &Cell) -> Vec<String> {
         f2(a.ratio_f32.max),
         f2(a.ratio_f32_in.max),
         f2(a.ratio_fixed.max),
-        format!("{} - {}", sig(a.kq.0), sig(a.kq.1)),
+        sig_range(a.kq.0, a.kq.1),
         a.refused.to_string(),
     ]
 }

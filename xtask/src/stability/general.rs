@@ -15,13 +15,16 @@ use core_math::accuracy::{
 use core_math::earth::{circular_state, limb_margin_rad, Attitude, EarthCamera, EarthGeometry};
 use core_math::sample::{roll_at_limb_margin, EarthCase};
 use core_math::vector::norm;
-use core_math::{Backend, EarthReference, Ellipsoid, EARTH_RATE_RAD_S, GENERAL_F32};
+use core_math::{
+    Backend, EarthReference, Ellipsoid, ImageMotion, ModelError, EARTH_RATE_RAD_S, GENERAL_F32,
+};
 
 use std::path::Path;
 
-use crate::markdown::{e2, sig, table};
+use crate::markdown::{e2, f2, sig, sig_range, table};
 
 use super::doc::lg;
+use super::general_fixed::{FAR_TARGET, NEAR_TARGET};
 use super::grid::{self, Cell as _, Panel, Spec, Worst};
 use super::maps::I0_SSO_DEG;
 use crate::accuracy::U_F32;
@@ -187,10 +190,78 @@ pub const GMAPS: [Spec<EarthCase>; 5] = [
     },
 ];
 
+/// A real-Earth backend under test against `EarthReference`: the inputs it takes, and
+/// its motion widened to f64. Both backends share one path ([`evaluate`], [`GCell`]);
+/// each keeps its own checks and wording.
+pub trait Tested: Clone + Copy + std::fmt::Debug + Default + Send {
+    /// The inputs the reference takes for the case's `g`: the backend's own inputs,
+    /// widened back to f64 where it rounds them itself on the way in.
+    fn inputs(g: &EarthGeometry<f64>) -> Result<EarthGeometry<f64>, ModelError>;
+    /// The backend's motion at those inputs, widened to f64.
+    fn motion(
+        c: &EarthCamera,
+        g: &EarthGeometry<f64>,
+        n_px: f64,
+    ) -> Result<ImageMotion<f64>, ModelError>;
+    /// What [`describe`] adds after the place.
+    fn note(o: &GOutcome) -> String;
+    /// Each stated bound a cell (or an aggregate) breaks, one line each.
+    fn broken(c: &GCell<Self>) -> Vec<String>;
+}
+
+/// `GENERAL_F32`, the attitude rounded to f32 by the backend itself; the reference at
+/// the inputs as given.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct F32;
+
+impl Tested for F32 {
+    fn inputs(g: &EarthGeometry<f64>) -> Result<EarthGeometry<f64>, ModelError> {
+        Ok(*g)
+    }
+
+    fn motion(
+        c: &EarthCamera,
+        g: &EarthGeometry<f64>,
+        n_px: f64,
+    ) -> Result<ImageMotion<f64>, ModelError> {
+        let m = GENERAL_F32.evaluate(c, &g.to::<f32>(), n_px)?;
+        Ok(ImageMotion {
+            v1_mps: f64::from(m.v1_mps),
+            v2_mps: f64::from(m.v2_mps),
+        })
+    }
+
+    fn note(o: &GOutcome) -> String {
+        format!(", v1 {} m/s", e2(o.v1))
+    }
+
+    /// A case at least [`MIN_MARGIN_DEG`] inside the limb that breaks
+    /// err <= EARTH_F32_KAPPA_C kappa u32, or one the f32 backend refused although the
+    /// reference accepts it.
+    fn broken(c: &GCell<F32>) -> Vec<String> {
+        let mut bad = Vec::new();
+        if c.ratio.max > EARTH_F32_KAPPA_C {
+            let at = c.ratio.at.map(|(c, o)| describe::<F32>(&c, &o));
+            bad.push(format!(
+                "general f32 err/(kappa u) = {:.3} > {EARTH_F32_KAPPA_C} at {}",
+                c.ratio.max,
+                at.unwrap_or_default()
+            ));
+        }
+        if c.refused > 0 {
+            bad.push(format!(
+                "{} case(s) the reference accepts refused by GENERAL_F32",
+                c.refused
+            ));
+        }
+        bad
+    }
+}
+
 /// What one case measures.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct GOutcome {
-    /// |dv| / |v| of GENERAL_F32 (attitude rounded to f32) against the reference.
+    /// |dv| / |v| of the backend (at its own inputs) against the reference.
     pub err: f64,
     /// |dv1| / |v1|: the line period's relative error (period = pixel / |v1|).
     pub err_v1: f64,
@@ -205,31 +276,43 @@ impl GOutcome {
     pub fn ratio(&self) -> f64 {
         self.err / (self.kappa * U_F32)
     }
-}
 
-pub enum GSkip {
-    /// Beyond the limb or within [`MIN_MARGIN_DEG`] of it.
-    Outside,
-    /// The reference accepts and the f32 backend refuses: a defect.
-    Refused,
-}
-
-pub fn evaluate(c: &EarthCase) -> Result<GOutcome, GSkip> {
-    let margin = limb_margin_rad(&c.geometry, &c.camera, c.n_px).map_err(|_| GSkip::Outside)?;
-    // Also NaN.
-    if margin.to_degrees().partial_cmp(&MIN_MARGIN_DEG) == Some(std::cmp::Ordering::Less)
-        || margin.is_nan()
-    {
-        return Err(GSkip::Outside);
+    /// The fixed backend's target at this case's limb margin (the maps stop at 0.01 deg).
+    pub fn target(&self) -> f64 {
+        if self.margin_rad.to_degrees() >= 1.0 {
+            FAR_TARGET
+        } else {
+            NEAR_TARGET
+        }
     }
+}
+
+/// Why a case has no outcome.
+pub enum GSkip {
+    /// Beyond the limb or within [`MIN_MARGIN_DEG`] of it, or the reference refuses it.
+    Outside,
+    /// The reference accepts and the backend refuses, with its typed error.
+    Refused(ModelError),
+    /// An Ok that is not finite (a defect: it must never happen).
+    NonFinite,
+}
+
+pub fn evaluate<B: Tested>(c: &EarthCase) -> Result<GOutcome, GSkip> {
+    let margin = match limb_margin_rad(&c.geometry, &c.camera, c.n_px) {
+        // Also NaN.
+        Ok(m) if m.to_degrees() >= MIN_MARGIN_DEG => m,
+        _ => return Err(GSkip::Outside),
+    };
+    let g64 = B::inputs(&c.geometry).map_err(GSkip::Refused)?;
     let r = EarthReference
-        .evaluate(&c.camera, &c.geometry, c.n_px)
+        .evaluate(&c.camera, &g64, c.n_px)
         .map_err(|_| GSkip::Outside)?;
-    let m = GENERAL_F32
-        .evaluate(&c.camera, &c.geometry.to::<f32>(), c.n_px)
-        .map_err(|_| GSkip::Refused)?;
-    let kappa = earth_kappa(&c.camera, &c.geometry, c.n_px).map_err(|_| GSkip::Outside)?;
-    let (d1, d2) = (m.v1_mps as f64 - r.v1_mps, m.v2_mps as f64 - r.v2_mps);
+    let m = B::motion(&c.camera, &g64, c.n_px).map_err(GSkip::Refused)?;
+    if !(m.v1_mps.is_finite() && m.v2_mps.is_finite()) {
+        return Err(GSkip::NonFinite);
+    }
+    let kappa = earth_kappa(&c.camera, &g64, c.n_px).map_err(|_| GSkip::Outside)?;
+    let (d1, d2) = (m.v1_mps - r.v1_mps, m.v2_mps - r.v2_mps);
     let v = libm::hypot(r.v1_mps, r.v2_mps);
     Ok(GOutcome {
         err: libm::hypot(d1, d2) / v,
@@ -244,11 +327,16 @@ pub fn evaluate(c: &EarthCase) -> Result<GOutcome, GSkip> {
 /// A case of a general map: where, and what it measured.
 pub type GSample = (EarthCase, GOutcome);
 
-/// Maxima over a cell's (or a set of cells') cases, with the case behind each.
+/// Maxima over a cell's (or a set of cells') cases, with the case behind each: what
+/// either backend's section of the document quotes.
 #[derive(Clone, Debug, Default)]
-pub struct GCell {
+pub struct GCell<B = F32> {
     pub n: u64,
+    /// Typed refusals of cases the reference accepts, and the first error seen.
     pub refused: u64,
+    pub refused_by: Option<ModelError>,
+    /// Ok results that are not finite (must stay 0).
+    pub non_finite: u64,
     pub err: Worst<GSample>,
     pub err_v1: Worst<GSample>,
     pub kappa: Worst<GSample>,
@@ -264,20 +352,41 @@ pub struct GCell {
     pub tame: Worst<GSample>,
     /// The largest |dv1|/|v1| where the drift is under 60 deg (|v1| >= |v|/2).
     pub steady: Worst<GSample>,
+    /// The largest error at least 1 deg inside the limb, and from 0.01 to 1 deg.
+    pub far: Worst<GSample>,
+    pub near: Worst<GSample>,
+    /// err / [`GOutcome::target`]: the largest over all cases, and over the checked ones
+    /// (every case from 0.01 to 1 deg, those with kappa <= 30 from 1 deg outward).
+    pub of_target: Worst<GSample>,
+    pub of_target_checked: Worst<GSample>,
+    /// Cases over their band's target, and the smallest kappa among them.
+    pub over: u64,
+    pub over_kappa_min: f64,
+    backend: std::marker::PhantomData<B>,
 }
 
-impl grid::Cell for GCell {
+impl<B: Tested> grid::Cell for GCell<B> {
     type Point = EarthCase;
 
     fn empty() -> Self {
-        GCell::empty()
+        GCell {
+            kappa_min: f64::INFINITY,
+            min_margin_rad: f64::INFINITY,
+            over_tol_kappa_min: f64::INFINITY,
+            over_kappa_min: f64::INFINITY,
+            ..GCell::default()
+        }
     }
 
     fn sample(&mut self, c: &EarthCase) {
-        match evaluate(c) {
+        match evaluate::<B>(c) {
             Ok(o) => self.add(c, &o),
             Err(GSkip::Outside) => {}
-            Err(GSkip::Refused) => self.refused += 1,
+            Err(GSkip::Refused(e)) => {
+                self.refused += 1;
+                self.refused_by = self.refused_by.or(Some(e));
+            }
+            Err(GSkip::NonFinite) => self.non_finite += 1,
         }
     }
 
@@ -285,58 +394,43 @@ impl grid::Cell for GCell {
         self.n
     }
 
-    fn merge(&mut self, o: &GCell) {
-        if o.n == 0 {
-            self.refused += o.refused;
-            return;
-        }
+    fn merge(&mut self, o: &Self) {
         self.n += o.n;
         self.refused += o.refused;
+        self.refused_by = self.refused_by.or(o.refused_by);
+        self.non_finite += o.non_finite;
         self.kappa_min = self.kappa_min.min(o.kappa_min);
         self.min_margin_rad = self.min_margin_rad.min(o.min_margin_rad);
         self.over_tol += o.over_tol;
         self.over_tol_kappa_min = self.over_tol_kappa_min.min(o.over_tol_kappa_min);
-        self.tame.merge_raise(&o.tame);
-        self.steady.merge_raise(&o.steady);
-        self.ratio.merge(&o.ratio);
-        self.kappa.merge(&o.kappa);
-        self.err.merge(&o.err);
-        self.err_v1.merge(&o.err_v1);
+        self.over += o.over;
+        self.over_kappa_min = self.over_kappa_min.min(o.over_kappa_min);
+        for (s, o) in [
+            (&mut self.tame, &o.tame),
+            (&mut self.steady, &o.steady),
+            (&mut self.far, &o.far),
+            (&mut self.near, &o.near),
+            (&mut self.of_target_checked, &o.of_target_checked),
+        ] {
+            s.merge_raise(o);
+        }
+        for (s, o) in [
+            (&mut self.ratio, &o.ratio),
+            (&mut self.kappa, &o.kappa),
+            (&mut self.err, &o.err),
+            (&mut self.err_v1, &o.err_v1),
+            (&mut self.of_target, &o.of_target),
+        ] {
+            s.merge(o);
+        }
     }
 
-    /// A case at least [`MIN_MARGIN_DEG`] inside the limb that breaks
-    /// err <= EARTH_F32_KAPPA_C kappa u32, or one the f32 backend refused although the
-    /// reference accepts it.
     fn broken(&self) -> Vec<String> {
-        let mut bad = Vec::new();
-        if self.ratio.max > EARTH_F32_KAPPA_C {
-            let at = self.ratio.at.map(|(c, o)| describe(&c, &o));
-            bad.push(format!(
-                "general f32 err/(kappa u) = {:.3} > {EARTH_F32_KAPPA_C} at {}",
-                self.ratio.max,
-                at.unwrap_or_default()
-            ));
-        }
-        if self.refused > 0 {
-            bad.push(format!(
-                "{} case(s) the reference accepts refused by GENERAL_F32",
-                self.refused
-            ));
-        }
-        bad
+        B::broken(self)
     }
 }
 
-impl GCell {
-    pub fn empty() -> Self {
-        GCell {
-            kappa_min: f64::INFINITY,
-            min_margin_rad: f64::INFINITY,
-            over_tol_kappa_min: f64::INFINITY,
-            ..GCell::default()
-        }
-    }
-
+impl<B: Tested> GCell<B> {
     fn add(&mut self, c: &EarthCase, o: &GOutcome) {
         self.n += 1;
         self.kappa_min = self.kappa_min.min(o.kappa);
@@ -345,9 +439,26 @@ impl GCell {
             self.over_tol += 1;
             self.over_tol_kappa_min = self.over_tol_kappa_min.min(o.kappa);
         }
+        let of_target = o.err / o.target();
+        if of_target > 1.0 {
+            self.over += 1;
+            self.over_kappa_min = self.over_kappa_min.min(o.kappa);
+        }
         let w = (*c, *o);
-        if o.kappa <= EARTH_F32_KAPPA_LIMIT && o.margin_rad.to_degrees() >= 1.0 {
-            self.tame.raise(o.err, w);
+        let (tame, far) = (
+            o.kappa <= EARTH_F32_KAPPA_LIMIT,
+            o.margin_rad.to_degrees() >= 1.0,
+        );
+        if far {
+            self.far.raise(o.err, w);
+            if tame {
+                self.tame.raise(o.err, w);
+            }
+        } else {
+            self.near.raise(o.err, w);
+        }
+        if tame || !far {
+            self.of_target_checked.raise(of_target, w);
         }
         if o.v1.abs() >= 0.5 * o.v {
             self.steady.raise(o.err_v1, w);
@@ -356,22 +467,15 @@ impl GCell {
         self.kappa.offer(o.kappa, w);
         self.err.offer(o.err, w);
         self.err_v1.offer(o.err_v1, w);
+        self.of_target.offer(of_target, w);
     }
 }
 
-/// A swept map of the general model.
-pub type GMap = grid::Map<GCell>;
+/// A swept map of the general model for backend `B`.
+pub type GMap<B = F32> = grid::Map<GCell<B>>;
 
-/// Where a case is.
-pub fn describe(c: &EarthCase, o: &GOutcome) -> String {
-    let mut s = case_place(c, o.margin_rad, o.v);
-    s.push_str(&format!(", v1 {} m/s", e2(o.v1)));
-    s
-}
-
-/// Where a case is, and its limb margin and image speed: the words every general map's
-/// `describe` starts with.
-pub fn case_place(c: &EarthCase, margin_rad: f64, v_mps: f64) -> String {
+/// Where a case is, its limb margin and image speed, then the backend's note.
+pub fn describe<B: Tested>(c: &EarthCase, o: &GOutcome) -> String {
     let a = &c.geometry.attitude;
     let r = c.geometry.state.position_m;
     let h_km = (norm(r) - c.geometry.ellipsoid.a_m) / 1e3;
@@ -389,10 +493,11 @@ pub fn case_place(c: &EarthCase, margin_rad: f64, v_mps: f64) -> String {
         ));
     }
     s.push_str(&format!(
-        ", n_px {:.0}; limb margin {} deg, |v| {} m/s",
+        ", n_px {:.0}; limb margin {} deg, |v| {} m/s{}",
         c.n_px,
-        sig(margin_rad.to_degrees()),
-        e2(v_mps)
+        sig(o.margin_rad.to_degrees()),
+        e2(o.v),
+        B::note(o)
     ));
     s
 }
@@ -404,7 +509,7 @@ pub fn write_pngs(m: &GMap, dir: &Path) -> Result<()> {
         .iter()
         .filter(|c| c.n > 0)
         .fold(1.0f64, |a, c| a.max(c.kappa.max));
-    let panels: [Panel<GCell>; 3] = [
+    let panels: [Panel<GCell<F32>>; 3] = [
         Panel {
             suffix: "kappa",
             title: "condition number kappa",
@@ -457,7 +562,7 @@ fn row(name: &str, a: &GCell) -> Vec<String> {
     vec![
         name.to_string(),
         a.n.to_string(),
-        format!("{} - {}", sig(a.kappa_min), sig(a.kappa.max)),
+        sig_range(a.kappa_min, a.kappa.max),
         e2(a.err.max),
         e2(a.err_v1.max),
         if a.tame.max > 0.0 {
@@ -471,7 +576,7 @@ fn row(name: &str, a: &GCell) -> Vec<String> {
         } else {
             "-".into()
         },
-        format!("{:.2}", a.ratio.max),
+        f2(a.ratio.max),
         sig(a.min_margin_rad.to_degrees()),
         a.refused.to_string(),
     ]
@@ -500,7 +605,7 @@ pub fn figures(maps: &[GMap], secs: f64) -> std::collections::BTreeMap<String, S
             ),
         );
         put("others", m.spec.others.into());
-        put("ratio", format!("{:.2}", a.ratio.max));
+        put("ratio", f2(a.ratio.max));
         put("kappa_max", sig(a.kappa.max));
         put("err", e2(a.err.max));
         put("err_v1", e2(a.err_v1.max));
@@ -514,28 +619,21 @@ pub fn figures(maps: &[GMap], secs: f64) -> std::collections::BTreeMap<String, S
             ("tame", &a.tame),
             ("max_err_v1", &a.err_v1),
         ] {
-            if let Some((c, o)) = &w.at {
-                put(&format!("{what}.at"), describe(c, o));
-                put(&format!("{what}.kappa"), sig(o.kappa));
-                put(&format!("{what}.err"), e2(o.err));
-                put(&format!("{what}.ratio"), format!("{:.2}", o.ratio()));
-                put(&format!("{what}.err_v1"), e2(o.err_v1));
-                put(&format!("{what}.v"), e2(o.v));
-            }
+            case_figures::<F32>(&mut put, what, w);
         }
         rows.push(row(&format!("{}: {}", m.spec.letter, m.spec.title), &a));
         all.merge(&a);
     }
     rows.push(row("all general maps", &all));
     put("G.samples", all.n.to_string());
-    put("G.ratio", format!("{:.2}", all.ratio.max));
+    put("G.ratio", f2(all.ratio.max));
     put("G.kappa_max", sig(all.kappa.max));
     put("G.err", e2(all.err.max));
     put("G.err_v1", e2(all.err_v1.max));
     put("G.err_v1_steady", e2(all.steady.max));
     put(
         "G.err_v1_steady_pct",
-        format!("{:.2}", 100.0 * all.steady.max / SEGMENT_BUDGET),
+        f2(100.0 * all.steady.max / SEGMENT_BUDGET),
     );
     put("G.err_tame", format!("{:.3e}", all.tame.max));
     put("G.over_tol_kappa", sig(all.over_tol_kappa_min));
@@ -544,16 +642,7 @@ pub fn figures(maps: &[GMap], secs: f64) -> std::collections::BTreeMap<String, S
         ("max_err_v1", &all.err_v1),
         ("steady", &all.steady),
     ] {
-        if let Some((c, o)) = &w.at {
-            let mut put = |x: &str, s: String| put(&format!("G.{what}.{x}"), s);
-            put("at", describe(c, o));
-            put("kappa", sig(o.kappa));
-            put("err", e2(o.err));
-            put("err_v1", e2(o.err_v1));
-            put("v", e2(o.v));
-            put("v1", e2(o.v1));
-            put("period_ms", sig(1e3 * CAMERA.pixel_m / o.v1.abs()));
-        }
+        case_figures::<F32>(&mut put, &format!("G.{what}"), w);
     }
     put("G.table", table(&TABLE_HEADER, &rows));
     put(
@@ -569,10 +658,7 @@ pub fn figures(maps: &[GMap], secs: f64) -> std::collections::BTreeMap<String, S
     );
     // The line period against a 96-stage segment's budget.
     put("G.budget", format!("{SEGMENT_BUDGET:.2e}"));
-    put(
-        "G.budget_pct",
-        format!("{:.2}", 100.0 * all.err_v1.max / SEGMENT_BUDGET),
-    );
+    put("G.budget_pct", f2(100.0 * all.err_v1.max / SEGMENT_BUDGET));
     put(
         "G.budget_kappa",
         sig(SEGMENT_BUDGET / (EARTH_F32_KAPPA_C * U_F32)),
@@ -601,10 +687,7 @@ pub fn figures(maps: &[GMap], secs: f64) -> std::collections::BTreeMap<String, S
         put("E.far_over_tol", far.over_tol.to_string());
         put("E.far_over_tol_kappa", sig(far.over_tol_kappa_min));
         let near = e.aggregate(|_, y| y < -1.0);
-        put(
-            "E.near_kappa",
-            format!("{} - {}", sig(near.kappa_min), sig(near.kappa.max)),
-        );
+        put("E.near_kappa", sig_range(near.kappa_min, near.kappa.max));
         // kappa x margin over each cell's largest-kappa case: kappa ~ 1/q ~ 1/sqrt(margin).
         let km: Vec<f64> = e
             .cells
@@ -615,7 +698,7 @@ pub fn figures(maps: &[GMap], secs: f64) -> std::collections::BTreeMap<String, S
         let (lo, hi) = km
             .iter()
             .fold((f64::INFINITY, 0.0f64), |(l, h), &x| (l.min(x), h.max(x)));
-        put("E.ksqrtm", format!("{} - {}", sig(lo), sig(hi)));
+        put("E.ksqrtm", sig_range(lo, hi));
     }
     // Maps D: kappa at least 1 deg inside the limb.
     for l in ["D", "D'"] {
@@ -629,7 +712,7 @@ pub fn figures(maps: &[GMap], secs: f64) -> std::collections::BTreeMap<String, S
             let l = l.replace('\'', "y");
             put(
                 &format!("{l}.far_kappa"),
-                format!("{} - {}", sig(a.kappa_min), sig(a.kappa.max)),
+                sig_range(a.kappa_min, a.kappa.max),
             );
             put(&format!("{l}.far_err"), e2(a.err.max));
         }
@@ -650,7 +733,7 @@ pub fn figures(maps: &[GMap], secs: f64) -> std::collections::BTreeMap<String, S
         put("F.pct_over", frac(&|c| c.over_tol > 0));
         // The reference |v| at zero rates, nadir pixel, for scale.
         let k0 = case(H0_KM, I0_SSO_DEG, G0_DEG, Attitude::default(), 0.0);
-        if let Ok(o) = evaluate(&k0) {
+        if let Ok(o) = evaluate::<F32>(&k0) {
             put("F.v0", e2(o.v));
             put("F.v1_0", e2(o.v1));
             put(
@@ -659,13 +742,30 @@ pub fn figures(maps: &[GMap], secs: f64) -> std::collections::BTreeMap<String, S
             );
             put("F.kappa0", sig(o.kappa));
             // The pitch rate whose rotational term f w matches |v| at nadir.
-            put(
-                "F.cancel_rate",
-                format!("{:.2}", (o.v / CAMERA.focal_m).to_degrees()),
-            );
+            put("F.cancel_rate", f2((o.v / CAMERA.focal_m).to_degrees()));
         }
     }
     v
+}
+
+/// The values the document may quote about one case (a map's worst, largest-kappa, ...),
+/// as (`{prefix}.<what>`, text). Every such case gets the same set, so that the template
+/// can quote any of them the same way; the keys it does not use are ignored.
+pub fn case_figures<B: Tested>(
+    put: &mut impl FnMut(&str, String),
+    prefix: &str,
+    w: &Worst<GSample>,
+) {
+    let Some((c, o)) = &w.at else { return };
+    put(&format!("{prefix}.at"), describe::<B>(c, o));
+    put(&format!("{prefix}.kappa"), sig(o.kappa));
+    put(&format!("{prefix}.err"), e2(o.err));
+    put(&format!("{prefix}.ratio"), f2(o.ratio()));
+    put(&format!("{prefix}.err_v1"), e2(o.err_v1));
+    put(&format!("{prefix}.v"), e2(o.v));
+    put(&format!("{prefix}.v1"), e2(o.v1));
+    let period_ms = 1e3 * CAMERA.pixel_m / o.v1.abs();
+    put(&format!("{prefix}.period_ms"), sig(period_ms));
 }
 
 /// Map E's table by limb-margin band (log10 of the margin in deg, the map's y): the

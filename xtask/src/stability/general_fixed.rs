@@ -12,226 +12,79 @@
 //! Every refusal is a typed error and is counted; none is silently skipped.
 
 use anyhow::Result;
-use core_math::accuracy::{earth_kappa, EARTH_F32_KAPPA_LIMIT};
+use core_math::accuracy::EARTH_F32_KAPPA_LIMIT;
 use core_math::earth::fixed::{geometry_from_f64, motion_to_f64};
-use core_math::earth::limb_margin_rad;
-use core_math::sample::EarthCase;
-use core_math::{Backend, EarthReference, ModelError, EARTH_FIXED};
+use core_math::earth::{EarthCamera, EarthGeometry};
+use core_math::{Backend, ImageMotion, ModelError, EARTH_FIXED};
 
 use std::path::Path;
 
 use crate::markdown::{e2, sig, table};
 
 use super::doc::lg;
-use super::general::MIN_MARGIN_DEG;
-use super::grid::{self, Cell as _, Panel, Worst};
+use super::general::{
+    case_figures, describe, GCell, GMap, GOutcome, GSample, Tested, MIN_MARGIN_DEG,
+};
+use super::grid::{Cell as _, Panel, Worst};
 
 /// The targets (relative |dv| / |v|) from 1 deg and from 0.01 deg inside the limb.
 pub const FAR_TARGET: f64 = 2e-6;
 pub const NEAR_TARGET: f64 = 2e-5;
 
-/// What one accepted case measures.
+/// `EARTH_FIXED`: the attitude rounded to I24F40, the reference at those inputs widened
+/// back.
 #[derive(Clone, Copy, Debug, Default)]
-pub struct FOutcome {
-    /// |dv| / |v| of EARTH_FIXED against the reference at the same (I24F40) inputs.
-    pub err: f64,
-    /// |dv1| / |v1|.
-    pub err_v1: f64,
-    pub kappa: f64,
-    pub margin_rad: f64,
-    /// |v| of the reference (m/s).
-    pub v: f64,
-}
+pub struct Fixed;
 
-impl FOutcome {
-    /// The target at this case's limb margin (the maps stop at 0.01 deg).
-    pub fn target(&self) -> f64 {
-        if self.margin_rad.to_degrees() >= 1.0 {
-            FAR_TARGET
-        } else {
-            NEAR_TARGET
-        }
-    }
-}
-
-/// What a case gives: measured, out of the maps (beyond or within 0.01 deg of the limb,
-/// or the reference refuses), refused by the backend with a typed error, or an Ok that
-/// is not finite (a defect: it must never happen).
-pub enum FResult {
-    Ok(FOutcome),
-    Outside,
-    Refused(ModelError),
-    NonFinite,
-}
-
-pub fn evaluate(c: &EarthCase) -> FResult {
-    let margin = match limb_margin_rad(&c.geometry, &c.camera, c.n_px) {
-        Ok(m) if m.to_degrees() >= MIN_MARGIN_DEG => m,
-        _ => return FResult::Outside,
-    };
-    let g = match geometry_from_f64(&c.geometry) {
-        Ok(g) => g,
-        Err(e) => return FResult::Refused(e),
-    };
-    let g64 = g.to_f64();
-    let Ok(r) = EarthReference.evaluate(&c.camera, &g64, c.n_px) else {
-        return FResult::Outside;
-    };
-    let m = match EARTH_FIXED.evaluate(&c.camera, &g, c.n_px) {
-        Ok(m) => motion_to_f64(&m),
-        Err(e) => return FResult::Refused(e),
-    };
-    if !(m.v1_mps.is_finite() && m.v2_mps.is_finite()) {
-        return FResult::NonFinite;
-    }
-    let Ok(kappa) = earth_kappa(&c.camera, &g64, c.n_px) else {
-        return FResult::Outside;
-    };
-    let (d1, d2) = (m.v1_mps - r.v1_mps, m.v2_mps - r.v2_mps);
-    let v = libm::hypot(r.v1_mps, r.v2_mps);
-    FResult::Ok(FOutcome {
-        err: libm::hypot(d1, d2) / v,
-        err_v1: d1.abs() / r.v1_mps.abs(),
-        kappa,
-        margin_rad: margin,
-        v,
-    })
-}
-
-/// A case of a fixed map: where, and what it measured.
-pub type FSample = (EarthCase, FOutcome);
-
-/// Maxima over a cell's (or a set of cells') cases, with the case behind each.
-#[derive(Clone, Debug, Default)]
-pub struct FCell {
-    pub n: u64,
-    /// Typed refusals of cases the reference accepts, and the first error seen.
-    pub refused: u64,
-    pub refused_by: Option<ModelError>,
-    /// Ok results that are not finite (must stay 0).
-    pub non_finite: u64,
-    pub err: Worst<FSample>,
-    pub err_v1: Worst<FSample>,
-    /// The largest error at least 1 deg inside the limb, and from 0.01 to 1 deg.
-    pub far: Worst<FSample>,
-    pub near: Worst<FSample>,
-    /// The first where kappa <= EARTH_F32_KAPPA_LIMIT, where its target is stated.
-    pub far_tame: Worst<FSample>,
-    /// err / target: the largest over all cases, and over the checked ones (every case
-    /// from 0.01 to 1 deg, those with kappa <= 30 from 1 deg outward).
-    pub of_target: Worst<FSample>,
-    pub of_target_checked: Worst<FSample>,
-    /// Cases over their band's target, and the smallest kappa among them.
-    pub over: u64,
-    pub over_kappa_min: f64,
-    pub min_margin_rad: f64,
-}
-
-impl grid::Cell for FCell {
-    type Point = EarthCase;
-
-    fn empty() -> Self {
-        FCell {
-            over_kappa_min: f64::INFINITY,
-            min_margin_rad: f64::INFINITY,
-            ..FCell::default()
-        }
+impl Tested for Fixed {
+    fn inputs(g: &EarthGeometry<f64>) -> Result<EarthGeometry<f64>, ModelError> {
+        Ok(geometry_from_f64(g)?.to_f64())
     }
 
-    fn sample(&mut self, c: &EarthCase) {
-        match evaluate(c) {
-            FResult::Ok(o) => self.add(c, &o),
-            FResult::Outside => {}
-            FResult::Refused(e) => {
-                self.refused += 1;
-                self.refused_by = self.refused_by.or(Some(e));
-            }
-            FResult::NonFinite => self.non_finite += 1,
-        }
+    /// The inputs rounded again, which gives them back exactly.
+    fn motion(
+        c: &EarthCamera,
+        g: &EarthGeometry<f64>,
+        n_px: f64,
+    ) -> Result<ImageMotion<f64>, ModelError> {
+        let q = geometry_from_f64(g)?;
+        Ok(motion_to_f64(&EARTH_FIXED.evaluate(c, &q, n_px)?))
     }
 
-    fn n(&self) -> u64 {
-        self.n
-    }
-
-    fn merge(&mut self, o: &FCell) {
-        self.n += o.n;
-        self.refused += o.refused;
-        self.refused_by = self.refused_by.or(o.refused_by);
-        self.non_finite += o.non_finite;
-        self.over += o.over;
-        self.over_kappa_min = self.over_kappa_min.min(o.over_kappa_min);
-        self.min_margin_rad = self.min_margin_rad.min(o.min_margin_rad);
-        self.err.merge(&o.err);
-        self.err_v1.merge(&o.err_v1);
-        self.of_target.merge(&o.of_target);
-        self.far.merge_raise(&o.far);
-        self.near.merge_raise(&o.near);
-        self.far_tame.merge_raise(&o.far_tame);
-        self.of_target_checked.merge_raise(&o.of_target_checked);
+    fn note(o: &GOutcome) -> String {
+        format!(", kappa {}", sig(o.kappa))
     }
 
     /// A checked case over its band's target, or a non-finite Ok. Refusals are
     /// typed errors, counted and reported, not failures: the backend's envelope
     /// (`docs/fixed-point.md`) is narrower than the reference's.
-    fn broken(&self) -> Vec<String> {
+    fn broken(c: &GCell<Fixed>) -> Vec<String> {
         let mut bad = Vec::new();
-        if self.of_target_checked.max > 1.0 {
-            let at = self.of_target_checked.at.map(|(c, o)| describe(&c, &o));
+        if c.of_target_checked.max > 1.0 {
+            let at = c
+                .of_target_checked
+                .at
+                .map(|(c, o)| describe::<Fixed>(&c, &o));
             bad.push(format!(
                 "EARTH_FIXED err/target = {:.3} > 1 at {}",
-                self.of_target_checked.max,
+                c.of_target_checked.max,
                 at.unwrap_or_default()
             ));
         }
-        if self.non_finite > 0 {
+        if c.non_finite > 0 {
             bad.push(format!(
                 "{} non-finite Ok result(s) of EARTH_FIXED",
-                self.non_finite
+                c.non_finite
             ));
         }
         bad
     }
 }
 
-impl FCell {
-    fn add(&mut self, c: &EarthCase, o: &FOutcome) {
-        self.n += 1;
-        self.min_margin_rad = self.min_margin_rad.min(o.margin_rad);
-        let w = (*c, *o);
-        let tame = o.kappa <= EARTH_F32_KAPPA_LIMIT;
-        let of_target = o.err / o.target();
-        if of_target > 1.0 {
-            self.over += 1;
-            self.over_kappa_min = self.over_kappa_min.min(o.kappa);
-        }
-        let far = o.margin_rad.to_degrees() >= 1.0;
-        if far {
-            self.far.raise(o.err, w);
-            if tame {
-                self.far_tame.raise(o.err, w);
-            }
-        } else {
-            self.near.raise(o.err, w);
-        }
-        if tame || !far {
-            self.of_target_checked.raise(of_target, w);
-        }
-        self.of_target.offer(of_target, w);
-        self.err.offer(o.err, w);
-        self.err_v1.offer(o.err_v1, w);
-    }
-}
-
 /// A swept map of the fixed backend.
-pub type FMap = grid::Map<FCell>;
-
-/// Where a case is.
-pub fn describe(c: &EarthCase, o: &FOutcome) -> String {
-    let mut s = super::general::case_place(c, o.margin_rad, o.v);
-    s.push_str(&format!(", kappa {}", sig(o.kappa)));
-    s
-}
+pub type FMap = GMap<Fixed>;
+type FCell = GCell<Fixed>;
+type FSample = GSample;
 
 /// Writes the map's PNG of the fixed error into `dir`.
 pub fn write_pngs(m: &FMap, dir: &Path) -> Result<()> {
@@ -275,7 +128,7 @@ fn row(name: &str, a: &FCell) -> Vec<String> {
         e2(a.err.max),
         e2(a.err_v1.max),
         or_dash(&a.far),
-        or_dash(&a.far_tame),
+        or_dash(&a.tame),
         or_dash(&a.near),
         sig(a.min_margin_rad.to_degrees()),
         if a.over > 0 {
@@ -305,9 +158,7 @@ pub fn figures(maps: &[FMap], secs: f64) -> std::collections::BTreeMap<String, S
         let mut put = |what: &str, s: String| put(&format!("X{l}.{what}"), s);
         put("err", e2(a.err.max));
         put("refused", a.refused.to_string());
-        if let Some((c, o)) = &a.err.at {
-            put("max_err.at", describe(c, o));
-        }
+        case_figures::<Fixed>(&mut put, "max_err", &a.err);
         rows.push(row(&format!("{}: {}", m.spec.letter, m.spec.title), &a));
         all.merge(&a);
     }
@@ -317,7 +168,7 @@ pub fn figures(maps: &[FMap], secs: f64) -> std::collections::BTreeMap<String, S
     put("X.err", e2(all.err.max));
     put("X.err_v1", e2(all.err_v1.max));
     put("X.far", e2(all.far.max));
-    put("X.far_tame", e2(all.far_tame.max));
+    put("X.far_tame", e2(all.tame.max));
     put("X.near", e2(all.near.max));
     put("X.over", all.over.to_string());
     put("X.over_kappa", sig(all.over_kappa_min));
@@ -328,15 +179,11 @@ pub fn figures(maps: &[FMap], secs: f64) -> std::collections::BTreeMap<String, S
     for (what, w) in [
         ("max_err", &all.err),
         ("far", &all.far),
-        ("far_tame", &all.far_tame),
+        ("far_tame", &all.tame),
         ("near", &all.near),
         ("of_target", &all.of_target),
     ] {
-        if let Some((c, o)) = &w.at {
-            put(&format!("X.{what}.at"), describe(c, o));
-            put(&format!("X.{what}.err"), e2(o.err));
-            put(&format!("X.{what}.kappa"), sig(o.kappa));
-        }
+        case_figures::<Fixed>(&mut put, &format!("X.{what}"), w);
     }
     put("X.table", table(&TABLE_HEADER, &rows));
     put(

@@ -9,6 +9,7 @@
 use anyhow::{anyhow, bail, Context, Result};
 use controller::bus::{Gnss, StarAttitude};
 use core_math::earth::dem::DemTile;
+pub use core_math::earth::frames::mat_mul;
 use core_math::earth::frames::{geodetic_from_itrf, Mat3, TimeScales};
 use core_math::earth::EarthGeometry;
 use core_math::EARTH_RATE_RAD_S;
@@ -125,10 +126,6 @@ for m in erfa.c2t06a(tt1, tt2, ut1, ut2, 0.0, 0.0):
 
 pub fn mat_vec(m: &Mat3, x: [f64; 3]) -> [f64; 3] {
     std::array::from_fn(|i| m[i][0] * x[0] + m[i][1] * x[1] + m[i][2] * x[2])
-}
-
-pub fn mat_mul(a: &Mat3, b: &Mat3) -> Mat3 {
-    std::array::from_fn(|i| std::array::from_fn(|j| (0..3).map(|k| a[i][k] * b[k][j]).sum()))
 }
 
 pub fn transpose(a: &Mat3) -> Mat3 {
