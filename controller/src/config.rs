@@ -10,6 +10,20 @@ pub const EARTH: Ellipsoid = Ellipsoid::WGS84;
 /// The Earth's rotation rate (rad/s): 7.292 115 9e-5 (IERS), core-math's.
 pub const EARTH_RATE_RAD_S: f64 = core_math::EARTH_RATE_RAD_S;
 
+/// How a star tracker's quaternion is blended with the attitude the gyros carried from
+/// the last one (`crate::track`; docs/controller.md, "The attitude between frames"): a complementary
+/// filter. Each new quaternion q_k is compared with the last estimate turned at its body
+/// rates and acceleration to t_k; the estimate moves by `gain` of the difference. The
+/// star tracker's noise (white, sigma per axis) leaves sigma sqrt(gain / (2 - gain)) in
+/// the estimate: 0.18 sigma at 1/16. A difference above `gate_rad` (a turn the gyros did
+/// not see), a gap above `max_gap_us` or `gain` 1 take the quaternion as it is.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AttitudeBlend {
+    pub gain: f32,
+    pub gate_rad: f32,
+    pub max_gap_us: u64,
+}
+
 /// Controller settings (defaults: `Config::default()`; rationale in docs/controller.md).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Config {
@@ -31,6 +45,11 @@ pub struct Config {
     /// outside b + low ..= a + high are refused, and scenes are planned and the period
     /// guard set for it.
     pub altitude_range_m: (f64, f64),
+    /// How the star tracker's quaternion is blended with the gyros' propagation.
+    /// Default gain 1/16, gate 3e-4 rad (15 sigma of a 4-arcsecond star tracker),
+    /// largest gap 0.5 s; [`AttitudeBlend::NONE`] for a bus that sends a filtered
+    /// attitude.
+    pub attitude_blend: AttitudeBlend,
     /// Evaluates the sample pixels in fixed point (`core_math::EARTH_FIXED`, integers
     /// only) instead of the f32 row form: for a core without an FPU. Off by default;
     /// the mps2-an385 firmware turns it on (docs/controller.md, "Backends").
@@ -46,6 +65,11 @@ impl Default for Config {
             gnss_stale_after_us: 2_000_000,
             max_time_jump_us: 5_000_000,
             altitude_range_m: (500e3, 800e3),
+            attitude_blend: AttitudeBlend {
+                gain: 0.0625,
+                gate_rad: 3e-4,
+                max_gap_us: 500_000,
+            },
             #[cfg(feature = "earth-fixed")]
             fixed_point_pixels: false,
         }

@@ -265,6 +265,7 @@ impl Controller {
                     &self.scene.mounting_q,
                     &pole,
                     &self.time_scales,
+                    self.gnss.as_ref(),
                 )
             });
         self.attitude = derived.ok();

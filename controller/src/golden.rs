@@ -17,7 +17,7 @@ use core_math::earth::dem::DemTile;
 use core_math::earth::frames::{self, TimeScales};
 use core_math::earth::kepler::Kepler;
 use core_math::earth::reference::EarthRefPixel;
-use core_math::earth::{Attitude, EarthCamera, EarthGeometry, InertialGeometry};
+use core_math::earth::{Attitude, EarthCamera, EarthGeometry, InertialAttitude, InertialGeometry};
 use core_math::{Backend, EarthReference, ImageMotion, ModelError, StateVector, GM_M3_S2};
 
 use crate::bus::{Gnss, StarAttitude};
@@ -195,15 +195,58 @@ fn bus_update_on(
         gps_s: Some(t_s),
         scales: *scales,
     };
+    // The controller's carry model: roll, pitch and yaw relative to the orbital frame
+    // keep their rates from the time of validity. Here exactly, through Part I's
+    // attitude at both instants; the quaternion at its body rates where the angles are
+    // degenerate.
+    let valid_s = secs(attitude.valid_us);
+    let at_valid = {
+        let carried = kepler.state_at(valid_s - secs(gnss.fix_us));
+        let c2t_v = frames::c2t(valid_s, scales)?;
+        let m: [[f64; 3]; 3] = core::array::from_fn(|i| {
+            core::array::from_fn(|j| (0..3).map(|k| c2t_v[i][k] * c2t_fix[j][k]).sum())
+        });
+        let to_v = |x: [f64; 3]| -> [f64; 3] {
+            core::array::from_fn(|i| m[i][0] * x[0] + m[i][1] * x[1] + m[i][2] * x[2])
+        };
+        let state_v = StateVector {
+            position_m: to_v(carried.position_m),
+            velocity_mps: to_v(carried.velocity_mps),
+        };
+        let camera = bus_geometry(
+            &BusState {
+                position_m: state_v.position_m,
+                velocity_mps: state_v.velocity_mps,
+                ..bus_state
+            },
+            &BusAttitude {
+                q: attitude.q.map(f64::from),
+                ..bus_attitude
+            },
+            &BusTime {
+                gps_s: Some(valid_s),
+                scales: *scales,
+            },
+            0.0,
+            EARTH,
+            EARTH_RATE_RAD_S,
+        )?;
+        (state_v, camera.attitude)
+    };
+    let euler_carried = euler_carried(&at_valid.0, &at_valid.1, &state, t_s - valid_s);
     let geometry = |h_m: f32| -> Result<InertialGeometry<f64>, ModelError> {
-        bus_geometry(
+        let g = bus_geometry(
             &bus_state,
             &bus_attitude,
             &time,
             f64::from(h_m),
             EARTH,
             EARTH_RATE_RAD_S,
-        )
+        )?;
+        Ok(InertialGeometry {
+            attitude: euler_carried.unwrap_or(g.attitude),
+            ..g
+        })
     };
     let evaluate =
         |camera: &EarthCamera, h_m: f32, n: f64| -> Result<ImageMotion<f64>, ModelError> {
@@ -227,6 +270,92 @@ fn bus_update_on(
         // The roll-pitch-yaw attitude is Part I's; the bus's is a quaternion.
         attitude: Attitude::default(),
     })
+}
+
+/// The camera's axes and angular velocity `dt_s` after `at` (in I of that instant,
+/// with the orbit's state `state_at` there), carried to `state` (in I of the later
+/// instant) with its roll, pitch and yaw relative to the orbital frame at constant
+/// rates: Part I's attitude (`EarthGeometry::to_inertial`) whose angles reproduce `at`'s
+/// axes and whose rates its angular velocity, advanced by `dt_s`. `None` where the
+/// angles are degenerate (pitch within 0.6 deg of +-90 deg).
+fn euler_carried(
+    state_at: &StateVector,
+    at: &InertialAttitude<f64>,
+    state: &StateVector,
+    dt_s: f64,
+) -> Option<InertialAttitude<f64>> {
+    let (r, v) = (state_at.position_m, state_at.velocity_mps);
+    let unit = |x: [f64; 3]| {
+        let n = libm::sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
+        x.map(|c| c / n)
+    };
+    let cross = |a: [f64; 3], b: [f64; 3]| {
+        [
+            a[1] * b[2] - a[2] * b[1],
+            a[2] * b[0] - a[0] * b[2],
+            a[0] * b[1] - a[1] * b[0],
+        ]
+    };
+    let (z_l, y_l) = (unit(r), unit(cross(r, v)));
+    let frame = [cross(y_l, z_l), y_l, z_l];
+    let m = &at.camera_to_inertial;
+    // A = L^T M: the camera's axes in the orbital frame, A = Rx(roll) Ry(pitch) Rz(yaw).
+    let a: [[f64; 3]; 3] = core::array::from_fn(|i| {
+        core::array::from_fn(|j| (0..3).map(|k| frame[i][k] * m[k][j]).sum())
+    });
+    if libm::fabs(a[0][2]) > libm::cos(0.01) {
+        return None;
+    }
+    let angles = Attitude {
+        roll_rad: libm::atan2(-a[1][2], a[2][2]),
+        pitch_rad: libm::asin(a[0][2]),
+        yaw_rad: libm::atan2(-a[0][1], a[0][0]),
+        ..Attitude::default()
+    };
+    let omega = |state: &StateVector, at: Attitude<f64>| {
+        EarthGeometry {
+            state: *state,
+            attitude: at,
+            ground_h_m: 0.0,
+            ellipsoid: EARTH,
+            earth_rate_rad_s: EARTH_RATE_RAD_S,
+        }
+        .to_inertial()
+        .ok()
+        .map(|g| g.attitude)
+    };
+    // Omega is affine in the three rates: its columns by unit rates, then solved.
+    let w0 = omega(state_at, angles)?.omega_rad_s;
+    let column = |k: usize| -> Option<[f64; 3]> {
+        let unit = Attitude {
+            roll_rate_rad_s: f64::from(u8::from(k == 0)),
+            pitch_rate_rad_s: f64::from(u8::from(k == 1)),
+            yaw_rate_rad_s: f64::from(u8::from(k == 2)),
+            ..angles
+        };
+        let w = omega(state_at, unit)?.omega_rad_s;
+        Some(core::array::from_fn(|i| w[i] - w0[i]))
+    };
+    let (c0, c1, c2) = (column(0)?, column(1)?, column(2)?);
+    let b: [f64; 3] = core::array::from_fn(|i| at.omega_rad_s[i] - w0[i]);
+    let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    let det = dot(c0, cross(c1, c2));
+    let rates = [
+        dot(b, cross(c1, c2)) / det,
+        dot(c0, cross(b, c2)) / det,
+        dot(c0, cross(c1, b)) / det,
+    ];
+    omega(
+        state,
+        Attitude {
+            roll_rad: angles.roll_rad + rates[0] * dt_s,
+            pitch_rad: angles.pitch_rad + rates[1] * dt_s,
+            yaw_rad: angles.yaw_rad + rates[2] * dt_s,
+            roll_rate_rad_s: rates[0],
+            pitch_rate_rad_s: rates[1],
+            yaw_rate_rad_s: rates[2],
+        },
+    )
 }
 
 /// The attitude quaternion `dt_s` after its validity, turned at its body rates:

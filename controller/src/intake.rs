@@ -216,8 +216,10 @@ impl Controller {
     /// An ATTITUDE frame's checks: finite (`non_finite`), the time of validity
     /// ([`Controller::check_data_time`], against `stale_after`), the quaternion's norm
     /// (`bad_quaternion`), the camera's rates (Omega, each axis) within the scene's
-    /// largest rate (`attitude_outside_model`). Returns the attitude in I and the pole
-    /// it was computed with (a new one when the one in force is too old for it).
+    /// largest rate (`attitude_outside_model`). Returns the attitude in I (the
+    /// quaternion blended with the last attitude carried: `Config::attitude_blend`) and
+    /// the pole it was computed with (a new one when the one in force is too old for
+    /// it).
     fn check_attitude(&self, frame: &Frame<'_>) -> Result<(AttitudeState, CelestialPole), Fault> {
         let received = StarAttitude::decode(frame.payload)?;
         let last = self.attitude.map(|a| a.received.valid_us);
@@ -228,8 +230,23 @@ impl Controller {
             self.config.stale_after_us,
         )?;
         let pole = pole_for(self.pole.as_ref(), received.valid_us, &self.time_scales)?;
-        let state =
-            AttitudeState::derive(&received, &self.scene.mounting_q, &pole, &self.time_scales)?;
+        // Blended only once it passed the quaternion's own check: a bad one is refused as
+        // it came.
+        crate::track::check_quaternion(&received)?;
+        let taken = match &self.attitude {
+            Some(last) => self
+                .config
+                .attitude_blend
+                .blend(last, &received, &self.scene.mounting_q),
+            None => received,
+        };
+        let state = AttitudeState::derive(
+            &taken,
+            &self.scene.mounting_q,
+            &pole,
+            &self.time_scales,
+            self.gnss.as_ref(),
+        )?;
         let max_rate = self.plan.envelope.max_rate_rad_s;
         if !state.omega_rad_s.iter().all(|w| w.abs() <= max_rate) {
             return Err(Fault::AttitudeOutsideModel);

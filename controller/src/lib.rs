@@ -34,7 +34,7 @@ pub mod sink;
 pub mod track;
 pub mod update;
 
-pub use config::{Config, EARTH};
+pub use config::{AttitudeBlend, Config, EARTH};
 pub use control::{Controller, Mode, SegmentOutput};
 pub use fault::{Counters, Fault};
 pub use frame::{Decoder, Event, Frame, FrameError};

@@ -9,9 +9,19 @@
 //! it is older than [`POLE_MAX_AGE_S`] (the precession-nutation series at most once a
 //! minute at a steady stream of frames) and the Earth rotation angle of the instant.
 //!
+//! The star tracker's quaternion is first blended with the attitude the gyros carried
+//! from the last one ([`AttitudeBlend`]), and the attitude keeps, besides its rates, the
+//! angular acceleration that constant roll, pitch and yaw rates relative to the orbital
+//! frame imply ([`euler_accel`]): in a slew with yaw steering the camera's rates in its
+//! own axes turn by 4e-5 rad/s^2, which a constant rate would carry as a period error
+//! of up to 6e-4 by the end of an attitude period (docs/controller.md, "The attitude
+//! between frames").
+//!
 //! What is done per update, in f32: the orbit's Taylor series ([`Propagator`]) to the
-//! update instant, the attitude turned by its body rates over the time since its
-//! validity (B exp([Omega]x dt), a series in the rotation vector), and both frames
+//! update instant, the attitude turned by its body rates and acceleration over the time
+//! since its validity (B exp([Omega dt + dOmega/dt dt^2 / 2]x), a series in the rotation
+//! vector; the next term of the rotation, Omega x dOmega/dt dt^3 / 12, is below 1e-10 rad
+//! in an attitude period), and both frames
 //! turned to the ITRF of the update instant: I at t is I at t0 turned about z by the
 //! Earth's rotation in t - t0 (R3(w (t - t0)); over 2 s this angle is 1.5e-4 rad, and
 //! ERA's own rate differs from `w` by 1e-8 of it, 1.5e-12 rad). No trigonometry.
@@ -22,7 +32,7 @@ use core_math::earth::{GeneralInstant, InertialAttitude};
 use core_math::{ModelError, Param, StateVector, GENERAL_F32};
 
 use crate::bus::{gps_s, Gnss, StarAttitude};
-use crate::config::EARTH_RATE_RAD_S;
+use crate::config::{AttitudeBlend, EARTH_RATE_RAD_S};
 use crate::fault::Fault;
 use crate::nav::Propagator;
 
@@ -61,6 +71,9 @@ pub struct AttitudeState {
     pub camera_to_inertial: [[f32; 3]; 3],
     /// Omega = R(cam_q)^T w_body (rad/s): the camera's angular velocity in its own axes.
     pub omega_rad_s: [f32; 3],
+    /// dOmega/dt (rad/s^2, camera axes) if the roll, pitch and yaw relative to the
+    /// orbital frame keep their rates ([`euler_accel`]); zero before the first fix.
+    pub omega_accel_rad_s2: [f32; 3],
 }
 
 /// The pole to use at `t_us`: `pole` when it is within [`POLE_MAX_AGE_S`] of it, else
@@ -81,6 +94,17 @@ pub fn pole_for(
     }
 }
 
+/// The quaternion's own check, before any blend: its norm within 1e-3 of one
+/// (`bad_quaternion`), finite (`non_finite`).
+pub fn check_quaternion(a: &StarAttitude) -> Result<(), Fault> {
+    quaternion_matrix(a.q.map(f64::from), Param::Quaternion)
+        .map(|_| ())
+        .map_err(|e| match e {
+            ModelError::NonFinite(_) => Fault::NonFinite,
+            _ => Fault::BadQuaternion,
+        })
+}
+
 impl AttitudeState {
     /// The attitude in I: B = C2T R(q) R(cam_q), Omega = R(cam_q)^T w. Refusals: a
     /// quaternion (the attitude's or the mounting's) whose norm is off by more than
@@ -90,6 +114,7 @@ impl AttitudeState {
         mounting_q: &[f32; 4],
         pole: &CelestialPole,
         scales: &TimeScales,
+        orbit: Option<&GnssState>,
     ) -> Result<AttitudeState, Fault> {
         let quaternion = |q: &[f32; 4], p: Param| {
             quaternion_matrix(q.map(f64::from), p).map_err(|e| match e {
@@ -106,12 +131,173 @@ impl AttitudeState {
         let w = a.body_rate_rad_s.map(f64::from);
         let omega: [f64; 3] =
             core::array::from_fn(|j| mount[0][j] * w[0] + mount[1][j] * w[1] + mount[2][j] * w[2]);
+        // The orbit's state in I at the time of validity: the fix's carried over the
+        // fix's age dt (at most `gnss_stale_after`, 2 s) by r + v dt - mu r dt^2 / (2 r^3),
+        // v - mu r dt / r^3 (the next terms move the orbital frame's axes by below 1e-8
+        // rad), its frame turned by the Earth's rotation since. The orbital frame's own
+        // turn over a second (1.1e-3 rad) would otherwise move the acceleration's axes,
+        // which in the default pass's roll slew is a 3e-6 period error.
+        let accel = orbit.map_or([0.0; 3], |g| {
+            let dt_s = (a.valid_us as f64 - g.fix_us as f64) * 1e-6;
+            let st = &g.propagator.state;
+            let (r, v) = (st.position_m, st.velocity_mps);
+            let r2 = dot(r, r);
+            let k = -core_math::GM_M3_S2 / (r2 * libm::sqrt(r2));
+            let r_t: [f64; 3] =
+                core::array::from_fn(|i| r[i] + v[i] * dt_s + 0.5 * k * r[i] * dt_s * dt_s);
+            let v_t: [f64; 3] = core::array::from_fn(|i| v[i] + k * r[i] * dt_s);
+            let s = EARTH_RATE_RAD_S * dt_s;
+            let turn = |x: [f64; 3]| [x[0] + s * x[1], x[1] - s * x[0], x[2]];
+            euler_accel(&b, omega, turn(r_t), turn(v_t))
+        });
         Ok(AttitudeState {
             received: *a,
             camera_to_inertial: b.map(|row| row.map(|x| x as f32)),
             omega_rad_s: omega.map(|x| x as f32),
+            omega_accel_rad_s2: accel.map(|x| x as f32),
         })
     }
+
+    /// The body's angular acceleration (rad/s^2, body axes): R(cam_q) dOmega/dt.
+    fn body_accel_rad_s2(&self, mounting_q: &[f32; 4]) -> Option<[f64; 3]> {
+        let m = quaternion_matrix(mounting_q.map(f64::from), Param::CameraQuaternion).ok()?;
+        let a = self.omega_accel_rad_s2.map(f64::from);
+        Some(core::array::from_fn(|i| {
+            m[i][0] * a[0] + m[i][1] * a[1] + m[i][2] * a[2]
+        }))
+    }
+}
+
+impl AttitudeBlend {
+    /// Taken as it is: for a bus whose attitude is already filtered.
+    pub const NONE: AttitudeBlend = AttitudeBlend {
+        gain: 1.0,
+        gate_rad: 0.0,
+        max_gap_us: 0,
+    };
+
+    /// `new` blended with `last` carried to its time of validity (the quaternion in
+    /// f64, rounded once to f32). `new` is later than `last` (the intake's checks).
+    pub fn blend(
+        &self,
+        last: &AttitudeState,
+        new: &StarAttitude,
+        mounting_q: &[f32; 4],
+    ) -> StarAttitude {
+        let gap_us = new.valid_us.saturating_sub(last.received.valid_us);
+        let accel = last.body_accel_rad_s2(mounting_q);
+        let (Some(accel), true) = (accel, self.gain < 1.0 && gap_us <= self.max_gap_us) else {
+            return *new;
+        };
+        let dt_s = gap_us as f64 * 1e-6;
+        let w = last.received.body_rate_rad_s.map(f64::from);
+        let turn: [f64; 3] = core::array::from_fn(|i| w[i] * dt_s + 0.5 * accel[i] * dt_s * dt_s);
+        let predicted = q_unit(q_mul(last.received.q.map(f64::from), q_exp(turn)));
+        let q = new.q.map(f64::from);
+        let inverse = [predicted[0], -predicted[1], -predicted[2], -predicted[3]];
+        let mut d = q_mul(inverse, q_unit(q));
+        if d[0] < 0.0 {
+            d = d.map(|x| -x);
+        }
+        let e = [2.0 * d[1], 2.0 * d[2], 2.0 * d[3]];
+        if e[0] * e[0] + e[1] * e[1] + e[2] * e[2]
+            > f64::from(self.gate_rad) * f64::from(self.gate_rad)
+        {
+            return *new;
+        }
+        let k = f64::from(self.gain);
+        let blended = q_unit(q_mul(predicted, q_exp(e.map(|x| k * x))));
+        StarAttitude {
+            q: blended.map(|x| x as f32),
+            ..*new
+        }
+    }
+}
+
+/// Hamilton product.
+fn q_mul(a: [f64; 4], b: [f64; 4]) -> [f64; 4] {
+    [
+        a[0] * b[0] - a[1] * b[1] - a[2] * b[2] - a[3] * b[3],
+        a[0] * b[1] + a[1] * b[0] + a[2] * b[3] - a[3] * b[2],
+        a[0] * b[2] - a[1] * b[3] + a[2] * b[0] + a[3] * b[1],
+        a[0] * b[3] + a[1] * b[2] - a[2] * b[1] + a[3] * b[0],
+    ]
+}
+
+fn q_unit(q: [f64; 4]) -> [f64; 4] {
+    let n2 = q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3];
+    let inv = 1.0 / libm::sqrt(n2);
+    q.map(|x| x * inv)
+}
+
+/// exp of the rotation vector `v` as a unit quaternion, cos(th/2) and sin(th/2)/th by
+/// their series to th^8: the blend turns by at most the envelope's rate over
+/// `max_gap_us` (0.35 rad/s over 0.5 s: th <= 0.18), where the next terms are below
+/// 1e-16.
+fn q_exp(v: [f64; 3]) -> [f64; 4] {
+    let t2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+    let c = 1.0 - t2 / 8.0 * (1.0 - t2 / 48.0 * (1.0 - t2 / 120.0 * (1.0 - t2 / 224.0)));
+    let s = 0.5 * (1.0 - t2 / 24.0 * (1.0 - t2 / 80.0 * (1.0 - t2 / 168.0 * (1.0 - t2 / 288.0))));
+    [c, s * v[0], s * v[1], s * v[2]]
+}
+
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+/// dOmega/dt (rad/s^2, camera axes) of a camera whose roll, pitch and yaw relative to
+/// the orbital frame (Part I: A = Rx(roll) Ry(pitch) Rz(yaw), the frame's z along r, y
+/// along r x v) keep their rates, from its axes `b` in I (x_I = b x_camera), its
+/// angular velocity `omega` relative to I in its own axes and the orbit's r, v in I.
+///
+/// The orbital frame turns at W = r x v / |r|^2. Relative to it the camera turns at
+/// Omega - W_c = w1 + w2 + w3 about the roll axis (the frame's x, fixed in it), the
+/// pitch axis (z_c x x_c / cos(pitch)) and the yaw axis (the camera's z): a rate about
+/// an axis that the later rotations carry turns with them, so in camera axes
+/// d(w1)/dt = -(w2 + w3) x w1, d(w2)/dt = -w3 x w2; and W_c = b^T W turns at -Omega
+/// while W itself changes with |r| (dW/dt = -2 (r.v) W / |r|^2 on the two-body orbit):
+/// dOmega/dt = -(w2 + w3) x w1 - w3 x w2 - Omega x W_c + b^T dW/dt. Zero where the
+/// pitch is within 0.6 deg of +-90 deg (the axes are then degenerate).
+pub fn euler_accel(b: &[[f64; 3]; 3], omega: [f64; 3], r: [f64; 3], v: [f64; 3]) -> [f64; 3] {
+    let to_camera = |x: [f64; 3]| -> [f64; 3] {
+        core::array::from_fn(|j| b[0][j] * x[0] + b[1][j] * x[1] + b[2][j] * x[2])
+    };
+    let h = cross(r, v);
+    let (r2, h2) = (dot(r, r), dot(h, h));
+    if !(r2 > 0.0 && h2 > 0.0) {
+        return [0.0; 3];
+    }
+    let w_orbit = to_camera(h.map(|x| x / r2));
+    // x of the orbital frame: (r x v) x r / (|r x v| |r|).
+    let x_frame = to_camera(cross(h, r).map(|x| x / libm::sqrt(h2 * r2)));
+    let z = [0.0, 0.0, 1.0];
+    let pitch_axis = cross(z, x_frame);
+    let relative: [f64; 3] = core::array::from_fn(|i| omega[i] - w_orbit[i]);
+    // relative = a x_frame + p pitch_axis + y z, by Cramer's rule; the determinant is
+    // cos(pitch)^2.
+    let det = dot(x_frame, cross(pitch_axis, z));
+    if libm::fabs(det) < 1e-4 {
+        return [0.0; 3];
+    }
+    let a = dot(relative, cross(pitch_axis, z)) / det;
+    let p = dot(x_frame, cross(relative, z)) / det;
+    let y = dot(x_frame, cross(pitch_axis, relative)) / det;
+    let w1 = x_frame.map(|x| a * x);
+    let w2 = pitch_axis.map(|x| p * x);
+    let w3 = [0.0, 0.0, y];
+    let t1 = cross([w2[0], w2[1], w2[2] + y], w1);
+    let t2 = cross(w3, w2);
+    let t3 = cross(omega, w_orbit);
+    let shrink = -2.0 * dot(r, v) / r2;
+    core::array::from_fn(|i| -t1[i] - t2[i] - t3[i] + shrink * w_orbit[i])
 }
 
 /// (sin, cos) of the Earth's rotation in `dt_s`: an angle below 1e-3 rad for any
@@ -130,14 +316,15 @@ fn to_later_itrf(x: [f32; 3], (s, c): (f32, f32)) -> [f32; 3] {
     [c * x[0] + s * x[1], c * x[1] - s * x[0], x[2]]
 }
 
-/// B exp([Omega]x dt): the camera's axes after turning at Omega for dt. With
-/// a = Omega dt, th^2 = |a|^2: exp([a]x) = 1 + s [a]x + c [a]x^2, s = sin(th)/th,
+/// B exp([a]x): the camera's axes after turning at Omega + dOmega/dt t for dt. With
+/// a = Omega dt + dOmega/dt dt^2 / 2, th^2 = |a|^2: exp([a]x) = 1 + s [a]x + c [a]x^2, s = sin(th)/th,
 /// c = (1 - cos th)/th^2, by their series to th^6 (the next terms, th^8/9! and
 /// th^8/10!, are below 3e-9 up to th = 0.35 rad: the envelope's largest rate on every
 /// axis for a second).
 #[inline(always)]
-fn turned(b: &[[f32; 3]; 3], omega: [f32; 3], dt_s: f32) -> [[f32; 3]; 3] {
-    let a = omega.map(|w| w * dt_s);
+fn turned(b: &[[f32; 3]; 3], omega: [f32; 3], accel: [f32; 3], dt_s: f32) -> [[f32; 3]; 3] {
+    let half_dt2 = 0.5 * dt_s * dt_s;
+    let a: [f32; 3] = core::array::from_fn(|i| omega[i] * dt_s + accel[i] * half_dt2);
     let t2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
     let s = 1.0 - t2 * (1.0 / 6.0 - t2 * (1.0 / 120.0 - t2 * (1.0 / 5040.0)));
     let c = 0.5 - t2 * (1.0 / 24.0 - t2 * (1.0 / 720.0 - t2 * (1.0 / 40320.0)));
@@ -186,7 +373,15 @@ pub fn instant_in_itrf(
 ) -> Result<(GeneralInstant<f32>, ItrfFrame), ModelError> {
     let state = gnss.propagator.parts_at(dt_fix_s);
     let turn = earth_turn(dt_fix_s);
-    let b = turned(&attitude.camera_to_inertial, attitude.omega_rad_s, dt_att_s);
+    let b = turned(
+        &attitude.camera_to_inertial,
+        attitude.omega_rad_s,
+        attitude.omega_accel_rad_s2,
+        dt_att_s,
+    );
+    let omega_rad_s: [f32; 3] = core::array::from_fn(|i| {
+        attitude.omega_rad_s[i] + attitude.omega_accel_rad_s2[i] * dt_att_s
+    });
     let (s, c) = earth_turn(dt_att_s);
     // The columns of B (camera axes in I at the attitude's time) into I at t.
     let b_t: [[f32; 3]; 3] = [
@@ -202,7 +397,7 @@ pub fn instant_in_itrf(
         state.r2_minus_a2_m2,
         &InertialAttitude {
             camera_to_inertial: b_t,
-            omega_rad_s: attitude.omega_rad_s,
+            omega_rad_s,
         },
         EARTH_RATE_RAD_S as f32,
     )?;

@@ -8,9 +8,9 @@
 
 mod common;
 
-use common::bus::{Bus, SCALES, T0_US};
+use common::bus::{attitude_frame, gnss_frame, scales_frame, scene_frame, Bus, SCALES, T0_US};
 use common::{feed, frame, periods, Registers, H, I0};
-use controller::bus::{encode_time_scales, Gnss, StarAttitude};
+use controller::bus::{Gnss, StarAttitude};
 use controller::frame::kind;
 use controller::{golden, Config, Controller, Fault, Mode, Scene};
 use core_math::earth::frames::Mat3;
@@ -67,30 +67,6 @@ fn bus() -> Bus {
     .unwrap();
     let cam = rotation_of(mounting());
     Bus::new(g, &cam, [0.012, -0.006, 0.002], T0_US + 70_000)
-}
-
-fn gnss_frame(seq: u16, tag_us: u64, g: &Gnss) -> Vec<u8> {
-    let mut p = [0u8; 64];
-    let n = g.encode(&mut p).unwrap();
-    frame(kind::GNSS, seq, tag_us, &p[..n])
-}
-
-fn attitude_frame(seq: u16, tag_us: u64, a: &StarAttitude) -> Vec<u8> {
-    let mut p = [0u8; 64];
-    let n = a.encode(&mut p).unwrap();
-    frame(kind::ATTITUDE, seq, tag_us, &p[..n])
-}
-
-fn scales_frame(seq: u16, tag_us: u64, leap_s: i16, dut1_s: f32) -> Vec<u8> {
-    let mut p = [0u8; 8];
-    let n = encode_time_scales(leap_s, dut1_s, &mut p).unwrap();
-    frame(kind::TIME_SCALES, seq, tag_us, &p[..n])
-}
-
-fn scene_frame(seq: u16, tag_us: u64, s: &Scene) -> Vec<u8> {
-    let mut p = [0u8; 512];
-    let n = s.encode(&mut p).unwrap();
-    frame(kind::SCENE, seq, tag_us, &p[..n])
 }
 
 /// One event of the clean stream: a frame at its tag, or an update instant.
@@ -184,6 +160,9 @@ fn bus_periods_match_the_reference_of_the_same_itrf_state_quaternion_and_time() 
                 };
                 assert_eq!(c.mode(), Mode::Nominal);
                 assert_eq!(c.time_scales(), &SCALES);
+                // The attitude in force: the quaternion as blended with the gyros'
+                // propagation (`tests/attitude_blend.rs` holds the blend to its own truth).
+                let a = c.bus_attitude().map_or(a, |s| s.received);
                 let gold =
                     golden::bus_update(c.scene(), c.plan(), c.heights_m(), &g, &a, &SCALES, t)
                         .unwrap();

@@ -1,12 +1,18 @@
 //! What a satellite bus sends, for the tests of the bus frames: a Kepler orbit in I (the
 //! ITRF frozen at T0) seen as GNSS fixes in the ITRF of each instant, and a camera whose
-//! axes turn at constant body rates, seen as GCRF star-tracker quaternions.
+//! axes turn at constant body rates ([`Bus`]) or whose roll, pitch and yaw relative to
+//! the orbital frame keep constant rates ([`EulerBus`], Part I's attitude), seen as
+//! GCRF star-tracker quaternions and gyro rates.
 
-use controller::bus::{Gnss, StarAttitude};
+use controller::bus::{encode_time_scales, Gnss, StarAttitude};
+use controller::frame::kind;
+use controller::Scene;
 use core_math::earth::frames::{self, Mat3, TimeScales};
 use core_math::earth::kepler::Kepler;
-use core_math::earth::InertialGeometry;
-use core_math::{EARTH_RATE_RAD_S, GM_M3_S2};
+use core_math::earth::{Attitude, EarthGeometry, InertialGeometry};
+use core_math::{Ellipsoid, StateVector, EARTH_RATE_RAD_S, GM_M3_S2};
+
+use super::frame;
 
 /// 2026-12 in GPS time (us since 1980-01-06).
 pub const T0_US: u64 = 1_480_000_000_000_000;
@@ -67,7 +73,7 @@ pub fn quaternion_of(m: &Mat3) -> [f64; 4] {
 }
 
 pub struct Bus {
-    kepler: Kepler,
+    pub kepler: Kepler,
     q0: [f64; 4],
     /// When the first attitude is valid.
     pub valid0_us: u64,
@@ -145,6 +151,123 @@ impl Bus {
         StarAttitude {
             valid_us,
             q: p.map(|x| x as f32),
+            body_rate_rad_s: w.map(|x| x as f32),
+        }
+    }
+}
+
+pub fn gnss_frame(seq: u16, tag_us: u64, g: &Gnss) -> Vec<u8> {
+    let mut p = [0u8; 64];
+    let n = g.encode(&mut p).unwrap();
+    frame(kind::GNSS, seq, tag_us, &p[..n])
+}
+
+pub fn attitude_frame(seq: u16, tag_us: u64, a: &StarAttitude) -> Vec<u8> {
+    let mut p = [0u8; 64];
+    let n = a.encode(&mut p).unwrap();
+    frame(kind::ATTITUDE, seq, tag_us, &p[..n])
+}
+
+pub fn scales_frame(seq: u16, tag_us: u64, leap_s: i16, dut1_s: f32) -> Vec<u8> {
+    let mut p = [0u8; 8];
+    let n = encode_time_scales(leap_s, dut1_s, &mut p).unwrap();
+    frame(kind::TIME_SCALES, seq, tag_us, &p[..n])
+}
+
+pub fn scene_frame(seq: u16, tag_us: u64, s: &Scene) -> Vec<u8> {
+    let mut p = [0u8; 512];
+    let n = s.encode(&mut p).unwrap();
+    frame(kind::SCENE, seq, tag_us, &p[..n])
+}
+
+/// Hamilton product.
+pub fn q_mul(a: [f64; 4], b: [f64; 4]) -> [f64; 4] {
+    [
+        a[0] * b[0] - a[1] * b[1] - a[2] * b[2] - a[3] * b[3],
+        a[0] * b[1] + a[1] * b[0] + a[2] * b[3] - a[3] * b[2],
+        a[0] * b[2] - a[1] * b[3] + a[2] * b[0] + a[3] * b[1],
+        a[0] * b[3] + a[1] * b[2] - a[2] * b[1] + a[3] * b[0],
+    ]
+}
+
+/// The angle (rad) between two attitudes given as quaternions.
+pub fn angle_between(a: [f64; 4], b: [f64; 4]) -> f64 {
+    let d = q_mul([a[0], -a[1], -a[2], -a[3]], b);
+    let v = (d[1] * d[1] + d[2] * d[2] + d[3] * d[3]).sqrt();
+    2.0 * v.atan2(d[0].abs())
+}
+
+/// A camera whose roll, pitch and yaw relative to the orbital frame keep constant
+/// rates from T0 (Part I's attitude, `EarthGeometry::to_inertial`, at every instant of
+/// the Kepler orbit), carried by a body turned by `mounting`.
+pub struct EulerBus {
+    pub bus: Bus,
+    pub attitude: Attitude<f64>,
+    pub mounting_q: [f64; 4],
+    mounting: Mat3,
+    c2t0: Mat3,
+}
+
+impl EulerBus {
+    pub fn new(state: StateVector, attitude: Attitude<f64>, mounting_q: [f64; 4]) -> EulerBus {
+        let geometry = EulerBus::geometry_of(state, attitude);
+        let mounting = core_math::earth::bus::quaternion_matrix(
+            mounting_q,
+            core_math::Param::CameraQuaternion,
+        )
+        .unwrap();
+        EulerBus {
+            bus: Bus::new(geometry, &mounting, [0.0; 3], T0_US),
+            attitude,
+            mounting_q,
+            mounting,
+            c2t0: frames::c2t(secs(T0_US), &SCALES).unwrap(),
+        }
+    }
+
+    fn geometry_of(state: StateVector, attitude: Attitude<f64>) -> InertialGeometry<f64> {
+        EarthGeometry {
+            state,
+            attitude,
+            ground_h_m: 0.0,
+            ellipsoid: Ellipsoid::WGS84,
+            earth_rate_rad_s: EARTH_RATE_RAD_S,
+        }
+        .to_inertial()
+        .unwrap()
+    }
+
+    /// The body's exact GCRF quaternion and body rates at `valid_us` (f64).
+    pub fn exact(&self, valid_us: u64) -> ([f64; 4], [f64; 3]) {
+        let dt = secs(valid_us) - secs(T0_US);
+        let a = self.attitude;
+        let at = Attitude {
+            roll_rad: a.roll_rad + a.roll_rate_rad_s * dt,
+            pitch_rad: a.pitch_rad + a.pitch_rate_rad_s * dt,
+            yaw_rad: a.yaw_rad + a.yaw_rate_rad_s * dt,
+            ..a
+        };
+        let g = EulerBus::geometry_of(self.bus.kepler.state_at(dt), at);
+        let body = mul(
+            &mul(&transpose(&self.c2t0), &g.attitude.camera_to_inertial),
+            &transpose(&self.mounting),
+        );
+        let o = g.attitude.omega_rad_s;
+        let m = &self.mounting;
+        let w = core::array::from_fn(|i| (0..3).map(|k| m[i][k] * o[k]).sum());
+        (quaternion_of(&body), w)
+    }
+
+    /// The star tracker's frame at `valid_us`: the exact attitude turned by `error_rad`
+    /// (a rotation vector, body axes), rounded to f32.
+    pub fn attitude(&self, valid_us: u64, error_rad: [f64; 3]) -> StarAttitude {
+        let (q, w) = self.exact(valid_us);
+        let e = error_rad;
+        let q = q_mul(q, [1.0, 0.5 * e[0], 0.5 * e[1], 0.5 * e[2]]);
+        let n = q.iter().map(|x| x * x).sum::<f64>().sqrt();
+        StarAttitude {
+            valid_us,
+            q: q.map(|x| (x / n) as f32),
             body_rate_rad_s: w.map(|x| x as f32),
         }
     }
