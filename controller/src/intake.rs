@@ -234,10 +234,7 @@ impl Controller {
         // it came.
         crate::track::check_quaternion(&received)?;
         let taken = match &self.attitude {
-            Some(last) => self
-                .config
-                .attitude_blend
-                .blend(last, &received, &self.scene.mounting_q),
+            Some(last) => self.config.attitude_blend.blend(last, &received),
             None => received,
         };
         let state = AttitudeState::derive(

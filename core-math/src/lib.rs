@@ -69,7 +69,7 @@ pub use model::{domain, Backend, Camera, ImageMotion, Model, EARTH_RATE_RAD_S, G
 pub use mtf::{mtf_drift, mtf_mismatch, sinc, smear_mtf, StageRule};
 pub use orbit::StateVector;
 pub use real::{Real, Scalar};
-pub use sqrt::sqrt_f64;
+pub use sqrt::{sqrt_f32, sqrt_f64};
 
 /// The real-Earth general form in f32, the form the firmware flies.
 pub const GENERAL_F32: General<f32> = General::new();
