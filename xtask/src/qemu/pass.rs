@@ -375,10 +375,9 @@ fn play(elf: &Path, pass: &Pass, plan: Option<reset::Plan>) -> Result<Played> {
             let got = reset::Uplink::split(&uplink, cut, resume);
             let (clean_cut, clean_resume) = plan.cuts(&clean);
             let clean_got = reset::Uplink::split(&clean, clean_cut, clean_resume);
-            if !clean_got.lost.is_empty() {
-                // The reference takes the inputs the firmware got: none of the lost ones.
-                navs = check::twin(&[clean_got.before, clean_got.rest].concat(), config)?.1;
-            }
+            // The reference takes the inputs the firmware had: none of the lost frames,
+            // and the attitude blend restarted by the reset.
+            navs = check::reset_inputs(clean_got.before, clean_got.rest, config)?;
             Some(reset::Report::new(
                 t_us,
                 &firmware,

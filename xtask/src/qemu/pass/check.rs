@@ -115,7 +115,11 @@ pub enum Source {
 /// Also returns the NAV frame and terrain in force at each update (the inputs of the
 /// reference check).
 pub fn twin(bytes: &[u8], config: Config) -> Result<(Downlink, BTreeMap<u64, InForce>)> {
-    let mut session = Session::new(new_controller(config)?);
+    Ok(twin_of(Session::new(new_controller(config)?), bytes))
+}
+
+/// [`twin`] from `session` on.
+fn twin_of(mut session: Session, bytes: &[u8]) -> (Downlink, BTreeMap<u64, InForce>) {
     let mut out = Vec::new();
     let mut inputs = BTreeMap::new();
     for &b in bytes {
@@ -163,7 +167,23 @@ pub fn twin(bytes: &[u8], config: Config) -> Result<(Downlink, BTreeMap<u64, InF
             break;
         }
     }
-    Ok((Downlink::decode(&out), inputs))
+    (Downlink::decode(&out), inputs)
+}
+
+/// The inputs in force at each update of a host run of the reset's model
+/// ([`reset_twin`]): what the firmware had in force, the attitude blend restarted by
+/// the reset included.
+pub fn reset_inputs(
+    prefix: &[u8],
+    suffix: &[u8],
+    config: Config,
+) -> Result<BTreeMap<u64, InForce>> {
+    let mut inputs = twin(prefix, config)?.1;
+    let (before, _) = host_run(prefix, config)?;
+    let cause = controller::restart::ResetCause::ALL[0];
+    let after = restarted(before, cause, 1, config)?;
+    inputs.extend(twin_of(Session::new(after), suffix).1);
+    Ok(inputs)
 }
 
 /// Relative tolerance of the f32 general form against the reference (the rounding to
@@ -188,7 +208,21 @@ pub fn reset_twin(
     resets: u32,
     config: Config,
 ) -> Result<(Vec<u8>, Vec<u8>)> {
-    let (mut before, out_before) = host_run(prefix, config)?;
+    let (before, out_before) = host_run(prefix, config)?;
+    let mut after = Session::new(restarted(before, cause, resets, config)?);
+    let mut out_after = Vec::new();
+    after.feed(suffix, &mut Accept, |f| out_after.extend_from_slice(f));
+    Ok((out_before, out_after))
+}
+
+/// The controller after a reset of `before`'s: blank, its snapshot restored, the DEM
+/// tile memory kept.
+fn restarted(
+    mut before: Session,
+    cause: controller::restart::ResetCause,
+    resets: u32,
+    config: Config,
+) -> Result<Controller> {
     let mut snapshot = controller::restart::Snapshot::EMPTY;
     let kept = before.controller.snapshot_inputs(&mut snapshot)
         && before.controller.snapshot_periods(&mut snapshot.periods);
@@ -206,10 +240,7 @@ pub fn reset_twin(
         // Nothing recorded (no tile before the reset) is a refusal here, as there.
         let _ = c.restore_dem();
     }
-    let mut after = Session::new(c);
-    let mut out_after = Vec::new();
-    after.feed(suffix, &mut Accept, |f| out_after.extend_from_slice(f));
-    Ok((out_before, out_after))
+    Ok(c)
 }
 
 /// Where `uplink` may be cut between two frames at `at_us`: after the last whole frame

@@ -232,8 +232,12 @@ pub struct Report {
     pub restored_us: Option<u64>,
     /// The first update after the reset with every record fresh (not held).
     pub fresh_at_us: Option<u64>,
-    /// Updates after `fresh_at_us` whose PERIODS differ from the twin's.
+    /// Updates after `fresh_at_us` whose PERIODS differ from the twin's, and the
+    /// largest relative change of a period among them.
     pub changed: usize,
+    pub largest_change: f64,
+    /// The attitude blend was in force, and the reset restarted it.
+    pub blend_restarts: bool,
     pub examples: Vec<String>,
     /// PERIODS and STATUS frames compared with the host's model of the reset.
     pub modelled: (usize, usize),
@@ -297,7 +301,13 @@ impl Report {
             .map(|(t, _)| *t);
         let twin: BTreeMap<u64, &Vec<u8>> = twin.periods.iter().map(|(t, p)| (*t, p)).collect();
         let mut changed = 0;
+        let mut largest_change = 0.0f64;
         let mut examples = Vec::new();
+        let mut attitude_frames = false;
+        Decoder::new().feed(before, |e| {
+            attitude_frames |= matches!(e, Event::Frame(f) if f.kind == kind::ATTITUDE);
+        });
+        let blend_restarts = attitude_frames && config.attitude_blend.gain < 1.0;
         if let Some(fresh) = fresh_at_us {
             // Mode, ticks and held flags: the drift and yaw request may differ in their
             // last bits on the bus's frames, whose C2T pole (kept up to a minute by
@@ -305,6 +315,17 @@ impl Report {
             for (t, p) in firmware.periods.iter().filter(|(t, _)| *t >= fresh) {
                 if super::describe(twin.get(t).copied()) != super::describe(Some(p)) {
                     changed += 1;
+                    if let (Some(a), Some(b)) = (
+                        twin.get(t).and_then(|q| Periods::decode(q)),
+                        Periods::decode(p),
+                    ) {
+                        for (x, y) in a.records().iter().zip(b.records()) {
+                            let rel = (f64::from(y.ticks) / f64::from(x.ticks) - 1.0).abs();
+                            if x.index == y.index && rel.is_finite() {
+                                largest_change = largest_change.max(rel);
+                            }
+                        }
+                    }
                     if examples.len() < 5 {
                         let held = Periods::decode(p)
                             .map_or(0, |p| p.records().iter().filter(|r| r.held).count());
@@ -369,6 +390,8 @@ impl Report {
             restored_us,
             fresh_at_us,
             changed,
+            largest_change,
+            blend_restarts,
             examples,
             modelled,
             unlike_model,
@@ -395,8 +418,16 @@ impl Report {
         let fresh = self.fresh_at_us.map_or("never fresh again".into(), |t| {
             format!("held until fresh telemetry at {:.2} s", t as f64 * 1e-6)
         });
+        let blend = if self.blend_restarts {
+            format!(
+                " (the attitude blend restarts from the first frame after it: largest period change {:.1e})",
+                self.largest_change
+            )
+        } else {
+            String::new()
+        };
         println!(
-            "reset: at {:.2} s ({}), {restored}, {fresh}; outputs changed by the reset {}",
+            "reset: at {:.2} s ({}), {restored}, {fresh}; outputs changed by the reset {}{blend}",
             self.reset_after_us as f64 * 1e-6,
             self.cause,
             self.changed
@@ -432,9 +463,11 @@ impl Report {
         if self.fresh_at_us.is_none() {
             p.push("no fresh update after the reset".into());
         }
-        // A reset that loses frames may change later outputs, as the same loss would
-        // without a reset: then the host's model of it is the check.
-        if self.lost.is_empty() {
+        // A reset restarts the attitude blend (its estimate is not kept), and one that
+        // loses frames loses them as a link would: either may change later outputs, and
+        // the host's model of the same reset is the check. Without a blend in force
+        // (NAV, or the blend off) and without a loss, nothing may change.
+        if self.lost.is_empty() && !self.blend_restarts {
             p.extend(self.examples.iter().cloned());
         }
         p.extend(self.unlike_model.iter().cloned());
