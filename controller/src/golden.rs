@@ -165,20 +165,24 @@ fn bus_update_on(
     let (r, v, w) = (gnss.position_m, gnss.velocity_mps, EARTH_RATE_RAD_S);
     let v_i = [v[0] - w * r[1], v[1] + w * r[0], v[2]];
     let kepler = Kepler::new(r, v_i, GM_M3_S2).ok_or(ModelError::DegenerateState)?;
-    let carried = kepler.state_at(t_s - secs(gnss.fix_us));
     let c2t_fix = frames::c2t(secs(gnss.fix_us), scales)?;
-    let c2t_t = frames::c2t(t_s, scales)?;
-    // I at t from I at the fix: C2T(t) C2T(fix)^T.
-    let m: [[f64; 3]; 3] = core::array::from_fn(|i| {
-        core::array::from_fn(|j| (0..3).map(|k| c2t_t[i][k] * c2t_fix[j][k]).sum())
-    });
-    let to_t = |x: [f64; 3]| -> [f64; 3] {
-        core::array::from_fn(|i| m[i][0] * x[0] + m[i][1] * x[1] + m[i][2] * x[2])
+    // The state at `at_s` in I of that instant: Kepler from the fix, then
+    // C2T(at) C2T(fix)^T.
+    let state_at = |at_s: f64| -> Result<StateVector, ModelError> {
+        let carried = kepler.state_at(at_s - secs(gnss.fix_us));
+        let c2t = frames::c2t(at_s, scales)?;
+        let m: [[f64; 3]; 3] = core::array::from_fn(|i| {
+            core::array::from_fn(|j| (0..3).map(|k| c2t[i][k] * c2t_fix[j][k]).sum())
+        });
+        let to = |x: [f64; 3]| -> [f64; 3] {
+            core::array::from_fn(|i| m[i][0] * x[0] + m[i][1] * x[1] + m[i][2] * x[2])
+        };
+        Ok(StateVector {
+            position_m: to(carried.position_m),
+            velocity_mps: to(carried.velocity_mps),
+        })
     };
-    let state = StateVector {
-        position_m: to_t(carried.position_m),
-        velocity_mps: to_t(carried.velocity_mps),
-    };
+    let state = state_at(t_s)?;
     let q = quaternion_at(attitude, t_s - secs(attitude.valid_us));
     let bus_attitude = BusAttitude {
         q,
@@ -201,18 +205,7 @@ fn bus_update_on(
     // degenerate.
     let valid_s = secs(attitude.valid_us);
     let at_valid = {
-        let carried = kepler.state_at(valid_s - secs(gnss.fix_us));
-        let c2t_v = frames::c2t(valid_s, scales)?;
-        let m: [[f64; 3]; 3] = core::array::from_fn(|i| {
-            core::array::from_fn(|j| (0..3).map(|k| c2t_v[i][k] * c2t_fix[j][k]).sum())
-        });
-        let to_v = |x: [f64; 3]| -> [f64; 3] {
-            core::array::from_fn(|i| m[i][0] * x[0] + m[i][1] * x[1] + m[i][2] * x[2])
-        };
-        let state_v = StateVector {
-            position_m: to_v(carried.position_m),
-            velocity_mps: to_v(carried.velocity_mps),
-        };
+        let state_v = state_at(valid_s)?;
         let camera = bus_geometry(
             &BusState {
                 position_m: state_v.position_m,

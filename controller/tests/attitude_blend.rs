@@ -13,9 +13,9 @@ use common::{feed, H, I0};
 use controller::track::euler_accel;
 use controller::{AttitudeBlend, Config, Controller, Scene};
 use core_math::earth::kepler::Kepler;
-use core_math::earth::{Attitude, EarthGeometry};
+use core_math::earth::Attitude;
 use core_math::sample::SplitMix64;
-use core_math::{Ellipsoid, StateVector, EARTH_RATE_RAD_S, GM_M3_S2};
+use core_math::{StateVector, GM_M3_S2};
 
 /// One sigma per axis of a 4-arcsecond star tracker (rad).
 const SIGMA_RAD: f64 = 2e-5;
@@ -30,22 +30,15 @@ fn gaussian(rng: &mut SplitMix64) -> f64 {
 /// the angles advanced at their rates and the orbit by Kepler's equation.
 fn omega_at(state: &StateVector, attitude: &Attitude<f64>, dt_s: f64) -> [f64; 3] {
     let k = Kepler::new(state.position_m, state.velocity_mps, GM_M3_S2).unwrap();
-    EarthGeometry {
-        state: k.state_at(dt_s),
-        attitude: Attitude {
-            roll_rad: attitude.roll_rad + attitude.roll_rate_rad_s * dt_s,
-            pitch_rad: attitude.pitch_rad + attitude.pitch_rate_rad_s * dt_s,
-            yaw_rad: attitude.yaw_rad + attitude.yaw_rate_rad_s * dt_s,
-            ..*attitude
-        },
-        ground_h_m: 0.0,
-        ellipsoid: Ellipsoid::WGS84,
-        earth_rate_rad_s: EARTH_RATE_RAD_S,
-    }
-    .to_inertial()
-    .unwrap()
-    .attitude
-    .omega_rad_s
+    let advanced = Attitude {
+        roll_rad: attitude.roll_rad + attitude.roll_rate_rad_s * dt_s,
+        pitch_rad: attitude.pitch_rad + attitude.pitch_rate_rad_s * dt_s,
+        yaw_rad: attitude.yaw_rad + attitude.yaw_rate_rad_s * dt_s,
+        ..*attitude
+    };
+    EulerBus::geometry_of(k.state_at(dt_s), advanced)
+        .attitude
+        .omega_rad_s
 }
 
 /// `euler_accel` is dOmega/dt of Part I's attitude at constant rates: against the
@@ -71,15 +64,7 @@ fn the_carried_acceleration_is_the_derivative_of_part_i_rates() {
             pitch_rate_rad_s: rate(&mut rng),
             yaw_rate_rad_s: rate(&mut rng),
         };
-        let g = EarthGeometry {
-            state,
-            attitude,
-            ground_h_m: 0.0,
-            ellipsoid: Ellipsoid::WGS84,
-            earth_rate_rad_s: EARTH_RATE_RAD_S,
-        }
-        .to_inertial()
-        .unwrap();
+        let g = EulerBus::geometry_of(state, attitude);
         let f32s = |x: [f64; 3]| x.map(|c| c as f32);
         let alpha = euler_accel(
             &g.attitude.camera_to_inertial.map(f32s),

@@ -225,7 +225,7 @@ impl EulerBus {
         }
     }
 
-    fn geometry_of(state: StateVector, attitude: Attitude<f64>) -> InertialGeometry<f64> {
+    pub fn geometry_of(state: StateVector, attitude: Attitude<f64>) -> InertialGeometry<f64> {
         EarthGeometry {
             state,
             attitude,
