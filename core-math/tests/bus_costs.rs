@@ -189,45 +189,6 @@ fn rotation(w: [f64; 3], t: f64) -> Mat3 {
     m
 }
 
-/// The unit quaternion (scalar first, Hamilton) of a rotation matrix, as
-/// `bus::quaternion_matrix` reads it (Shepperd's method).
-fn quaternion_of(m: &Mat3) -> [f64; 4] {
-    let tr = m[0][0] + m[1][1] + m[2][2];
-    if tr > 0.0 {
-        let s = 2.0 * libm::sqrt(tr + 1.0);
-        [
-            s / 4.0,
-            (m[2][1] - m[1][2]) / s,
-            (m[0][2] - m[2][0]) / s,
-            (m[1][0] - m[0][1]) / s,
-        ]
-    } else if m[0][0] > m[1][1] && m[0][0] > m[2][2] {
-        let s = 2.0 * libm::sqrt(1.0 + m[0][0] - m[1][1] - m[2][2]);
-        [
-            (m[2][1] - m[1][2]) / s,
-            s / 4.0,
-            (m[0][1] + m[1][0]) / s,
-            (m[0][2] + m[2][0]) / s,
-        ]
-    } else if m[1][1] > m[2][2] {
-        let s = 2.0 * libm::sqrt(1.0 + m[1][1] - m[0][0] - m[2][2]);
-        [
-            (m[0][2] - m[2][0]) / s,
-            (m[0][1] + m[1][0]) / s,
-            s / 4.0,
-            (m[1][2] + m[2][1]) / s,
-        ]
-    } else {
-        let s = 2.0 * libm::sqrt(1.0 + m[2][2] - m[0][0] - m[1][1]);
-        [
-            (m[1][0] - m[0][1]) / s,
-            (m[0][2] + m[2][0]) / s,
-            (m[1][2] + m[2][1]) / s,
-            s / 4.0,
-        ]
-    }
-}
-
 /// The geometry with every vector of I (state, camera axes) turned by `m`; the angular
 /// velocity, in camera coordinates, unchanged.
 fn turned(g: &InertialGeometry<f64>, m: &Mat3) -> InertialGeometry<f64> {
@@ -428,7 +389,7 @@ fn gcrf_taken_as_of_date() {
                 mat_vec(&t2c, truth.state.velocity_mps),
             );
             let attitude = |frame| BusAttitude {
-                q: quaternion_of(&b_gcrf),
+                q: core_math::earth::bus::matrix_quaternion(&b_gcrf),
                 frame,
                 body_rate_rad_s: truth.attitude.omega_rad_s,
                 camera_q: IDENTITY_QUATERNION,

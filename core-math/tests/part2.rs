@@ -631,3 +631,27 @@ fn bus_conversion_follows_the_frames() {
     }
     assert_eq!(g2.attitude.omega_rad_s, g.attitude.omega_rad_s);
 }
+
+/// `matrix_quaternion` inverts `quaternion_matrix` up to the sign, on every one of
+/// Shepperd's four branches (each component the largest in turn), to 1e-15.
+#[test]
+fn matrix_quaternion_inverts_quaternion_matrix() {
+    let mut rng = core_math::sample::SplitMix64(0x0DD5_4A7E_2026);
+    let mut worst = 0.0f64;
+    for k in 0..20_000 {
+        let mut q: [f64; 4] = core::array::from_fn(|_| rng.uniform(-1.0, 1.0));
+        // Every fourth case makes component k % 4 the largest by far.
+        if k % 2 == 0 {
+            q[k % 4] *= 8.0;
+        }
+        let n = q.iter().map(|c| c * c).sum::<f64>().sqrt();
+        let q = q.map(|c| c / n);
+        let m = quaternion_matrix(q, Param::Quaternion).unwrap();
+        let back = core_math::earth::bus::matrix_quaternion(&m);
+        let (plus, minus) = (0..4).fold((0.0f64, 0.0f64), |(p, n), i| {
+            (p.max((back[i] - q[i]).abs()), n.max((back[i] + q[i]).abs()))
+        });
+        worst = worst.max(plus.min(minus));
+    }
+    assert!(worst <= 1e-15, "{worst:e}");
+}

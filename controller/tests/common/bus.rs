@@ -7,6 +7,7 @@
 use controller::bus::{encode_time_scales, Gnss, StarAttitude};
 use controller::frame::kind;
 use controller::Scene;
+use core_math::earth::bus::matrix_quaternion;
 use core_math::earth::frames::{self, Mat3, TimeScales};
 use core_math::earth::kepler::Kepler;
 use core_math::earth::{Attitude, EarthGeometry, InertialGeometry};
@@ -31,45 +32,6 @@ pub fn mul(a: &Mat3, b: &Mat3) -> Mat3 {
 
 pub fn transpose(a: &Mat3) -> Mat3 {
     core::array::from_fn(|i| core::array::from_fn(|j| a[j][i]))
-}
-
-/// A rotation matrix's quaternion (scalar first; Shepperd's choice of the largest
-/// component, so that no division is by a small number).
-pub fn quaternion_of(m: &Mat3) -> [f64; 4] {
-    let tr = m[0][0] + m[1][1] + m[2][2];
-    if tr > 0.0 {
-        let s = 2.0 * (1.0 + tr).sqrt();
-        [
-            0.25 * s,
-            (m[2][1] - m[1][2]) / s,
-            (m[0][2] - m[2][0]) / s,
-            (m[1][0] - m[0][1]) / s,
-        ]
-    } else if m[0][0] > m[1][1] && m[0][0] > m[2][2] {
-        let s = 2.0 * (1.0 + m[0][0] - m[1][1] - m[2][2]).sqrt();
-        [
-            (m[2][1] - m[1][2]) / s,
-            0.25 * s,
-            (m[0][1] + m[1][0]) / s,
-            (m[0][2] + m[2][0]) / s,
-        ]
-    } else if m[1][1] > m[2][2] {
-        let s = 2.0 * (1.0 + m[1][1] - m[0][0] - m[2][2]).sqrt();
-        [
-            (m[0][2] - m[2][0]) / s,
-            (m[0][1] + m[1][0]) / s,
-            0.25 * s,
-            (m[1][2] + m[2][1]) / s,
-        ]
-    } else {
-        let s = 2.0 * (1.0 + m[2][2] - m[0][0] - m[1][1]).sqrt();
-        [
-            (m[1][0] - m[0][1]) / s,
-            (m[0][2] + m[2][0]) / s,
-            (m[1][2] + m[2][1]) / s,
-            0.25 * s,
-        ]
-    }
 }
 
 pub struct Bus {
@@ -105,7 +67,7 @@ impl Bus {
         let w = core::array::from_fn(|i| (0..3).map(|k| mounting[i][k] * omega[k]).sum());
         Bus {
             kepler,
-            q0: quaternion_of(&body),
+            q0: matrix_quaternion(&body),
             valid0_us,
             body_rate_rad_s: w,
             geometry,
@@ -255,7 +217,7 @@ impl EulerBus {
         let o = g.attitude.omega_rad_s;
         let m = &self.mounting;
         let w = core::array::from_fn(|i| (0..3).map(|k| m[i][k] * o[k]).sum());
-        (quaternion_of(&body), w)
+        (matrix_quaternion(&body), w)
     }
 
     /// The star tracker's frame at `valid_us`: the exact attitude turned by `error_rad`

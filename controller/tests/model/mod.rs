@@ -22,6 +22,7 @@ use controller::scene::{
 };
 use controller::session::Session;
 use controller::{Config, Controller, Fault, LinePeriodSink, Mode, Scene, SegmentOutput};
+use core_math::earth::frames::TimeScales;
 use core_math::sample::SplitMix64;
 use core_math::{StateVector, GM_M3_S2};
 
@@ -76,6 +77,12 @@ pub enum Action {
     /// A bus frame (GNSS, ATTITUDE, TIME_SCALES), in the window, whose content is
     /// refused with one of the bus's faults.
     BadBus { dt_us: u64, what: u8 },
+    /// A valid GNSS fix and a valid ATTITUDE frame 1 us later, in the window, tagged at
+    /// their time of fix and validity: one circular orbit followed in time, the camera
+    /// along its orbital frame turned by up to 1e-4 rad per axis from `seed` (a star
+    /// tracker's noise, now and then past the blend's gate), rates up to 1e-3 rad/s:
+    /// what drives the attitude blend and the bus's updates.
+    Bus { dt_us: u64, seed: u64 },
     /// A DEM upload frame, in the window: a DEM_BEGIN or the next chunk, valid, or one
     /// of the upload's faults (a bad grid, a repeated DEM_BEGIN, a chunk missing,
     /// repeated, of another upload, with a height out of range, a tile whose CRC is
@@ -113,7 +120,7 @@ impl Action {
                 1 + (x >> 3) % 60_000
             }
         };
-        match sel % 38 {
+        match sel % 40 {
             0..=7 => Action::Nav {
                 dt_us: dt(a),
                 u_rad: frac(b) * core::f64::consts::TAU,
@@ -178,6 +185,10 @@ impl Action {
             32 | 33 => Action::BadBus {
                 dt_us: dt(a),
                 what: b as u8,
+            },
+            34 | 35 => Action::Bus {
+                dt_us: dt(a),
+                seed: b,
             },
             _ => Action::Dem {
                 dt_us: dt(a),
@@ -364,6 +375,56 @@ fn state(i: f64, u: f64, h: f64) -> StateVector {
         position_m: core::array::from_fn(|k| a * (cu * p[k] + su * q[k])),
         velocity_mps: core::array::from_fn(|k| speed * (-su * p[k] + cu * q[k])),
     }
+}
+
+/// A valid GNSS fix at `t_us` and attitude at `t_us` + 1 (see [`Action::Bus`]): the
+/// camera (mounted as the paper's scene mounts it, on the body's axes) along the
+/// orbital frame of the fix, seen in the GCRF through C2T with `scales`, then turned.
+fn bus_frames(t_us: u64, seed: u64, scales: &TimeScales) -> (Gnss, StarAttitude) {
+    // The orbit's argument of latitude at t: 0.9 rad at 0, at its mean motion.
+    let u_rad = 0.9 + (GM_M3_S2 / (R_M + 645e3).powi(3)).sqrt() * (t_us as f64 * 1e-6);
+    let sv = state(1.7, u_rad, 645e3);
+    let (r, v, w) = (sv.position_m, sv.velocity_mps, core_math::EARTH_RATE_RAD_S);
+    let gnss = Gnss {
+        fix_us: t_us,
+        position_m: r,
+        velocity_mps: [v[0] + w * r[1], v[1] - w * r[0], v[2]],
+    };
+    let unit = |x: [f64; 3]| {
+        let n = (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
+        x.map(|c| c / n)
+    };
+    let cross = |a: [f64; 3], b: [f64; 3]| {
+        [
+            a[1] * b[2] - a[2] * b[1],
+            a[2] * b[0] - a[0] * b[2],
+            a[0] * b[1] - a[1] * b[0],
+        ]
+    };
+    let (z, y) = (unit(r), unit(cross(r, v)));
+    let x = cross(y, z);
+    let c2t = core_math::earth::frames::c2t((t_us + 1) as f64 * 1e-6, scales).unwrap();
+    // GCRF from camera: C2T^T [x y z].
+    let body: [[f64; 3]; 3] = core::array::from_fn(|i| {
+        core::array::from_fn(|j| (0..3).map(|k| c2t[k][i] * [x, y, z][j][k]).sum())
+    });
+    let q = core_math::earth::bus::matrix_quaternion(&body);
+    let mut rng = SplitMix64(seed);
+    let e: [f64; 3] = core::array::from_fn(|_| rng.uniform(-1e-4, 1e-4));
+    let turn = [1.0, 0.5 * e[0], 0.5 * e[1], 0.5 * e[2]];
+    let q = [
+        q[0] * turn[0] - q[1] * turn[1] - q[2] * turn[2] - q[3] * turn[3],
+        q[0] * turn[1] + q[1] * turn[0] + q[2] * turn[3] - q[3] * turn[2],
+        q[0] * turn[2] - q[1] * turn[3] + q[2] * turn[0] + q[3] * turn[1],
+        q[0] * turn[3] + q[1] * turn[2] - q[2] * turn[1] + q[3] * turn[0],
+    ];
+    let n = q.iter().map(|x| x * x).sum::<f64>().sqrt();
+    let attitude = StarAttitude {
+        valid_us: t_us + 1,
+        q: q.map(|x| (x / n) as f32),
+        body_rate_rad_s: core::array::from_fn(|_| rng.uniform(-1e-3, 1e-3) as f32),
+    };
+    (gnss, attitude)
 }
 
 /// A bus frame's kind and payload, tagged `t_us`, that the controller must refuse,
@@ -731,6 +792,8 @@ impl Harness {
         &self,
     ) -> (
         Option<u64>,
+        Option<u64>,
+        Option<controller::track::AttitudeState>,
         Scene,
         Vec<f32>,
         Vec<SegmentOutput>,
@@ -740,6 +803,8 @@ impl Harness {
         let c = &self.session.controller;
         (
             c.nav().map(|n| n.time_us),
+            c.gnss().map(|g| g.fix_us),
+            c.bus_attitude().copied(),
             *c.scene(),
             c.heights_m().to_vec(),
             c.outputs().copied().collect(),
@@ -799,6 +864,16 @@ impl Harness {
                     }
                     Some(&kind::SCENE) => {
                         assert_eq!(Some(*c.scene()), scene, "SCENE not taken");
+                    }
+                    // The bus's data replace NAV.
+                    Some(&kind::GNSS) => {
+                        self.model.nav_time_us = None;
+                        assert_eq!(c.gnss().map(|g| g.fix_us), Some(t_us), "GNSS not taken");
+                    }
+                    Some(&kind::ATTITUDE) => {
+                        self.model.nav_time_us = None;
+                        let taken = c.bus_attitude().map(|a| a.received.valid_us);
+                        assert_eq!(taken, Some(t_us), "ATTITUDE not taken");
                     }
                     _ => {}
                 }
@@ -973,6 +1048,17 @@ impl Harness {
                 let t = now + dt_us;
                 let (k, payload, f) = bad_bus_payload(t, what);
                 self.one_frame(k, t, &payload, Err(f), None);
+            }
+            Action::Bus { dt_us, seed } => {
+                let t = now + dt_us;
+                let scales = *self.session.controller.time_scales();
+                let (gnss, attitude) = bus_frames(t, seed, &scales);
+                let mut p = [0u8; 64];
+                let n = gnss.encode(&mut p).unwrap();
+                self.one_frame(kind::GNSS, t, &p[..n], Ok(()), None);
+                // A tag equal to the last is refused (`time_went_backwards`): 1 us on.
+                let n = attitude.encode(&mut p).unwrap();
+                self.one_frame(kind::ATTITUDE, t + 1, &p[..n], Ok(()), None);
             }
             Action::Terrain { dt_us, what, x } => {
                 let count = self.session.controller.scene().count;

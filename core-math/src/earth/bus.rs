@@ -128,6 +128,31 @@ pub fn quaternion_matrix(q: [f64; 4], param: Param) -> Result<Mat3, ModelError> 
     ])
 }
 
+/// The unit quaternion (w, x, y, z, scalar first) of a rotation matrix, the inverse of
+/// [`quaternion_matrix`] up to the sign: Shepperd's choice of the largest of 4w^2,
+/// 4x^2, 4y^2, 4z^2 (1 + trace, 1 + m00 - m11 - m22, ...), so that no division is by a
+/// small number. For test generators and host tools; `m` orthonormal.
+pub fn matrix_quaternion(m: &Mat3) -> [f64; 4] {
+    let d = [m[0][0], m[1][1], m[2][2]];
+    let t = [
+        1.0 + d[0] + d[1] + d[2],
+        1.0 + d[0] - d[1] - d[2],
+        1.0 - d[0] + d[1] - d[2],
+        1.0 - d[0] - d[1] + d[2],
+    ];
+    let k = (0..4).fold(0, |b, i| if t[i] > t[b] { i } else { b });
+    let s = 0.5 / libm::sqrt(t[k]);
+    let (x, y, z) = (m[2][1] - m[1][2], m[0][2] - m[2][0], m[1][0] - m[0][1]);
+    let (xy, xz, yz) = (m[0][1] + m[1][0], m[0][2] + m[2][0], m[1][2] + m[2][1]);
+    let q = match k {
+        0 => [t[0], x, y, z],
+        1 => [x, t[1], xy, xz],
+        2 => [y, xy, t[2], yz],
+        _ => [z, xz, yz, t[3]],
+    };
+    q.map(|c| c * s)
+}
+
 fn mat_mul(a: &Mat3, b: &Mat3) -> Mat3 {
     core::array::from_fn(|i| {
         core::array::from_fn(|j| a[i][0] * b[0][j] + a[i][1] * b[1][j] + a[i][2] * b[2][j])

@@ -132,28 +132,6 @@ pub fn transpose(a: &Mat3) -> Mat3 {
     std::array::from_fn(|i| std::array::from_fn(|j| a[j][i]))
 }
 
-/// A rotation matrix's quaternion, scalar first (Shepperd: from its largest component).
-fn quaternion_of(m: &Mat3) -> [f64; 4] {
-    let d = [m[0][0], m[1][1], m[2][2]];
-    let t = [
-        1.0 + d[0] + d[1] + d[2],
-        1.0 + d[0] - d[1] - d[2],
-        1.0 - d[0] + d[1] - d[2],
-        1.0 - d[0] - d[1] + d[2],
-    ];
-    let k = (0..4).fold(0, |b, i| if t[i] > t[b] { i } else { b });
-    let s = 0.5 / t[k].sqrt();
-    let (x, y, z) = (m[2][1] - m[1][2], m[0][2] - m[2][0], m[1][0] - m[0][1]);
-    let (xy, xz, yz) = (m[0][1] + m[1][0], m[0][2] + m[2][0], m[1][2] + m[2][1]);
-    let q = match k {
-        0 => [t[0], x, y, z],
-        1 => [x, t[1], xy, xz],
-        2 => [y, xy, t[2], yz],
-        _ => [z, xz, yz, t[3]],
-    };
-    q.map(|c| c * s)
-}
-
 pub fn q_mul(q: [f64; 4], e: [f64; 4]) -> [f64; 4] {
     [
         q[0] * e[0] - q[1] * e[1] - q[2] * e[2] - q[3] * e[3],
@@ -239,7 +217,7 @@ impl AgileTruth {
         let cam = quaternion_matrix(mounting_q())?;
         // x_GCRF = C2T(0)^T B R(cam)^T x_body.
         let body = mat_mul(&mat_mul(&transpose(&self.c2t0), &b), &transpose(&cam));
-        let mut q = quaternion_of(&body);
+        let mut q = core_math::earth::bus::matrix_quaternion(&body);
         let mut w = mat_vec(&cam, omega);
         if let Some(n) = noise {
             let e = n.vec3(SIGMA_ATTITUDE_RAD);
