@@ -55,8 +55,13 @@ const SINC_MINIMAX_F32: [f64; 7] = [
 /// sin(x)/x, with sinc(0) = 1: a polynomial on |x| <= pi (no call, no 0/0), sin(x)/x beyond.
 ///
 /// Inlined, the quotient's route out of line: the stage limit evaluates four of these
-/// per segment and update (`cargo xtask bench --profile`).
-#[inline(always)]
+/// per segment and update (`cargo xtask bench --profile`). Out of line on the M3, whose
+/// update takes the integer sincs (`int`): there the f32 ones are the cold routes'.
+#[cfg_attr(all(target_arch = "arm", not(target_abi = "eabihf")), inline(never))]
+#[cfg_attr(
+    not(all(target_arch = "arm", not(target_abi = "eabihf"))),
+    inline(always)
+)]
 pub fn sinc<T: Real>(x: T) -> T {
     let pi = T::from_f64(PI);
     if x <= pi && -x <= pi {
@@ -663,6 +668,22 @@ pub mod int {
         assert_eq!(isqrt_u64(u64::MAX), u64::from(u32::MAX));
     }
 
+    /// Whether `m` stages keep the product of the two sincs at `floor` (Q60) or above.
+    // Out of line on the M3: the search's usual case and its steps inlined a copy each
+    // (docs/target.md, flash).
+    #[cfg_attr(all(target_arch = "arm", not(target_abi = "eabihf")), inline(never))]
+    #[cfg_attr(
+        not(all(target_arch = "arm", not(target_abi = "eabihf"))),
+        inline(always)
+    )]
+    fn meets_q30(xe: Smear, xt: Smear, floor: i64, m: u32) -> bool {
+        match (factor_q30(xe, m), factor_q30(xt, m)) {
+            (Some(a), Some(b)) => i64::from(a) * i64::from(b) >= floor,
+            // Past either factor's first zero the product is under every floor.
+            _ => false,
+        }
+    }
+
     #[cold]
     #[inline(never)]
     fn beyond_main_lobe(stages: u32, e: f32, t: f32) -> f32 {
@@ -721,12 +742,7 @@ pub mod int {
             }
             let m = self.guess_int(larger, smaller, limit);
             let floor = (u64::from(floor_q30) << 30) as i64;
-            let meets = |m: u32| match (factor_q30(xe, m), factor_q30(xt, m)) {
-                (Some(a), Some(b)) => i64::from(a) * i64::from(b) >= floor,
-                // Past either factor's first zero the product is under every floor.
-                _ => false,
-            };
-            match settle_guess(m, limit, meets) {
+            match settle_guess(m, limit, |m| meets_q30(xe, xt, floor, m)) {
                 Some(m) => Ok(m),
                 None => {
                     self.max_stages_with_drift_by_bisection(rel_mismatch, tan_drift, stage_limit)

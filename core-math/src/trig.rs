@@ -93,7 +93,8 @@ pub fn sin_cos_f32(x: f32) -> (f32, f32) {
 /// |x| in Q60, reduced by pi/2 in Q60 to r, then sin r = r S(r^2) and cos r = C(r^2),
 /// the Taylor polynomials (degrees 5 and 6 in r^2) by Horner's rule in Q30 and 32 x 32
 /// products, r's product by S in [`Wide`]. Within 1e-8 relative before the rounding to
-/// f32 (`core-math/tests/trig.rs`); |x| >= 4 rad and non-finite arguments: [`sin_cos_f32`].
+/// f32 (`core-math/tests/trig.rs`); |x| >= 4 rad and non-finite arguments: the f64
+/// `sincos` of the exact argument, rounded to f32 (as [`sin_cos_f32`] beyond 12 800 rad).
 pub fn sin_cos_int(x: f32) -> (f32, f32) {
     let bits = x.to_bits();
     let biased = (bits >> 23) & 0xff;
@@ -101,9 +102,10 @@ pub fn sin_cos_int(x: f32) -> (f32, f32) {
     if biased < 107 {
         return (x, 1.0);
     }
-    // |x| >= 4, NaN, infinities.
+    // |x| >= 4, NaN, infinities: no attitude the scene's envelope allows, so the cold
+    // f64 route (inlined, `sin_cos_f32` was a second copy of it beside the planner's).
     if biased >= 129 {
-        return sin_cos_f32(x);
+        return sin_cos_huge(x);
     }
     // |x| = mant 2^(biased - 150), in Q60: a left shift of 17 to 38, below 2^62.
     let a = u64::from((bits & 0x7f_ffff) | 0x80_0000) << (biased - 90);
