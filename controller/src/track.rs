@@ -215,6 +215,9 @@ fn q_mul(a: [f32; 4], b: [f32; 4]) -> [f32; 4] {
     ]
 }
 
+// Out of line on the M3, where each product is a software call: inlined, the
+// frame's acceleration and blend held a copy at each use (docs/target.md, flash).
+#[cfg_attr(all(target_arch = "arm", not(target_abi = "eabihf")), inline(never))]
 fn q_unit(q: [f32; 4]) -> [f32; 4] {
     let n2 = q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3];
     let inv = 1.0 / core_math::sqrt_f32(n2);
@@ -232,6 +235,9 @@ fn q_exp(v: [f32; 3]) -> [f32; 4] {
     [c, s * v[0], s * v[1], s * v[2]]
 }
 
+// Out of line on the M3, where each product is a software call: inlined, the
+// frame's acceleration and blend held a copy at each use (docs/target.md, flash).
+#[cfg_attr(all(target_arch = "arm", not(target_abi = "eabihf")), inline(never))]
 fn cross(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
     [
         a[1] * b[2] - a[2] * b[1],
@@ -240,6 +246,9 @@ fn cross(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
     ]
 }
 
+// Out of line on the M3, where each product is a software call: inlined, the
+// frame's acceleration and blend held a copy at each use (docs/target.md, flash).
+#[cfg_attr(all(target_arch = "arm", not(target_abi = "eabihf")), inline(never))]
 fn dot(a: [f32; 3], b: [f32; 3]) -> f32 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
