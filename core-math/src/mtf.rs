@@ -82,6 +82,18 @@ pub fn sinc<T: Real>(x: T) -> T {
     }
 }
 
+/// [`sinc`] as a call, for the cold routes (the bisection and the one-factor limits
+/// that bracket it): inlined, their unrolled tests held six copies of it. (On the M3
+/// [`sinc`] is a call already.)
+#[cfg_attr(all(target_arch = "arm", not(target_abi = "eabihf")), inline(always))]
+#[cfg_attr(
+    not(all(target_arch = "arm", not(target_abi = "eabihf"))),
+    inline(never)
+)]
+fn sinc_cold<T: Real>(x: T) -> T {
+    sinc(x)
+}
+
 /// sin(x)/x for |x| > pi, NaN and infinities included.
 #[cold]
 #[inline(never)]
@@ -290,7 +302,7 @@ impl<T: Real> StageRule<T> {
             // without the software `floorf` this core would call.
             (self.mismatch_budget / d).to_u32().min(stage_limit)
         };
-        let meets = |m: u32| sinc(T::from_f64(HALF_PI) * T::from_u32(m) * d) >= self.mtf_floor;
+        let meets = |m: u32| sinc_cold(T::from_f64(HALF_PI) * T::from_u32(m) * d) >= self.mtf_floor;
         // The guess is off by at most one stage from rounding (the floor is kept away
         // from 1 and inside the main lobe), so the correction is bounded: at most two
         // steps each way, whatever the inputs.
@@ -353,7 +365,8 @@ impl<T: Real> StageRule<T> {
     /// [`StageRule::meets_pair`] at `m`, as a call.
     #[inline(never)]
     fn meets_pair_out_of_line(&self, e: T, t: T, m: u32) -> bool {
-        self.meets_pair(e, t)(m)
+        let x = T::from_f64(HALF_PI) * T::from_u32(m);
+        sinc_cold(x * e) * sinc_cold(x * t) >= self.mtf_floor
     }
 
     /// Whether M stages meet the floor under mismatch e and drift tangent t (both >= 0).

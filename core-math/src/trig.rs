@@ -190,7 +190,13 @@ const TAN_PI_8: f32 = 0.414_213_57;
 /// unsteered camera in a roll slew, drifts to 1.2 rad) the reduction is one division.
 /// Beyond, and NaN, out of line. The same operations in the same order as
 /// [`atan_reduced`], so bit for bit the same results.
-#[inline(always)]
+// Out of line on the M3, whose update takes the integer arctangents: there
+// this one is the cold routes', each of which inlined it (docs/target.md, flash).
+#[cfg_attr(all(target_arch = "arm", not(target_abi = "eabihf")), inline(never))]
+#[cfg_attr(
+    not(all(target_arch = "arm", not(target_abi = "eabihf"))),
+    inline(always)
+)]
 pub fn atan_f32(x: f32) -> f32 {
     let a = x.abs();
     if a <= TAN_PI_8 {

@@ -51,6 +51,20 @@ fn signed_i24f40(x: f32) -> i64 {
     }
 }
 
+/// The steered centre's drift angle in f32, where the turn left the fixed formats'
+/// envelope: rare, so out of line (inlined, it was a fifth of `segment_fixed`).
+#[cold]
+#[inline(never)]
+fn steered_drift_cold(
+    update: &core_math::earth::GeneralUpdate<f32>,
+    seg: &SegmentPlan,
+    sin: f32,
+    cos: f32,
+) -> Result<f32, Fault> {
+    let m = steered_centre(update, seg, sin, cos)?;
+    Ok(atan_pair_rad(m.v2_mps, m.v1_mps))
+}
+
 /// The plan's constants of [`period_fixed`].
 #[derive(Clone, Copy)]
 pub(super) struct PeriodConsts {
@@ -223,10 +237,7 @@ impl Controller {
                 let m = core_math::EARTH_FIXED.motion(up, px)?;
                 signed(m.v2_mps.to_bits(), m.v1_mps.to_bits())
             }
-            (Some((sin, cos, _)), _, _) => {
-                let m = steered_centre(&update.float, seg, sin, cos)?;
-                atan_pair_rad(m.v2_mps, m.v1_mps)
-            }
+            (Some((sin, cos, _)), _, _) => steered_drift_cold(&update.float, seg, sin, cos)?,
         };
         Ok(SegmentOutput {
             index: seg.index,

@@ -296,9 +296,6 @@ impl<T: Real> General<T> {
     /// The update for the ground ellipsoid raised by `ground_h_m` (semi-axes A = a + h,
     /// B = b + h) from the instant's constants: the quadratic's terms, no trigonometry,
     /// two divisions.
-    // Out of line: once per ground height and update, and the planner's probes and the
-    // update each inlined a copy (docs/target.md, flash).
-    #[inline(never)]
     pub fn ground(
         &self,
         inst: &GeneralInstant<T>,
