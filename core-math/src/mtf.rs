@@ -156,16 +156,22 @@ const GUESS_STEPS: u32 = 3;
 /// The stage limit from a guess `m` (at most `limit`): down to a count that `meets` the
 /// floor (M = 0 always does: the product is 1), then up while the next count meets it
 /// too, at most [`GUESS_STEPS`] each way; None when that does not settle it (the
-/// bisection then answers).
+/// bisection then answers). `meets_call` is the same test, for the steps.
 #[inline(always)]
-fn settle_guess(m: u32, limit: u32, meets: impl Fn(u32) -> bool) -> Option<u32> {
+fn settle_guess(
+    m: u32,
+    limit: u32,
+    meets: impl Fn(u32) -> bool,
+    meets_call: impl Fn(u32) -> bool,
+) -> Option<u32> {
     // The usual case inline: the guess meets the floor and one stage more does not.
     // The steps either way out of line: `meets` is inlined (two sincs), and unrolled
-    // they were six more copies of it in the update (docs/target.md, flash).
+    // they were six more copies of it in the update; `meets_call`, a call, spares the
+    // steps' loop a seventh (docs/target.md, flash).
     if (m == 0 || meets(m)) && (m == limit || !meets(m + 1)) {
         return Some(m);
     }
-    settle_guess_by_steps(m, limit, meets)
+    settle_guess_by_steps(m, limit, meets_call)
 }
 
 /// [`settle_guess`] from the start, a step at a time.
@@ -356,7 +362,8 @@ impl<T: Real> StageRule<T> {
             // guess >= 0: truncation is the floor.
             guess.to_u32()
         };
-        match settle_guess(m, limit, self.meets_pair(e, t)) {
+        let steps = |m: u32| self.meets_pair_out_of_line(e, t, m);
+        match settle_guess(m, limit, self.meets_pair(e, t), steps) {
             Some(m) => Ok(m),
             None => self.max_stages_with_drift_by_bisection(rel_mismatch, tan_drift, stage_limit),
         }
@@ -755,7 +762,8 @@ pub mod int {
             }
             let m = self.guess_int(larger, smaller, limit);
             let floor = (u64::from(floor_q30) << 30) as i64;
-            match settle_guess(m, limit, |m| meets_q30(xe, xt, floor, m)) {
+            let meets = |m: u32| meets_q30(xe, xt, floor, m);
+            match settle_guess(m, limit, meets, meets) {
                 Some(m) => Ok(m),
                 None => {
                     self.max_stages_with_drift_by_bisection(rel_mismatch, tan_drift, stage_limit)
@@ -809,7 +817,7 @@ mod tests {
                     };
                     let meets = |n: u32| n <= k;
                     assert_eq!(
-                        settle_guess(m, limit, meets),
+                        settle_guess(m, limit, meets, meets),
                         expect,
                         "k {k}, limit {limit}, guess {m}"
                     );

@@ -225,9 +225,10 @@ fn atan_poly(z: f32) -> f32 {
 }
 
 /// atan x for every x (the polynomial's range reduced as in [`atan_f32`]): the out of
-/// line part of [`atan_f32`], for |x| > tan(3 pi/8) and NaN.
+/// line part of [`atan_f32`], for |x| > tan(3 pi/8) and NaN; and [`atan_f32`] as a call
+/// for callers off the per-segment path, bit for bit its results (tested below).
 #[inline(never)]
-fn atan_reduced(x: f32) -> f32 {
+pub fn atan_reduced(x: f32) -> f32 {
     let a = x.abs();
     // The base angle as an f32 plus its rounding error (pi/2 - FRAC_PI_2 and
     // pi/4 - FRAC_PI_4), added to the small part first: just above tan(pi/8) the

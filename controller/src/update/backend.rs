@@ -5,6 +5,7 @@
 //! either route (docs/controller.md, "Backends").
 
 use super::*;
+use core_math::trig::atan_reduced;
 
 impl Controller {
     /// The segment's [`Extremes`] by the configured backend.
@@ -207,7 +208,8 @@ impl Controller {
         GENERAL_F32
             .motion(ground, &self.plan.boresight)
             .ok()
-            .and_then(|m| steer_from(m.v1_mps, m.v2_mps, drift_angle_rad(m.v2_mps / m.v1_mps)))
+            // `atan_f32`'s value as a call (once per update; inlined, a second copy).
+            .and_then(|m| steer_from(m.v1_mps, m.v2_mps, atan_reduced(m.v2_mps / m.v1_mps)))
     }
 }
 
