@@ -108,6 +108,8 @@ impl StarAttitude {
 /// Decodes a TIME_SCALES payload and checks it with core-math's rules
 /// ([`TimeScales::validate`]): a non-finite UT1 - UTC is `non_finite`, leap seconds
 /// outside 0..=60 or |UT1 - UTC| >= 0.9 s are `time_scales`.
+// Out of line: the frame's check and the restart's restore each inlined it.
+#[inline(never)]
 pub fn decode_time_scales(payload: &[u8]) -> Result<TimeScales, Fault> {
     if payload.len() != TIME_SCALES_LEN {
         return Err(Fault::BadLength);

@@ -64,6 +64,22 @@ pub struct SegmentOutput {
     pub held: bool,
 }
 
+/// Every output slot as `SegmentOutput::default()`, as one constant: all zero, so the
+/// blank session clears it at once (built from `default()` in place, it was a store
+/// per field of each slot: docs/target.md, flash).
+const NO_OUTPUTS: [SegmentOutput; MAX_SEGMENTS] = [SegmentOutput {
+    index: 0,
+    ticks: 0,
+    worst_mismatch: 0.0,
+    mtf: 0.0,
+    max_stages: 0,
+    drift_rad: 0.0,
+    worst_drift_rad: 0.0,
+    residual_drift_rad: 0.0,
+    reversed: false,
+    held: false,
+}; MAX_SEGMENTS];
+
 impl SegmentOutput {
     /// The record of an active segment that has no valid period: none computed yet
     /// under its current geometry (a new or changed segment whose updates all failed).
@@ -206,7 +222,7 @@ impl Controller {
             last_fault: None,
             frames_accepted: 0,
             time_resyncs: 0,
-            outputs: [SegmentOutput::default(); MAX_SEGMENTS],
+            outputs: NO_OUTPUTS,
             has_output: [false; MAX_SEGMENTS],
             yaw_request_rad: None,
             updates: 0,
@@ -409,5 +425,16 @@ impl Controller {
                 self.hold(index);
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod blank_tests {
+    use super::*;
+
+    /// The blank session's output slots are what `SegmentOutput::default()` gives.
+    #[test]
+    fn no_outputs_are_the_default() {
+        assert_eq!(NO_OUTPUTS, [SegmentOutput::default(); MAX_SEGMENTS]);
     }
 }

@@ -215,6 +215,9 @@ fn q_mul(a: [f32; 4], b: [f32; 4]) -> [f32; 4] {
     ]
 }
 
+// Out of line on the M3, where each product is a software call: inlined, the
+// frame's acceleration and blend held a copy at each use (docs/target.md, flash).
+#[cfg_attr(all(target_arch = "arm", not(target_abi = "eabihf")), inline(never))]
 fn q_unit(q: [f32; 4]) -> [f32; 4] {
     let n2 = q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3];
     let inv = 1.0 / core_math::sqrt_f32(n2);
@@ -232,6 +235,9 @@ fn q_exp(v: [f32; 3]) -> [f32; 4] {
     [c, s * v[0], s * v[1], s * v[2]]
 }
 
+// Out of line on the M3, where each product is a software call: inlined, the
+// frame's acceleration and blend held a copy at each use (docs/target.md, flash).
+#[cfg_attr(all(target_arch = "arm", not(target_abi = "eabihf")), inline(never))]
 fn cross(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
     [
         a[1] * b[2] - a[2] * b[1],
@@ -240,6 +246,9 @@ fn cross(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
     ]
 }
 
+// Out of line on the M3, where each product is a software call: inlined, the
+// frame's acceleration and blend held a copy at each use (docs/target.md, flash).
+#[cfg_attr(all(target_arch = "arm", not(target_abi = "eabihf")), inline(never))]
 fn dot(a: [f32; 3], b: [f32; 3]) -> f32 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
@@ -328,9 +337,19 @@ fn turned(b: &[[f32; 3]; 3], omega: [f32; 3], accel: [f32; 3], dt_s: f32) -> [[f
             id + s * k[i][j] + c * k2
         })
     });
-    core::array::from_fn(|i| {
-        core::array::from_fn(|j| b[i][0] * e[0][j] + b[i][1] * e[1][j] + b[i][2] * e[2][j])
-    })
+    core::array::from_fn(|i| row_times(&b[i], &e))
+}
+
+/// The row `r` times the matrix `e`.
+// Out of line on the M3, where each product is a software call: the update's turn of
+// the camera's axes inlined it for each row (docs/target.md, flash).
+#[cfg_attr(all(target_arch = "arm", not(target_abi = "eabihf")), inline(never))]
+#[cfg_attr(
+    not(all(target_arch = "arm", not(target_abi = "eabihf"))),
+    inline(always)
+)]
+fn row_times(r: &[f32; 3], e: &[[f32; 3]; 3]) -> [f32; 3] {
+    core::array::from_fn(|j| r[0] * e[0][j] + r[1] * e[1][j] + r[2] * e[2][j])
 }
 
 /// The satellite and the camera's axes in the ITRF of an update instant: what the DEM's

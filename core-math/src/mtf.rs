@@ -55,8 +55,13 @@ const SINC_MINIMAX_F32: [f64; 7] = [
 /// sin(x)/x, with sinc(0) = 1: a polynomial on |x| <= pi (no call, no 0/0), sin(x)/x beyond.
 ///
 /// Inlined, the quotient's route out of line: the stage limit evaluates four of these
-/// per segment and update (`cargo xtask bench --profile`).
-#[inline(always)]
+/// per segment and update (`cargo xtask bench --profile`). Out of line on the M3, whose
+/// update takes the integer sincs (`int`): there the f32 ones are the cold routes'.
+#[cfg_attr(all(target_arch = "arm", not(target_abi = "eabihf")), inline(never))]
+#[cfg_attr(
+    not(all(target_arch = "arm", not(target_abi = "eabihf"))),
+    inline(always)
+)]
 pub fn sinc<T: Real>(x: T) -> T {
     let pi = T::from_f64(PI);
     if x <= pi && -x <= pi {
@@ -75,6 +80,18 @@ pub fn sinc<T: Real>(x: T) -> T {
     } else {
         sinc_beyond_pi(x)
     }
+}
+
+/// [`sinc`] as a call, for the cold routes (the bisection and the one-factor limits
+/// that bracket it): inlined, their unrolled tests held six copies of it. (On the M3
+/// [`sinc`] is a call already.)
+#[cfg_attr(all(target_arch = "arm", not(target_abi = "eabihf")), inline(always))]
+#[cfg_attr(
+    not(all(target_arch = "arm", not(target_abi = "eabihf"))),
+    inline(never)
+)]
+fn sinc_cold<T: Real>(x: T) -> T {
+    sinc(x)
 }
 
 /// sin(x)/x for |x| > pi, NaN and infinities included.
@@ -139,16 +156,22 @@ const GUESS_STEPS: u32 = 3;
 /// The stage limit from a guess `m` (at most `limit`): down to a count that `meets` the
 /// floor (M = 0 always does: the product is 1), then up while the next count meets it
 /// too, at most [`GUESS_STEPS`] each way; None when that does not settle it (the
-/// bisection then answers).
+/// bisection then answers). `meets_call` is the same test, for the steps.
 #[inline(always)]
-fn settle_guess(m: u32, limit: u32, meets: impl Fn(u32) -> bool) -> Option<u32> {
+fn settle_guess(
+    m: u32,
+    limit: u32,
+    meets: impl Fn(u32) -> bool,
+    meets_call: impl Fn(u32) -> bool,
+) -> Option<u32> {
     // The usual case inline: the guess meets the floor and one stage more does not.
     // The steps either way out of line: `meets` is inlined (two sincs), and unrolled
-    // they were six more copies of it in the update (docs/target.md, flash).
+    // they were six more copies of it in the update; `meets_call`, a call, spares the
+    // steps' loop a seventh (docs/target.md, flash).
     if (m == 0 || meets(m)) && (m == limit || !meets(m + 1)) {
         return Some(m);
     }
-    settle_guess_by_steps(m, limit, meets)
+    settle_guess_by_steps(m, limit, meets_call)
 }
 
 /// [`settle_guess`] from the start, a step at a time.
@@ -285,7 +308,7 @@ impl<T: Real> StageRule<T> {
             // without the software `floorf` this core would call.
             (self.mismatch_budget / d).to_u32().min(stage_limit)
         };
-        let meets = |m: u32| sinc(T::from_f64(HALF_PI) * T::from_u32(m) * d) >= self.mtf_floor;
+        let meets = |m: u32| sinc_cold(T::from_f64(HALF_PI) * T::from_u32(m) * d) >= self.mtf_floor;
         // The guess is off by at most one stage from rounding (the floor is kept away
         // from 1 and inside the main lobe), so the correction is bounded: at most two
         // steps each way, whatever the inputs.
@@ -339,7 +362,8 @@ impl<T: Real> StageRule<T> {
             // guess >= 0: truncation is the floor.
             guess.to_u32()
         };
-        match settle_guess(m, limit, self.meets_pair(e, t)) {
+        let steps = |m: u32| self.meets_pair_out_of_line(e, t, m);
+        match settle_guess(m, limit, self.meets_pair(e, t), steps) {
             Some(m) => Ok(m),
             None => self.max_stages_with_drift_by_bisection(rel_mismatch, tan_drift, stage_limit),
         }
@@ -348,7 +372,8 @@ impl<T: Real> StageRule<T> {
     /// [`StageRule::meets_pair`] at `m`, as a call.
     #[inline(never)]
     fn meets_pair_out_of_line(&self, e: T, t: T, m: u32) -> bool {
-        self.meets_pair(e, t)(m)
+        let x = T::from_f64(HALF_PI) * T::from_u32(m);
+        sinc_cold(x * e) * sinc_cold(x * t) >= self.mtf_floor
     }
 
     /// Whether M stages meet the floor under mismatch e and drift tangent t (both >= 0).
@@ -663,6 +688,22 @@ pub mod int {
         assert_eq!(isqrt_u64(u64::MAX), u64::from(u32::MAX));
     }
 
+    /// Whether `m` stages keep the product of the two sincs at `floor` (Q60) or above.
+    // Out of line on the M3: the search's usual case and its steps inlined a copy each
+    // (docs/target.md, flash).
+    #[cfg_attr(all(target_arch = "arm", not(target_abi = "eabihf")), inline(never))]
+    #[cfg_attr(
+        not(all(target_arch = "arm", not(target_abi = "eabihf"))),
+        inline(always)
+    )]
+    fn meets_q30(xe: Smear, xt: Smear, floor: i64, m: u32) -> bool {
+        match (factor_q30(xe, m), factor_q30(xt, m)) {
+            (Some(a), Some(b)) => i64::from(a) * i64::from(b) >= floor,
+            // Past either factor's first zero the product is under every floor.
+            _ => false,
+        }
+    }
+
     #[cold]
     #[inline(never)]
     fn beyond_main_lobe(stages: u32, e: f32, t: f32) -> f32 {
@@ -721,12 +762,8 @@ pub mod int {
             }
             let m = self.guess_int(larger, smaller, limit);
             let floor = (u64::from(floor_q30) << 30) as i64;
-            let meets = |m: u32| match (factor_q30(xe, m), factor_q30(xt, m)) {
-                (Some(a), Some(b)) => i64::from(a) * i64::from(b) >= floor,
-                // Past either factor's first zero the product is under every floor.
-                _ => false,
-            };
-            match settle_guess(m, limit, meets) {
+            let meets = |m: u32| meets_q30(xe, xt, floor, m);
+            match settle_guess(m, limit, meets, meets) {
                 Some(m) => Ok(m),
                 None => {
                     self.max_stages_with_drift_by_bisection(rel_mismatch, tan_drift, stage_limit)
@@ -780,7 +817,7 @@ mod tests {
                     };
                     let meets = |n: u32| n <= k;
                     assert_eq!(
-                        settle_guess(m, limit, meets),
+                        settle_guess(m, limit, meets, meets),
                         expect,
                         "k {k}, limit {limit}, guess {m}"
                     );

@@ -93,7 +93,8 @@ pub fn sin_cos_f32(x: f32) -> (f32, f32) {
 /// |x| in Q60, reduced by pi/2 in Q60 to r, then sin r = r S(r^2) and cos r = C(r^2),
 /// the Taylor polynomials (degrees 5 and 6 in r^2) by Horner's rule in Q30 and 32 x 32
 /// products, r's product by S in [`Wide`]. Within 1e-8 relative before the rounding to
-/// f32 (`core-math/tests/trig.rs`); |x| >= 4 rad and non-finite arguments: [`sin_cos_f32`].
+/// f32 (`core-math/tests/trig.rs`); |x| >= 4 rad and non-finite arguments: the f64
+/// `sincos` of the exact argument, rounded to f32 (as [`sin_cos_f32`] beyond 12 800 rad).
 pub fn sin_cos_int(x: f32) -> (f32, f32) {
     let bits = x.to_bits();
     let biased = (bits >> 23) & 0xff;
@@ -101,9 +102,10 @@ pub fn sin_cos_int(x: f32) -> (f32, f32) {
     if biased < 107 {
         return (x, 1.0);
     }
-    // |x| >= 4, NaN, infinities.
+    // |x| >= 4, NaN, infinities: no attitude the scene's envelope allows, so the cold
+    // f64 route (inlined, `sin_cos_f32` was a second copy of it beside the planner's).
     if biased >= 129 {
-        return sin_cos_f32(x);
+        return sin_cos_huge(x);
     }
     // |x| = mant 2^(biased - 150), in Q60: a left shift of 17 to 38, below 2^62.
     let a = u64::from((bits & 0x7f_ffff) | 0x80_0000) << (biased - 90);
@@ -188,7 +190,13 @@ const TAN_PI_8: f32 = 0.414_213_57;
 /// unsteered camera in a roll slew, drifts to 1.2 rad) the reduction is one division.
 /// Beyond, and NaN, out of line. The same operations in the same order as
 /// [`atan_reduced`], so bit for bit the same results.
-#[inline(always)]
+// Out of line on the M3, whose update takes the integer arctangents: there
+// this one is the cold routes', each of which inlined it (docs/target.md, flash).
+#[cfg_attr(all(target_arch = "arm", not(target_abi = "eabihf")), inline(never))]
+#[cfg_attr(
+    not(all(target_arch = "arm", not(target_abi = "eabihf"))),
+    inline(always)
+)]
 pub fn atan_f32(x: f32) -> f32 {
     let a = x.abs();
     if a <= TAN_PI_8 {
@@ -217,9 +225,10 @@ fn atan_poly(z: f32) -> f32 {
 }
 
 /// atan x for every x (the polynomial's range reduced as in [`atan_f32`]): the out of
-/// line part of [`atan_f32`], for |x| > tan(3 pi/8) and NaN.
+/// line part of [`atan_f32`], for |x| > tan(3 pi/8) and NaN; and [`atan_f32`] as a call
+/// for callers off the per-segment path, bit for bit its results (tested below).
 #[inline(never)]
-fn atan_reduced(x: f32) -> f32 {
+pub fn atan_reduced(x: f32) -> f32 {
     let a = x.abs();
     // The base angle as an f32 plus its rounding error (pi/2 - FRAC_PI_2 and
     // pi/4 - FRAC_PI_4), added to the small part first: just above tan(pi/8) the

@@ -7,7 +7,13 @@
 use core::ops::{Add, Div, Mul, Sub};
 
 /// a . b = a0 b0 + a1 b1 + a2 b2 (summed in that order).
-#[inline(always)]
+// Out of line on the M3, where its products are software calls: inlined at six
+// callers (docs/target.md, flash).
+#[cfg_attr(all(target_arch = "arm", not(target_abi = "eabihf")), inline(never))]
+#[cfg_attr(
+    not(all(target_arch = "arm", not(target_abi = "eabihf"))),
+    inline(always)
+)]
 pub fn dot<T>(a: [T; 3], b: [T; 3]) -> T
 where
     T: Copy + Add<Output = T> + Mul<Output = T>,

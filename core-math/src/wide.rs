@@ -201,7 +201,13 @@ impl core::ops::Add for Wide {
 /// (`hi` 2^32 + `lo`) / `d`, truncated, for `d` >= 2^31 and `hi` < `d` (so the quotient
 /// fits 32 bits): two 16-bit digits by the core's 32-bit divide (Knuth's algorithm D,
 /// with the remainder in i64), where a 64-bit division is a software call.
-#[inline(always)]
+// Out of line on the M3, the one core that divides `Wide`s in its update: five copies
+// inlined there, against a call per division (docs/target.md, flash).
+#[cfg_attr(all(target_arch = "arm", not(target_abi = "eabihf")), inline(never))]
+#[cfg_attr(
+    not(all(target_arch = "arm", not(target_abi = "eabihf"))),
+    inline(always)
+)]
 pub fn div_64_32(hi: u32, lo: u32, d: u32) -> u32 {
     let d1 = d >> 16;
     // One quotient digit of (`top` 2^16 + `next`) / d, and the remainder; `top` < d.

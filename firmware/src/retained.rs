@@ -240,6 +240,8 @@ pub fn boot(hardware: Option<ResetCause>) -> Boot {
 
 /// Notes why the core is about to be reset, for the next [`boot`]. Called by a handler
 /// that resets the core next; leaves a record that does not check out alone.
+// Out of line: the fault handler and the watchdog's each inlined a copy.
+#[inline(never)]
 pub fn note_cause(cause: ResetCause) {
     let mut record = read();
     if record.checks_out() {

@@ -396,10 +396,10 @@ fn atan_small(t: f32) -> Option<f32> {
     Some(t * (1.0 - t2 * (1.0 / 3.0 - t2 * (0.2 - t2 * (1.0 / 7.0 - t2 * (1.0 / 9.0))))))
 }
 
+/// `atan_f32`'s value, as a call (it inlined a copy here).
 #[cold]
-#[inline(never)]
 fn atan_far(t: f32) -> f32 {
-    core_math::trig::atan_f32(t)
+    core_math::trig::atan_reduced(t)
 }
 
 /// (v1, v2) at the row's pixel p2 with the ground at range s: the row form

@@ -5,6 +5,7 @@
 //! either route (docs/controller.md, "Backends").
 
 use super::*;
+use core_math::trig::atan_reduced;
 
 impl Controller {
     /// The segment's [`Extremes`] by the configured backend.
@@ -146,14 +147,19 @@ impl Controller {
     }
 
     /// The yaw request's (sin, cos, angle) from the boresight's motion, and the first
-    /// ground of the update with its height (none yet: NaN never equals a height).
+    /// ground of the update with its height: the boresight segment's, which the request
+    /// is formed on and the loop then reuses for every segment at that height (made
+    /// again there, it was a second `ground` per update).
     #[cfg(not(feature = "earth-fixed"))]
     #[inline(always)]
     pub(super) fn steer_and_ground(
         &self,
         instant: &GeneralInstant<f32>,
     ) -> (Steer, f32, Result<Ground, Fault>) {
-        (self.steer_f32(instant), f32::NAN, Err(Fault::OutOfRange))
+        let boresight_h = self.height(self.plan.boresight_segment);
+        let ground = self.make_ground(instant, boresight_h, None);
+        let steer = ground.as_ref().ok().and_then(|g| self.steer_f32(g));
+        (steer, boresight_h, ground)
     }
 
     /// The same by the configured backend. With fixed-point pixels the boresight
@@ -167,11 +173,12 @@ impl Controller {
         &self,
         instant: &GeneralInstant<f32>,
     ) -> (Steer, f32, Result<Ground, Fault>) {
-        if !self.fixed_pixels() {
-            return (self.steer_f32(instant), f32::NAN, Err(Fault::OutOfRange));
-        }
         let boresight_h = self.height(self.plan.boresight_segment);
         let mut ground = self.make_ground(instant, boresight_h, None);
+        if !self.fixed_pixels() {
+            let steer = ground.as_ref().ok().and_then(|g| self.steer_f32(&g.float));
+            return (steer, boresight_h, ground);
+        }
         let steer = match &ground {
             Ok(Ground { fixed: Some(f), .. }) => {
                 f.boresight_over_focal().ok().and_then(|(vf1, vf2)| {
@@ -194,16 +201,15 @@ impl Controller {
         (steer, boresight_h, ground)
     }
 
-    /// The yaw request from the boresight's motion in f32 at the boresight segment's
-    /// height.
+    /// The yaw request from the boresight's motion in f32 on `ground`, the boresight
+    /// segment's.
     #[inline(always)]
-    pub(super) fn steer_f32(&self, instant: &GeneralInstant<f32>) -> Option<(f32, f32, f32)> {
-        let boresight_h = self.height(self.plan.boresight_segment);
+    pub(super) fn steer_f32(&self, ground: &GeneralUpdate<f32>) -> Option<(f32, f32, f32)> {
         GENERAL_F32
-            .ground(instant, &EARTH, boresight_h)
-            .and_then(|u| GENERAL_F32.motion(&u, &self.plan.boresight))
+            .motion(ground, &self.plan.boresight)
             .ok()
-            .and_then(|m| steer_from(m.v1_mps, m.v2_mps, drift_angle_rad(m.v2_mps / m.v1_mps)))
+            // `atan_f32`'s value as a call (once per update; inlined, a second copy).
+            .and_then(|m| steer_from(m.v1_mps, m.v2_mps, atan_reduced(m.v2_mps / m.v1_mps)))
     }
 }
 
@@ -287,7 +293,7 @@ pub(super) struct Ground {
 
 impl Controller {
     #[cfg(not(feature = "earth-fixed"))]
-    #[inline(always)]
+    #[inline(never)]
     pub(super) fn make_ground(
         &self,
         instant: &GeneralInstant<f32>,

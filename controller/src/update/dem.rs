@@ -114,6 +114,8 @@ impl Controller {
     /// again whenever that tile changes: a commit, a restore, the store lent or taken
     /// back. None when no tile is in force, or when the route refuses it (wider than
     /// it handles): then the TERRAIN heights are the ground.
+    // Out of line: the DEM upload's commit and the boot's restore each inlined it.
+    #[inline(never)]
     pub(crate) fn refresh_dem_ground(&mut self) {
         let tile = self.dem_given.or_else(|| self.dem.tile());
         self.dem_ground = tile.and_then(|t| DemGround::new(&t).ok());

@@ -39,6 +39,32 @@ pub(super) fn f32_to_i24f40(x: f32) -> u64 {
     Wide::from_f32(x).map_or(0, |w| w.to_u64_scaled(40))
 }
 
+/// [`f32_to_i24f40`] of |x|, with x's sign (saturating at `i64::MAX`).
+// Out of line: six conversions inlined were most of the DEM route's way in.
+#[inline(never)]
+fn signed_i24f40(x: f32) -> i64 {
+    let m = f32_to_i24f40(f32::from_bits(x.to_bits() & 0x7fff_ffff)).min(i64::MAX as u64) as i64;
+    if x.to_bits() >> 31 != 0 {
+        -m
+    } else {
+        m
+    }
+}
+
+/// The steered centre's drift angle in f32, where the turn left the fixed formats'
+/// envelope: rare, so out of line (inlined, it was a fifth of `segment_fixed`).
+#[cold]
+#[inline(never)]
+fn steered_drift_cold(
+    update: &core_math::earth::GeneralUpdate<f32>,
+    seg: &SegmentPlan,
+    sin: f32,
+    cos: f32,
+) -> Result<f32, Fault> {
+    let m = steered_centre(update, seg, sin, cos)?;
+    Ok(atan_pair_rad(m.v2_mps, m.v1_mps))
+}
+
 /// The plan's constants of [`period_fixed`].
 #[derive(Clone, Copy)]
 pub(super) struct PeriodConsts {
@@ -130,19 +156,40 @@ pub(super) struct ExtremesBits {
     pub(super) d1: u64,
 }
 
+impl ExtremesBits {
+    /// The DEM route's f32 [`Extremes`] in I24F40 bits: exact for every magnitude from
+    /// 2^-16 to 2^23 m/s (an f32's 24 bits then lie within the format's 64), truncated
+    /// below, saturating above; NaN as 0.
+    pub(super) fn of(e: &Extremes) -> ExtremesBits {
+        let signed = signed_i24f40;
+        ExtremesBits {
+            c1: signed(e.centre.v1_mps),
+            c2: signed(e.centre.v2_mps),
+            lo: signed(e.lo),
+            hi: signed(e.hi),
+            d2: signed(e.drift_v2).unsigned_abs(),
+            d1: signed(e.drift_v1).unsigned_abs(),
+        }
+    }
+}
+
 impl Controller {
-    /// [`Controller::segment`] with fixed-point pixels and no DEM tile: the period, its
-    /// ticks, the mismatch and the drift tangent from the samples' I24F40 extremes in
-    /// integers ([`period_fixed`]), the MTF, stage limit and drift angles by the integer
-    /// forms.
+    /// [`Controller::segment`] with fixed-point pixels: the period, its ticks, the
+    /// mismatch and the drift tangent from the samples' I24F40 extremes (or the DEM
+    /// route's `dem`) in integers ([`period_fixed`]), the MTF, stage limit and drift
+    /// angles by the integer forms.
     #[inline(never)]
     pub(super) fn segment_fixed(
         &self,
         update: &Ground,
         seg: &SegmentPlan,
         steer: Option<(f32, f32, f32)>,
+        dem: Option<ExtremesBits>,
     ) -> Result<SegmentOutput, Fault> {
-        let e = extremes_fixed(update, seg)?;
+        let e = match dem {
+            Some(e) => e,
+            None => extremes_fixed(update, seg)?,
+        };
         let reversed = e.c1 > 0;
         // Every sample must move the same way as the centre.
         let (v_min, v_max) = if reversed {
@@ -190,10 +237,7 @@ impl Controller {
                 let m = core_math::EARTH_FIXED.motion(up, px)?;
                 signed(m.v2_mps.to_bits(), m.v1_mps.to_bits())
             }
-            (Some((sin, cos, _)), _, _) => {
-                let m = steered_centre(&update.float, seg, sin, cos)?;
-                atan_pair_rad(m.v2_mps, m.v1_mps)
-            }
+            (Some((sin, cos, _)), _, _) => steered_drift_cold(&update.float, seg, sin, cos)?,
         };
         Ok(SegmentOutput {
             index: seg.index,

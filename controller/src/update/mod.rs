@@ -29,15 +29,31 @@ impl Controller {
         cfg!(feature = "fixed-only") || self.config.fixed_point_pixels
     }
 
-    /// The attitude's sine and cosine: in integers with fixed-point pixels (a core
-    /// without an FPU, where each f32 operation is a software call), else in f32.
+    /// The general form's per-instant constants of the NAV route: the attitude's sines
+    /// and cosines in integers with fixed-point pixels (a core without an FPU, where
+    /// each f32 operation is a software call), else in f32; either way through an
+    /// out-of-line form that the plan build calls too (inlined here, it was a second
+    /// copy: docs/target.md, flash).
     #[inline(always)]
-    fn sin_cos(&self, x: f32) -> (f32, f32) {
+    fn nav_instant(
+        &self,
+        state: &crate::nav::StateParts,
+        attitude: &core_math::earth::Attitude<f32>,
+    ) -> Result<GeneralInstant<f32>, core_math::ModelError> {
+        let (r, v, r2_minus_a2) = (state.position_m, state.velocity_mps, state.r2_minus_a2_m2);
+        let w = EARTH_RATE_RAD_S as f32;
         #[cfg(feature = "earth-fixed")]
         if self.fixed_pixels() {
-            return core_math::trig::sin_cos_int(x);
+            return GENERAL_F32.instant_parts_with(
+                r,
+                v,
+                r2_minus_a2,
+                attitude,
+                w,
+                core_math::trig::sin_cos_int,
+            );
         }
-        core_math::trig::sin_cos_f32(x)
+        GENERAL_F32.instant_parts(r, v, r2_minus_a2, attitude, w)
     }
 
     /// Moves the clock to `now_us` (from the time source) and runs the update that is due,
@@ -87,14 +103,7 @@ impl Controller {
                 let dt_s = seconds_since(t_us, nav.time_us);
                 let state = nav.propagator.parts_at(dt_s);
                 let attitude = attitude_at(&nav.attitude, dt_s);
-                GENERAL_F32.instant_parts_by(
-                    state.position_m,
-                    state.velocity_mps,
-                    state.r2_minus_a2_m2,
-                    &attitude,
-                    EARTH_RATE_RAD_S as f32,
-                    |x| self.sin_cos(x),
-                )
+                self.nav_instant(&state, &attitude)
             }
             (None, Some(gnss), Some(attitude)) if self.update_mode != Mode::Stale => {
                 track::instant_in_itrf(
@@ -206,9 +215,11 @@ impl Controller {
         steer: Option<(f32, f32, f32)>,
         dem: Option<&Extremes>,
     ) -> Result<SegmentOutput, Fault> {
+        // With fixed-point pixels the DEM's f32 extremes take the integer route too: its
+        // f32 twin here was a second copy of the tail in the M3's flash.
         #[cfg(feature = "earth-fixed")]
-        if dem.is_none() && self.fixed_pixels() {
-            return self.segment_fixed(update, seg, steer);
+        if self.fixed_pixels() {
+            return self.segment_fixed(update, seg, steer, dem.map(ExtremesBits::of));
         }
         // |v1| extremes and the largest |v2/v1| over the samples and the centre; every
         // one must move the same way along P1 (one transfer direction per segment). In

@@ -200,14 +200,7 @@ pub(super) fn atan_pair_rad(num: f32, den: f32) -> f32 {
     }
     let r = (q.checked_shr(shift).unwrap_or(0) + (1 << 9)) >> 10;
     let r = r.min(1 << 30) as i32;
-    let at = atan_unit_q30(r);
-    let q = if past_one { HALF_PI_Q30 - at } else { at };
-    let rad = q30_to_f32(q.max(0) as u32);
-    if (num.to_bits() ^ den.to_bits()) >> 31 != 0 {
-        -rad
-    } else {
-        rad
-    }
+    atan_q30_rad(r, past_one, (num.to_bits() ^ den.to_bits()) >> 31 != 0)
 }
 
 /// atan(`num` / `den`) (rad) of two integer magnitudes, negated when `negative`: the
@@ -231,6 +224,16 @@ pub(super) fn atan_ratio_rad(num: u64, den: u64, negative: bool) -> f32 {
     let r = (Wide::from_u64(small, 0) / Wide::from_u64(big, 0))
         .to_u64_scaled(30)
         .min(1 << 30) as i32;
+    atan_q30_rad(r, past_one, negative)
+}
+
+/// The tail both integer arctangents share: atan(`r`) of the ratio `r` in Q30 on [0, 1],
+/// its complement when the ratio was `past_one`, rounded once to f32 and negated when
+/// `negative`.
+// Out of line: inlined, the unrolled polynomial was a copy in each of the two.
+#[cfg(feature = "earth-fixed")]
+#[inline(never)]
+fn atan_q30_rad(r: i32, past_one: bool, negative: bool) -> f32 {
     let at = atan_unit_q30(r);
     let q = if past_one { HALF_PI_Q30 - at } else { at };
     let rad = q30_to_f32(q.max(0) as u32);

@@ -150,7 +150,26 @@ impl<T: Real> General<T> {
         attitude: &Attitude<T>,
         earth_rate_rad_s: T,
     ) -> Result<GeneralInstant<T>, ModelError> {
+        #[cfg(all(target_arch = "arm", not(target_abi = "eabihf")))]
+        return self.instant_parts_with(r, v, r2_minus_a2, attitude, earth_rate_rad_s, T::sin_cos);
+        #[cfg(not(all(target_arch = "arm", not(target_abi = "eabihf"))))]
         self.instant_parts_by(r, v, r2_minus_a2, attitude, earth_rate_rad_s, T::sin_cos)
+    }
+
+    /// [`General::instant_parts_by`] with `sin_cos` through a pointer: one copy for
+    /// every caller, where the M3 calls it with two (the planner's f32 sines, the
+    /// update's integer ones: `trig::sin_cos_int`) and each would otherwise inline it.
+    #[inline(never)]
+    pub fn instant_parts_with(
+        &self,
+        r: [T; 3],
+        v: [T; 3],
+        r2_minus_a2: T,
+        attitude: &Attitude<T>,
+        earth_rate_rad_s: T,
+        sin_cos: fn(T) -> (T, T),
+    ) -> Result<GeneralInstant<T>, ModelError> {
+        self.instant_parts_by(r, v, r2_minus_a2, attitude, earth_rate_rad_s, sin_cos)
     }
 
     /// [`General::instant_parts`] with the attitude's sines and cosines by `sin_cos`
