@@ -36,7 +36,13 @@ impl DemGround {
         let mut edges_done = false;
         for n in 1..=MAX_EVALUATIONS {
             let found = match self.evaluate(rays, &ray, h) {
-                Evaluation::Outside => Some(SampleGround::Outside),
+                Evaluation::Outside => {
+                    // The ray's stretch through the band lies off the tile: nothing
+                    // settled at an edge.
+                    self.stats.outside += 1;
+                    self.remember(k, j, f32::NAN);
+                    return Ok(SampleGround::Outside);
+                }
                 Evaluation::March => break,
                 Evaluation::Off(at) if !edges_done => {
                     edges_done = true;
