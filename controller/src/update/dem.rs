@@ -21,26 +21,39 @@ pub(super) fn dem_extremes(
     terrain_h_m: f32,
 ) -> Result<Extremes, Fault> {
     let r = &seg.row;
-    let rays = SegmentRays::new(
+    let (d0, dy) = SegmentRays::directions(frame, r.p1_m, r.focal_m);
+    let ends = match (seg.samples.get(1), seg.samples.last()) {
+        (Some(a), Some(b)) if !dem.all_on_tile(k, seg.samples.len()) => Some((a.p2_m, b.p2_m)),
+        _ => None,
+    };
+    // The footprint carried from an earlier update while the rays stay within its
+    // bound, else made again from the rays.
+    let mut footprint =
+        ends.and_then(|(a, b)| dem.carried_footprint(k, &frame.position_m, &d0, &dy, a, b));
+    // A segment wholly off the tile is the flat route's, at its TERRAIN height.
+    if let (Some(f), Some((a, b))) = (&footprint, ends) {
+        if f.off_tile_over(a, b) {
+            dem.segment_off_tile(k, seg.samples.len());
+            return extremes(update, seg);
+        }
+    }
+    let made = footprint.is_none();
+    let rays = SegmentRays::from_directions(
         dem,
         heights_m,
-        frame,
-        r.p1_m,
-        r.focal_m,
+        frame.position_m,
+        d0,
+        dy,
         r.uu0_m2,
         r2_minus_a2_m2,
     );
-    let footprint = match (seg.samples.get(1), seg.samples.last()) {
-        (Some(a), Some(b)) if !dem.all_on_tile(k, seg.samples.len()) => {
-            dem.footprint(&rays, a.p2_m, b.p2_m)
-        }
-        _ => None,
-    };
-    // A segment wholly off the tile is the flat route's, at its TERRAIN height.
-    if let (Some(f), Some(a), Some(b)) = (&footprint, seg.samples.get(1), seg.samples.last()) {
-        if f.off_tile_over(a.p2_m, b.p2_m) {
-            dem.segment_off_tile(k, seg.samples.len());
-            return extremes(update, seg);
+    if made {
+        if let Some((a, b)) = ends {
+            footprint = dem.footprint(k, &rays, a, b);
+            if footprint.is_some_and(|f| f.off_tile_over(a, b)) {
+                dem.segment_off_tile(k, seg.samples.len());
+                return extremes(update, seg);
+            }
         }
     }
     let row = GENERAL_F32.row_motion(update, &seg.row);
