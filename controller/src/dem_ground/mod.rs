@@ -190,12 +190,18 @@ impl DemGround {
             rows_per_m_max: (1.01 * rows_per_rad / (EARTH.a_m * (1.0 - e2) + min_m - BAND_MARGIN_M))
                 as f32,
         };
-        Ok(DemGround {
+        let mut ground = DemGround {
             frame,
-            history_m: [[[f32::NAN, 0.0]; MAX_SAMPLES]; MAX_SEGMENTS],
+            history_m: [[[0.0; 2]; MAX_SAMPLES]; MAX_SEGMENTS],
             carried: [None; MAX_SEGMENTS],
             stats: DemStats::default(),
-        })
+        };
+        // No height yet: a loop, where the array's literal of NaN pairs was unrolled
+        // into stores (docs/target.md, flash).
+        for pair in ground.history_m.iter_mut().flatten() {
+            pair[0] = f32::NAN;
+        }
+        Ok(ground)
     }
 }
 
