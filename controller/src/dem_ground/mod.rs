@@ -295,31 +295,35 @@ impl Footprint {
 /// have moved since.
 ///
 /// The bound. Let the ends' rays move from (r, d) to (r', d'), d = d0 + p2 dy
-/// (unnormalised, |d| the same for a p2 unless the row changed), each by at most
-/// dr = |r' - r| and s |d' - d| at the ray's parameter s at mid-band. The point where
-/// a ray meets the raised ellipsoid moves, to first order, by the oblique projection of
-/// dr + s (d' - d) along d onto the tangent plane, whose norm is sec(theta): at most
+/// (unnormalised, |d| the same for a p2 unless the row changed), by dr = |r' - r| and
+/// s |d' - d| at the ray's parameter s at mid-band. The point where a ray meets the
+/// raised ellipsoid moves, to first order, by the oblique projection of dr + s (d' - d)
+/// along d onto the tangent plane, whose norm is sec(theta): at most
 /// sec(theta) (dr + s |d' - d|). [`Carried::holds`] admits a move only while
 /// dr^2 + (1.1 s)^2 |d' - d|^2 <= `lim_m2`, which `lim_m2` keeps below (0.005 range)^2
-/// and (5 km)^2: the direction then turns by at most 0.01 rad (twice |d' - d| / |d|,
-/// the unit vector's change), the normal by at most 0.012 rad (the point moves under
-/// 0.03 of the range, the range under 3 000 km at 72 deg from the vertical, over a radius
-/// of curvature above 6 300 km), so theta changes by under 0.022 rad: sec^2 by under
-/// 2 tan(theta) 0.022 < 14 % at tan^2 < 9, the first-order step off by under tan(theta)
-/// 0.022 < 7 %, s by under 10 %. With 1.25 on sec^2 and 1.2 on the step, the point
-/// moves at most m = 1.2 sec (dr + 1.1 s |d' - d|), m^2 <= 3.6 sec^2 (dr^2 + ...).
+/// and (5 km)^2: dr + s |d' - d| is then under 0.0071 of the range and 7.1 km, the
+/// direction turns by at most 0.015 rad (twice |d' - d| / |d|, the unit vector's
+/// change), the point moves under 31 km and 0.031 of the range (below), the normal
+/// under it turns by under 0.005 rad (radii of curvature above 6 300 km), so theta
+/// changes by under 0.02 rad: sec^2 by under 2 tan(theta) 0.02 < 12 % at tan^2 < 9, the
+/// first-order step is off by under tan(theta) 0.02 < 6 %, s changes by under 4 %.
+/// With 1.25 on sec^2, 1.2 on the step and 1.1 on s, the point moves at most
+/// m = 1.2 sec (dr + 1.1 s |d' - d|), m^2 <= 3.6 sec^2 (dr^2 + (1.1 s)^2 |d' - d|^2).
 /// Along the raised ellipsoid a point moving m changes latitude by at most m over the
-/// least meridian radius and longitude by at most m over its distance from the axis
-/// (both with 1 % for chord against arc): each grid coordinate of each end by at most
-/// kappa m, kappa the larger of [`TileFrame::rows_per_m_max`] and cols per radian over
-/// the ends' least distance from the axis less 10 km. Every sample's affine coordinate
-/// between the ends then moves by at most kappa m; the bow's margin, a share of the
-/// ends' L1 distance, by at most 4 `bow_share` kappa m; the band's margin, rows per
-/// metre of height along the ray, by under 10 % (sec(theta) by under 7 %, the rays'
-/// rates by |d' - d| / |d| < 0.01 of a term that is the band's depth over the range,
-/// under 3 %, of the move's). So where the carried footprint, its margins 1.1 times
-/// the made one's plus w, puts a sample beyond an edge, the footprint made now would
-/// put it there too, as long as (1.1 + 4 `bow_share`) kappa m <= w: `lim_m2`.
+/// least meridian radius, and longitude by at most m over its distance from the axis
+/// less 31 km, at least 0.9 of the distance from 310 km on (both with 1 % for chord
+/// against arc): each grid coordinate of each end by at most kappa m, kappa the largest
+/// of [`TileFrame::rows_per_m_max`], cols per radian over 0.9 of the ends' least
+/// distance from the axis, and the tile centre's cols per metre. Every sample's affine
+/// coordinate between the ends then moves by at most kappa m; the bow's margin, a share
+/// of the ends' L1 distance, by at most 4 `bow_share` kappa m; the band's margin, the
+/// rows per metre of height along the ray (the centre's Jacobian, d and sec(theta)) over
+/// half the band, by under 6 % through sec(theta) (the 1.1 on the margins) and, through
+/// d, by at most kappa sec(theta) |d' - d| / |d| times half the band (5.3 km at most),
+/// which is under 0.1 kappa m for ranges above 110 km. So where the carried footprint,
+/// its margins 1.1 times the made one's plus w, puts a sample beyond an edge, the
+/// footprint made now would put it there too, as long as (1.1 + 4 `bow_share`) kappa m
+/// <= w: `lim_m2`.
 /// `controller/src/dem_ground/tests.rs`, `a_carried_footprint_holds_within_its_bound`,
 /// checks the bound against the ends' true moves in f64 and the samples it skips
 /// against `DemTile::first_crossing`.
@@ -362,7 +366,7 @@ impl Carried {
         let margin = larger(f.row_margin, f.col_margin);
         let w = larger(CARRY_MIN_CELLS, 0.9 * (f.beyond(a_m, b_m) - 0.1 * margin));
         // The ends' points at mid-band, their squared distances from the axis; from
-        // 100 km, that less 10 km is at least 0.9 of it.
+        // 310 km, that less 31 km is at least 0.9 of it.
         let axis2 = |p2: f32, s: f32| {
             let p: [f32; 2] =
                 core::array::from_fn(|i| self.r[i] + s * (self.d0[i] + p2 * self.dy[i]));
@@ -370,9 +374,13 @@ impl Carried {
         };
         let axis2_m2 = smaller(axis2(a_m, self.s[0]), axis2(b_m, self.s[1]));
         let cols_per_m = 1.01 / 0.9 * t.cols_per_rad;
+        let c = t.cols_per_m;
         let kappa2 = larger(
-            t.rows_per_m_max * t.rows_per_m_max,
-            cols_per_m * cols_per_m / axis2_m2,
+            larger(
+                t.rows_per_m_max * t.rows_per_m_max,
+                cols_per_m * cols_per_m / axis2_m2,
+            ),
+            c[0] * c[0] + c[1] * c[1] + c[2] * c[2],
         );
         let share = 1.1 + 4.0 * t.bow_share;
         let range2_m2 = smaller(
@@ -388,8 +396,12 @@ impl Carried {
         );
         let s = 1.1 * larger(self.s[0], self.s[1]);
         self.c_d = s * s;
-        // Within 100 km of the axis, no bound: made again at every update.
-        self.lim_m2 = if axis2_m2 > 1e10 { lim_m2 } else { -1.0 };
+        // Within 310 km of the axis, no bound: made again at every update.
+        self.lim_m2 = if axis2_m2 > 310e3 * 310e3 {
+            lim_m2
+        } else {
+            -1.0
+        };
         self.footprint.row_margin = 1.1 * f.row_margin + w;
         self.footprint.col_margin = 1.1 * f.col_margin + w;
     }
