@@ -81,7 +81,7 @@ pub struct DemStats {
 }
 
 /// The tile's constants for the route, in f32, made once per tile.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, Default)]
 struct TileFrame {
     tan_lat_c: f32,
     cos_lon_c: f32,
@@ -119,6 +119,8 @@ struct TileFrame {
 #[derive(Clone, Debug)]
 pub struct DemGround {
     frame: TileFrame,
+    /// Whether `frame` is a tile's, in force ([`DemGround::install`]).
+    active: bool,
     /// Each plan segment's samples' heights at the last update (NaN: none) and their
     /// change over it (m).
     history_m: [[[f32; 2]; MAX_SAMPLES]; MAX_SEGMENTS],
@@ -138,6 +140,54 @@ pub enum TileRefusal {
 impl DemGround {
     /// The route's constants for `tile` (f64 trigonometry, once per tile).
     pub fn new(tile: &DemTile<'_, i16>) -> Result<DemGround, TileRefusal> {
+        let mut ground = DemGround::blank();
+        ground.install(tile)?;
+        Ok(ground)
+    }
+
+    /// A route with no tile ([`DemGround::install`] gives it one): what the controller
+    /// holds from its construction, in place (the route is 3 KB: made as a value for
+    /// each new tile, it passed through the stack of whoever put it in force,
+    /// docs/target.md, "Size and time per board").
+    #[inline(always)]
+    pub(crate) fn blank() -> DemGround {
+        DemGround {
+            frame: TileFrame::default(),
+            active: false,
+            // Zeros (a fill), set by `install` before any use.
+            history_m: [[[0.0; 2]; MAX_SAMPLES]; MAX_SEGMENTS],
+            carried: [None; MAX_SEGMENTS],
+            stats: DemStats::default(),
+        }
+    }
+
+    /// No tile: the TERRAIN heights are the ground.
+    pub(crate) fn clear(&mut self) {
+        self.active = false;
+    }
+
+    /// Puts the route on `tile` in force in place: its constants (f64 trigonometry,
+    /// once per tile), no heights or footprints kept, the counts from zero. On a
+    /// refusal nothing changes.
+    #[inline(never)]
+    pub(crate) fn install(&mut self, tile: &DemTile<'_, i16>) -> Result<(), TileRefusal> {
+        self.frame = Self::frame_for(tile)?;
+        self.active = true;
+        // A loop: the array's literal of NaN pairs was unrolled into stores (flash).
+        for pair in self.history_m.iter_mut().flatten() {
+            *pair = [f32::NAN, 0.0];
+        }
+        self.carried.fill(None);
+        self.stats = DemStats::default();
+        Ok(())
+    }
+
+    /// Whether a tile is in force ([`DemGround::install`]).
+    pub(crate) fn active(&self) -> bool {
+        self.active
+    }
+
+    fn frame_for(tile: &DemTile<'_, i16>) -> Result<TileFrame, TileRefusal> {
         let g: DemGrid = *tile.grid();
         let (rows, cols) = ((g.nrows - 1) as f64, (g.ncols - 1) as f64);
         if 0.5 * rows * g.dlat_deg > MAX_TILE_HALF_DEG
@@ -190,18 +240,7 @@ impl DemGround {
             rows_per_m_max: (1.01 * rows_per_rad / (EARTH.a_m * (1.0 - e2) + min_m - BAND_MARGIN_M))
                 as f32,
         };
-        let mut ground = DemGround {
-            frame,
-            history_m: [[[0.0; 2]; MAX_SAMPLES]; MAX_SEGMENTS],
-            carried: [None; MAX_SEGMENTS],
-            stats: DemStats::default(),
-        };
-        // No height yet: a loop, where the array's literal of NaN pairs was unrolled
-        // into stores (docs/target.md, flash).
-        for pair in ground.history_m.iter_mut().flatten() {
-            pair[0] = f32::NAN;
-        }
-        Ok(ground)
+        Ok(frame)
     }
 }
 

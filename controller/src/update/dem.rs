@@ -86,7 +86,8 @@ impl Controller {
             Some(t) => t.heights_m(),
             None => self.dem.heights_in_force().unwrap_or(&[]),
         };
-        let (Some(dem), Some(seg)) = (self.dem_ground.as_mut(), self.plan.segments.get(k)) else {
+        let dem = &mut self.dem_ground;
+        let (true, Some(seg)) = (dem.active(), self.plan.segments.get(k)) else {
             return Err(Fault::InvalidScene);
         };
         dem_extremes(
@@ -111,12 +112,11 @@ impl Controller {
         &mut self,
         tile: Option<core_math::earth::dem::DemTile<'static, i16>>,
     ) -> Result<(), TileRefusal> {
-        let ground = match &tile {
-            Some(t) => Some(DemGround::new(t)?),
-            None => None,
-        };
+        match &tile {
+            Some(t) => self.dem_ground.install(t)?,
+            None => self.dem_ground.clear(),
+        }
         self.dem_given = tile;
-        self.dem_ground = ground;
         if self.dem_given.is_none() {
             self.refresh_dem_ground();
         }
@@ -129,18 +129,23 @@ impl Controller {
     /// it handles): then the TERRAIN heights are the ground.
     pub(crate) fn refresh_dem_ground(&mut self) {
         let tile = self.dem_given.or_else(|| self.dem.tile());
-        self.dem_ground = tile.and_then(|t| DemGround::new(&t).ok());
+        // In place (`DemGround::blank`): a refused tile leaves no route.
+        if tile.is_none_or(|t| self.dem_ground.install(&t).is_err()) {
+            self.dem_ground.clear();
+        }
     }
 
     /// The DEM tile the update's ground comes from, if any: None also when the route
     /// refused the tile in force.
     pub fn dem_tile_in_force(&self) -> Option<core_math::earth::dem::DemTile<'_, i16>> {
-        self.dem_ground.as_ref()?;
+        if !self.dem_ground.active() {
+            return None;
+        }
         self.dem_given.or_else(|| self.dem.tile())
     }
 
     /// How the DEM route found the samples' ground since the tile was set.
     pub fn dem_stats(&self) -> Option<DemStats> {
-        self.dem_ground.as_ref().map(|d| d.stats)
+        self.dem_ground.active().then_some(self.dem_ground.stats)
     }
 }
