@@ -170,8 +170,9 @@ pub struct Controller {
     /// The DEM tile upload and the tile in force ([`crate::dem`]).
     pub(crate) dem: Dem,
     /// The DEM tile in force and the per-sample state of its route
-    /// ([`crate::dem_ground`]); None: the TERRAIN heights are the ground.
-    pub(crate) dem_ground: Option<crate::dem_ground::DemGround>,
+    /// ([`crate::dem_ground`]), in place from the controller's construction; while
+    /// none is in force (`DemGround::active`), the TERRAIN heights are the ground.
+    pub(crate) dem_ground: crate::dem_ground::DemGround,
     /// A tile given by [`Controller::set_dem_tile`] (tests, the bench): it wins over
     /// the uploaded one.
     pub(crate) dem_given: Option<core_math::earth::dem::DemTile<'static, i16>>,
@@ -230,7 +231,7 @@ impl Controller {
             inputs_generation: 0,
             boot: None,
             dem: Dem::default(),
-            dem_ground: None,
+            dem_ground: crate::dem_ground::DemGround::blank(),
             dem_given: None,
         }
     }

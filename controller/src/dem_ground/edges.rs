@@ -4,15 +4,43 @@
 use super::*;
 
 impl DemGround {
-    /// Where a segment's row sees the tile: its grid coordinates at mid-band as an
-    /// affine function of p2, from the samples at p2 `a_m` and `b_m` (the row's ends),
-    /// with a margin for the footprint's bow between them (its section by the rays'
-    /// plane, and the grid's meridians converging: [`TileFrame`]'s share of the ends'
-    /// distance) and for each sample's stretch through the band. A sample the function
-    /// puts beyond an edge by more than the margin sees ground off the tile, for no
-    /// evaluation. `None`: an end the route cannot place (the samples are each
-    /// evaluated).
-    pub(crate) fn footprint(&self, rays: &SegmentRays, a_m: f32, b_m: f32) -> Option<Footprint> {
+    /// The footprint of plan segment `k`'s row carried from an earlier update
+    /// ([`Carried`]): widened, and only while the rays (r, d0, dy) have moved less than
+    /// its bound since; `None`: [`DemGround::footprint`] makes it again.
+    #[inline(always)]
+    pub(crate) fn carried_footprint(
+        &mut self,
+        k: usize,
+        r: &[f32; 3],
+        d0: &[f32; 3],
+        dy: &[f32; 3],
+        a_m: f32,
+        b_m: f32,
+    ) -> Option<Footprint> {
+        let t = &self.frame;
+        let c = self.carried.get_mut(k)?.as_mut()?;
+        if c.lim_m2.is_nan() {
+            c.bound(t);
+        }
+        c.holds(r, d0, dy, a_m, b_m).then_some(c.footprint)
+    }
+
+    /// Where plan segment `k`'s row sees the tile: its grid coordinates at mid-band as
+    /// an affine function of p2, from the samples at p2 `a_m` and `b_m` (the row's
+    /// ends), with a margin for the footprint's bow between them (its section by the
+    /// rays' plane, and the grid's meridians converging: [`TileFrame`]'s share of the
+    /// ends' distance) and for each sample's stretch through the band. A sample the
+    /// function puts beyond an edge by more than the margin sees ground off the tile,
+    /// for no evaluation. `None`: an end the route cannot place (the samples are each
+    /// evaluated). Kept, widened, for later updates ([`DemGround::carried_footprint`]).
+    pub(crate) fn footprint(
+        &mut self,
+        k: usize,
+        rays: &SegmentRays,
+        a_m: f32,
+        b_m: f32,
+    ) -> Option<Footprint> {
+        *self.carried.get_mut(k)? = None;
         let t = &self.frame;
         let h = 0.5 * (t.lo_m + t.hi_m);
         let ray = |p2: f32| Ray {
@@ -22,26 +50,46 @@ impl DemGround {
             jr: rays.jr0 + p2 * rays.jry,
             jc: rays.jc0 + p2 * rays.jcy,
         };
-        let x = self.locate(rays, &ray(a_m), h)?;
-        let y = self.locate(rays, &ray(b_m), h)?;
+        let (ray_a, ray_b) = (ray(a_m), ray(b_m));
+        let x = self.locate(rays, &ray_a, h)?;
+        let y = self.locate(rays, &ray_b, h)?;
+        let t = &self.frame;
         if !(x.tan2 < MAX_TAN2 && y.tan2 < MAX_TAN2 && b_m != a_m) {
             return None;
         }
         let bow = t.bow_share * ((x.row - y.row).abs() + (x.col - y.col).abs()) + 2.0;
         let half = 0.5 * (t.hi_m - t.lo_m) * (1.0 + EDGE_SHARE);
-        let larger = |p: f32, q: f32| if p.abs() > q.abs() { p.abs() } else { q.abs() };
+        // Comparisons, not f32::min/max (software calls on the M4F).
+        let larger = |p: f32, q: f32| if p > q { p } else { q };
         let per_m = 1.0 / (b_m - a_m);
-        Some(Footprint {
+        let f = Footprint {
             a_m,
             row: x.row,
             col: x.col,
             row_per_m: (y.row - x.row) * per_m,
             col_per_m: (y.col - x.col) * per_m,
-            row_margin: bow + larger(x.drow_dh, y.drow_dh) * half,
-            col_margin: bow + larger(x.dcol_dh, y.dcol_dh) * half,
+            row_margin: bow + larger(x.drow_dh.abs(), y.drow_dh.abs()) * half,
+            col_margin: bow + larger(x.dcol_dh.abs(), y.dcol_dh.abs()) * half,
             last_row: t.last_row,
             last_col: t.last_col,
-        })
+        };
+        // Kept for the carried form ([`Carried::bound`], made at the next update).
+        let carried = Carried {
+            footprint: f,
+            b_m,
+            r: rays.r,
+            d0: rays.d0,
+            dy: rays.dy,
+            s: [x.s, y.s],
+            tan2: larger(x.tan2, y.tan2),
+            uu0: rays.uu0,
+            c_d: 0.0,
+            lim_m2: f32::NAN,
+        };
+        if let Some(slot) = self.carried.get_mut(k) {
+            *slot = Some(carried);
+        }
+        Some(f)
     }
 
     /// The stretch of the ray through the band that lies in the tile, from a point of

@@ -81,7 +81,7 @@ pub struct DemStats {
 }
 
 /// The tile's constants for the route, in f32, made once per tile.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, Default)]
 struct TileFrame {
     tan_lat_c: f32,
     cos_lon_c: f32,
@@ -109,16 +109,24 @@ struct TileFrame {
     /// converging meridians, with L at most 500 km: 0.02 + 0.02 tan(lat) at the tile's
     /// largest |latitude|.
     bow_share: f32,
+    /// Rows per metre along the raised ellipsoids at most: rows per radian over the
+    /// least meridian radius of curvature, a (1 - e^2) at the band's foot, with 1 %
+    /// for the chord's length against the arc's ([`Carried`]).
+    rows_per_m_max: f32,
 }
 
 /// The DEM tile in force and what the route keeps between updates.
 #[derive(Clone, Debug)]
 pub struct DemGround {
     frame: TileFrame,
+    /// Whether `frame` is a tile's, in force ([`DemGround::install`]).
+    active: bool,
     /// Each plan segment's samples' heights at the last update (NaN: none) and their
     /// change over it (m).
-    last_h_m: [[f32; MAX_SAMPLES]; MAX_SEGMENTS],
-    step_h_m: [[f32; MAX_SAMPLES]; MAX_SEGMENTS],
+    history_m: [[[f32; 2]; MAX_SAMPLES]; MAX_SEGMENTS],
+    /// Each plan segment's footprint as last made, widened to hold while the rays move
+    /// by less than its bound ([`Carried`]).
+    carried: [Option<Carried>; MAX_SEGMENTS],
     pub stats: DemStats,
 }
 
@@ -132,6 +140,54 @@ pub enum TileRefusal {
 impl DemGround {
     /// The route's constants for `tile` (f64 trigonometry, once per tile).
     pub fn new(tile: &DemTile<'_, i16>) -> Result<DemGround, TileRefusal> {
+        let mut ground = DemGround::blank();
+        ground.install(tile)?;
+        Ok(ground)
+    }
+
+    /// A route with no tile ([`DemGround::install`] gives it one): what the controller
+    /// holds from its construction, in place (the route is 3 KB: made as a value for
+    /// each new tile, it passed through the stack of whoever put it in force,
+    /// docs/target.md, "Size and time per board").
+    #[inline(always)]
+    pub(crate) fn blank() -> DemGround {
+        DemGround {
+            frame: TileFrame::default(),
+            active: false,
+            // Zeros (a fill), set by `install` before any use.
+            history_m: [[[0.0; 2]; MAX_SAMPLES]; MAX_SEGMENTS],
+            carried: [None; MAX_SEGMENTS],
+            stats: DemStats::default(),
+        }
+    }
+
+    /// No tile: the TERRAIN heights are the ground.
+    pub(crate) fn clear(&mut self) {
+        self.active = false;
+    }
+
+    /// Puts the route on `tile` in force in place: its constants (f64 trigonometry,
+    /// once per tile), no heights or footprints kept, the counts from zero. On a
+    /// refusal nothing changes.
+    #[inline(never)]
+    pub(crate) fn install(&mut self, tile: &DemTile<'_, i16>) -> Result<(), TileRefusal> {
+        self.frame = Self::frame_for(tile)?;
+        self.active = true;
+        // A loop: the array's literal of NaN pairs was unrolled into stores (flash).
+        for pair in self.history_m.iter_mut().flatten() {
+            *pair = [f32::NAN, 0.0];
+        }
+        self.carried.fill(None);
+        self.stats = DemStats::default();
+        Ok(())
+    }
+
+    /// Whether a tile is in force ([`DemGround::install`]).
+    pub(crate) fn active(&self) -> bool {
+        self.active
+    }
+
+    fn frame_for(tile: &DemTile<'_, i16>) -> Result<TileFrame, TileRefusal> {
         let g: DemGrid = *tile.grid();
         let (rows, cols) = ((g.nrows - 1) as f64, (g.ncols - 1) as f64);
         if 0.5 * rows * g.dlat_deg > MAX_TILE_HALF_DEG
@@ -181,13 +237,10 @@ impl DemGround {
             cols_per_m: east.map(|x| (x * cols_per_rad / parallel_m) as f32),
             bow_share: (0.02 + 0.02 * tan_small(libm::fabs(lat_c) + MAX_TILE_HALF_DEG.to_radians()))
                 as f32,
+            rows_per_m_max: (1.01 * rows_per_rad / (EARTH.a_m * (1.0 - e2) + min_m - BAND_MARGIN_M))
+                as f32,
         };
-        Ok(DemGround {
-            frame,
-            last_h_m: [[f32::NAN; MAX_SAMPLES]; MAX_SEGMENTS],
-            step_h_m: [[0.0; MAX_SAMPLES]; MAX_SEGMENTS],
-            stats: DemStats::default(),
-        })
+        Ok(frame)
     }
 }
 
@@ -200,7 +253,7 @@ fn tan_small(x: f64) -> f64 {
 }
 
 /// A segment's row's view of the tile ([`DemGround::footprint`]).
-#[derive(Clone, Copy)]
+#[derive(Clone, Copy, Debug)]
 pub(crate) struct Footprint {
     a_m: f32,
     row: f32,
@@ -214,6 +267,33 @@ pub(crate) struct Footprint {
 }
 
 impl Footprint {
+    /// By how many cells beyond its margins the footprint from p2 `a_m` to `b_m` lies
+    /// beyond one edge of the tile (below zero: it reaches the tile).
+    fn beyond(&self, a_m: f32, b_m: f32) -> f32 {
+        let (da, db) = (a_m - self.a_m, b_m - self.a_m);
+        let (ra, rb) = (
+            self.row + self.row_per_m * da,
+            self.row + self.row_per_m * db,
+        );
+        let (ca, cb) = (
+            self.col + self.col_per_m * da,
+            self.col + self.col_per_m * db,
+        );
+        let (r_lo, r_hi) = if ra < rb { (ra, rb) } else { (rb, ra) };
+        let (c_lo, c_hi) = if ca < cb { (ca, cb) } else { (cb, ca) };
+        let larger = |p: f32, q: f32| if p > q { p } else { q };
+        larger(
+            larger(
+                -r_hi - self.row_margin,
+                r_lo - self.row_margin - self.last_row,
+            ),
+            larger(
+                -c_hi - self.col_margin,
+                c_lo - self.col_margin - self.last_col,
+            ),
+        )
+    }
+
     /// Whether the sample at p2 sees ground off the tile.
     #[inline(always)]
     pub(crate) fn off_tile(&self, p2_m: f32) -> bool {
@@ -249,6 +329,137 @@ impl Footprint {
     }
 }
 
+/// A segment's footprint carried from the update that made it ([`DemGround::footprint`]),
+/// its margins widened by `w` cells and by a tenth, with what bounds how far the rays
+/// have moved since.
+///
+/// The bound. Let the ends' rays move from (r, d) to (r', d'), d = d0 + p2 dy
+/// (unnormalised, |d| the same for a p2 unless the row changed), by dr = |r' - r| and
+/// s |d' - d| at the ray's parameter s at mid-band. The point where a ray meets the
+/// raised ellipsoid moves, to first order, by the oblique projection of dr + s (d' - d)
+/// along d onto the tangent plane, whose norm is sec(theta): at most
+/// sec(theta) (dr + s |d' - d|). [`Carried::holds`] admits a move only while
+/// dr^2 + (1.1 s)^2 |d' - d|^2 <= `lim_m2`, which `lim_m2` keeps below (0.005 range)^2
+/// and (5 km)^2: dr + s |d' - d| is then under 0.0071 of the range and 7.1 km, the
+/// direction turns by at most 0.015 rad (twice |d' - d| / |d|, the unit vector's
+/// change), the point moves under 31 km and 0.031 of the range (below), the normal
+/// under it turns by under 0.005 rad (radii of curvature above 6 300 km), so theta
+/// changes by under 0.02 rad: sec^2 by under 2 tan(theta) 0.02 < 12 % at tan^2 < 9, the
+/// first-order step is off by under tan(theta) 0.02 < 6 %, s changes by under 4 %.
+/// With 1.25 on sec^2, 1.2 on the step and 1.1 on s, the point moves at most
+/// m = 1.2 sec (dr + 1.1 s |d' - d|), m^2 <= 3.6 sec^2 (dr^2 + (1.1 s)^2 |d' - d|^2).
+/// Along the raised ellipsoid a point moving m changes latitude by at most m over the
+/// least meridian radius, and longitude by at most m over its distance from the axis
+/// less 31 km, at least 0.9 of the distance from 310 km on (both with 1 % for chord
+/// against arc): each grid coordinate of each end by at most kappa m, kappa the largest
+/// of [`TileFrame::rows_per_m_max`], cols per radian over 0.9 of the ends' least
+/// distance from the axis, and the tile centre's cols per metre. Every sample's affine
+/// coordinate between the ends then moves by at most kappa m; the bow's margin, a share
+/// of the ends' L1 distance, by at most 4 `bow_share` kappa m; the band's margin, the
+/// rows per metre of height along the ray (the centre's Jacobian, d and sec(theta)) over
+/// half the band, by under 6 % through sec(theta) (the 1.1 on the margins) and, through
+/// d, by at most kappa sec(theta) |d' - d| / |d| times half the band (5.3 km at most),
+/// which is under 0.1 kappa m for ranges above 110 km. So where the carried footprint,
+/// its margins 1.1 times the made one's plus w, puts a sample beyond an edge, the
+/// footprint made now would put it there too, as long as (1.1 + 4 `bow_share`) kappa m
+/// <= w: `lim_m2`.
+/// `controller/src/dem_ground/tests.rs`, `a_carried_footprint_holds_within_its_bound`,
+/// checks the bound against the ends' true moves in f64 and the samples it skips
+/// against `DemTile::first_crossing`.
+#[derive(Clone, Copy, Debug)]
+struct Carried {
+    footprint: Footprint,
+    /// The row's far end (p2, m; the near one is the footprint's `a_m`).
+    b_m: f32,
+    /// r, d0 and dy when the footprint was made.
+    r: [f32; 3],
+    d0: [f32; 3],
+    dy: [f32; 3],
+    /// The ends' parameters s at mid-band, their larger tan^2(theta), |u|^2 at p2 = 0.
+    s: [f32; 2],
+    tan2: f32,
+    uu0: f32,
+    /// (1.1 s)^2, s the ends' larger parameter at mid-band.
+    c_d: f32,
+    /// The largest dr^2 + c_d |d' - d|^2 (m^2) the widened footprint holds for; NaN
+    /// until [`Carried::bound`] (at the update after the one that made it: the first
+    /// update over a tile, which makes every segment's, is spared the work).
+    lim_m2: f32,
+}
+
+/// Cells a carried footprint's margins are widened by at least ([`Carried`]): the rays
+/// may move a cell's share of it before the footprint is made again.
+const CARRY_MIN_CELLS: f32 = 1.0;
+
+impl Carried {
+    /// Widens the footprint as made and sets the bound it then holds for.
+    #[inline(never)]
+    fn bound(&mut self, t: &TileFrame) {
+        let f = self.footprint;
+        let (a_m, b_m) = (f.a_m, self.b_m);
+        // Comparisons, not f32::min/max (software calls on the M4F).
+        let larger = |p: f32, q: f32| if p > q { p } else { q };
+        let smaller = |p: f32, q: f32| if p < q { p } else { q };
+        // Wide enough to hold long where the row lies wholly beyond an edge (and
+        // still wholly beyond it), a cell otherwise.
+        let margin = larger(f.row_margin, f.col_margin);
+        let w = larger(CARRY_MIN_CELLS, 0.9 * (f.beyond(a_m, b_m) - 0.1 * margin));
+        // The ends' points at mid-band, their squared distances from the axis; from
+        // 310 km, that less 31 km is at least 0.9 of it.
+        let axis2 = |p2: f32, s: f32| {
+            let p: [f32; 2] =
+                core::array::from_fn(|i| self.r[i] + s * (self.d0[i] + p2 * self.dy[i]));
+            p[0] * p[0] + p[1] * p[1]
+        };
+        let axis2_m2 = smaller(axis2(a_m, self.s[0]), axis2(b_m, self.s[1]));
+        let cols_per_m = 1.01 / 0.9 * t.cols_per_rad;
+        let c = t.cols_per_m;
+        let kappa2 = larger(
+            larger(
+                t.rows_per_m_max * t.rows_per_m_max,
+                cols_per_m * cols_per_m / axis2_m2,
+            ),
+            c[0] * c[0] + c[1] * c[1] + c[2] * c[2],
+        );
+        let share = 1.1 + 4.0 * t.bow_share;
+        let range2_m2 = smaller(
+            self.s[0] * self.s[0] * (self.uu0 + a_m * a_m),
+            self.s[1] * self.s[1] * (self.uu0 + b_m * b_m),
+        );
+        let lim_m2 = smaller(
+            smaller(
+                w * w / (share * share * kappa2 * 3.6 * (1.0 + self.tan2)),
+                0.005 * 0.005 * range2_m2,
+            ),
+            5e3 * 5e3,
+        );
+        let s = 1.1 * larger(self.s[0], self.s[1]);
+        self.c_d = s * s;
+        // Within 310 km of the axis, no bound: made again at every update.
+        self.lim_m2 = if axis2_m2 > 310e3 * 310e3 {
+            lim_m2
+        } else {
+            -1.0
+        };
+        self.footprint.row_margin = 1.1 * f.row_margin + w;
+        self.footprint.col_margin = 1.1 * f.col_margin + w;
+    }
+
+    /// Whether the rays at this update (r, d0, dy) and the row's ends are within the
+    /// bound the footprint was widened for.
+    #[inline(always)]
+    fn holds(&self, r: &[f32; 3], d0: &[f32; 3], dy: &[f32; 3], a_m: f32, b_m: f32) -> bool {
+        let sq = |x: [f32; 3]| x[0] * x[0] + x[1] * x[1] + x[2] * x[2];
+        let dr = sq(core::array::from_fn(|i| r[i] - self.r[i]));
+        let dd0: [f32; 3] = core::array::from_fn(|i| d0[i] - self.d0[i]);
+        let ddy: [f32; 3] = core::array::from_fn(|i| dy[i] - self.dy[i]);
+        let da = sq(core::array::from_fn(|i| dd0[i] + a_m * ddy[i]));
+        let db = sq(core::array::from_fn(|i| dd0[i] + b_m * ddy[i]));
+        let dd = if da > db { da } else { db };
+        a_m == self.footprint.a_m && b_m == self.b_m && dr + self.c_d * dd <= self.lim_m2
+    }
+}
+
 /// One segment's rays at one update: d = d0 + p2 dy (the camera's row p1 turned into
 /// the ITRF), with what every evaluation reads.
 pub(crate) struct SegmentRays<'h> {
@@ -272,6 +483,7 @@ pub(crate) struct SegmentRays<'h> {
 }
 
 impl<'h> SegmentRays<'h> {
+    #[cfg(test)]
     pub(crate) fn new(
         ground: &DemGround,
         heights_m: &'h [i16],
@@ -281,11 +493,39 @@ impl<'h> SegmentRays<'h> {
         uu0_m2: f32,
         r2_minus_a2_m2: f32,
     ) -> SegmentRays<'h> {
+        let (d0, dy) = Self::directions(frame, p1_m, focal_m);
+        Self::from_directions(
+            ground,
+            heights_m,
+            frame.position_m,
+            d0,
+            dy,
+            uu0_m2,
+            r2_minus_a2_m2,
+        )
+    }
+
+    /// d0 = B (p1, 0, -f) and dy = B (0, 1, 0).
+    #[inline(always)]
+    pub(crate) fn directions(frame: &ItrfFrame, p1_m: f32, focal_m: f32) -> ([f32; 3], [f32; 3]) {
         let b = &frame.camera_to_itrf;
-        let r = frame.position_m;
-        // B (p1, 0, -f) and B (0, 1, 0).
-        let d0: [f32; 3] = core::array::from_fn(|i| b[i][0] * p1_m - b[i][2] * focal_m);
-        let dy: [f32; 3] = core::array::from_fn(|i| b[i][1]);
+        (
+            core::array::from_fn(|i| b[i][0] * p1_m - b[i][2] * focal_m),
+            core::array::from_fn(|i| b[i][1]),
+        )
+    }
+
+    /// [`SegmentRays::new`] from r and the [`SegmentRays::directions`].
+    #[inline(always)]
+    pub(crate) fn from_directions(
+        ground: &DemGround,
+        heights_m: &'h [i16],
+        r: [f32; 3],
+        d0: [f32; 3],
+        dy: [f32; 3],
+        uu0_m2: f32,
+        r2_minus_a2_m2: f32,
+    ) -> SegmentRays<'h> {
         let dot = |x: [f32; 3], y: [f32; 3]| x[0] * y[0] + x[1] * y[1] + x[2] * y[2];
         let t = &ground.frame;
         SegmentRays {
@@ -363,6 +603,7 @@ mod search;
 mod tests;
 
 /// One sample's ray: d, r.d, |d|^2 = |u|^2, and rows and columns per unit of s.
+#[derive(Clone, Copy)]
 struct Ray {
     d: [f32; 3],
     rd: f32,

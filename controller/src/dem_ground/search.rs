@@ -24,24 +24,55 @@ impl DemGround {
             jr: rays.jr0 + p2_m * rays.jry,
             jc: rays.jc0 + p2_m * rays.jcy,
         };
+        let [last, step] = self.slot(k, j);
+        if last.is_finite() {
+            // The steady state: the search's first step alone, from the last height and
+            // its change, where it certifies (as the search below would at n = 1).
+            let h = clamp(last + step, self.frame.lo_m, self.frame.hi_m);
+            if let Evaluation::At { at, g, q2, .. } = self.evaluate(rays, &ray, h) {
+                let tol = HEIGHT_TOLERANCE_M;
+                let a = g.abs() + tol;
+                let reach = g.abs() * 5.0 + 1.0;
+                if q2 * a * a <= tol * tol && self.inside_over(&at, -reach, reach) {
+                    self.stats.searched += 1;
+                    self.stats.evaluations += 1;
+                    self.remember(k, j, h + g);
+                    return Ok(SampleGround::Range(at.s + g * at.ds_dh));
+                }
+            }
+            return self.search(k, j, rays, &ray, last + step);
+        }
+        self.search(k, j, rays, &ray, terrain_h_m)
+    }
+
+    /// [`DemGround::sample`]'s search from the height `start` (m).
+    #[inline(never)]
+    fn search(
+        &mut self,
+        k: usize,
+        j: usize,
+        rays: &SegmentRays,
+        ray: &Ray,
+        start: f32,
+    ) -> Result<SampleGround, ModelError> {
         let (band_lo, band_hi) = (self.frame.lo_m, self.frame.hi_m);
-        let (last, step) = (self.slot(k, j, true), self.slot(k, j, false));
-        let start = if last.is_finite() {
-            last + step
-        } else {
-            terrain_h_m
-        };
         let mut h = clamp(start, band_lo, band_hi);
         let (mut lo, mut hi) = (band_lo, band_hi);
         let mut edges_done = false;
-        for n in 1..=MAX_EVALUATIONS {
-            let found = match self.evaluate(rays, &ray, h) {
-                Evaluation::Outside => Some(SampleGround::Outside),
+        for n in 1..MAX_EVALUATIONS + 1 {
+            let found = match self.evaluate(rays, ray, h) {
+                Evaluation::Outside => {
+                    // The ray's stretch through the band lies off the tile: nothing
+                    // settled at an edge.
+                    self.stats.outside += 1;
+                    self.remember(k, j, f32::NAN);
+                    return Ok(SampleGround::Outside);
+                }
                 Evaluation::March => break,
                 Evaluation::Off(at) if !edges_done => {
                     edges_done = true;
                     let monotone = self.frame.slope2 * at.tan2 < MAX_CONTRACTION * MAX_CONTRACTION;
-                    match self.edges(rays, &ray, h, &at, monotone) {
+                    match self.edges(rays, ray, h, &at, monotone) {
                         Some(Edges::Done(found)) => Some(found),
                         Some(Edges::Within(l, u, false)) if monotone => {
                             self.stats.edges += 1;
@@ -73,7 +104,7 @@ impl DemGround {
                             break;
                         }
                         edges_done = true;
-                        match self.edges(rays, &ray, h, &at, true) {
+                        match self.edges(rays, ray, h, &at, true) {
                             Some(Edges::Done(found)) => Some(found),
                             Some(Edges::Within(l, u, false)) => {
                                 self.stats.edges += 1;
@@ -109,7 +140,7 @@ impl DemGround {
             }
         }
         self.remember(k, j, f32::NAN);
-        Ok(match self.trace(rays, &ray) {
+        Ok(match self.trace(rays, ray) {
             Some(found) => {
                 self.stats.traced += 1;
                 found
@@ -188,48 +219,46 @@ impl DemGround {
     /// Notes the first `n` samples of plan segment `k` as off the tile by its
     /// segment's footprint, all at once ([`DemGround::off_tile`] each).
     pub(crate) fn segment_off_tile(&mut self, k: usize, n: usize) {
-        if let (Some(last), Some(step)) = (self.last_h_m.get_mut(k), self.step_h_m.get_mut(k)) {
+        if let Some(history) = self.history_m.get_mut(k) {
             let n = n.min(MAX_SAMPLES);
-            last[..n].fill(f32::NAN);
-            step[..n].fill(0.0);
+            history[..n].fill([f32::NAN, 0.0]);
             self.stats.outside += n as u32;
         }
     }
 
     /// Whether the first `n` samples of plan segment `k` all found their ground on the
     /// tile at the last update: the footprint, which only spares evaluations of
-    /// samples off the tile, is then not worth its two evaluations ([`DemGround::sample`]
-    /// places a sample that has since left the tile by itself).
+    /// samples off the tile, is then not worth making ([`DemGround::sample`] places a
+    /// sample that has since left the tile by itself).
     pub(crate) fn all_on_tile(&self, k: usize, n: usize) -> bool {
-        self.last_h_m
+        self.history_m
             .get(k)
-            .and_then(|last| last.get(..n))
-            .is_some_and(|last| last.iter().all(|h| h.is_finite()))
+            .and_then(|history| history.get(..n))
+            .is_some_and(|history| history.iter().all(|h| h[0].is_finite()))
     }
 
-    pub(super) fn slot(&self, k: usize, j: usize, last: bool) -> f32 {
-        let table = if last { &self.last_h_m } else { &self.step_h_m };
-        table
+    /// Sample `j` of plan segment `k`'s height at the last update (NaN: none) and its
+    /// change over it (m).
+    pub(super) fn slot(&self, k: usize, j: usize) -> [f32; 2] {
+        self.history_m
             .get(k)
             .and_then(|s| s.get(j))
             .copied()
-            .unwrap_or(f32::NAN)
+            .unwrap_or([f32::NAN, 0.0])
     }
 
     /// Notes the sample's height for the next update's start, and its change.
     pub(super) fn remember(&mut self, k: usize, j: usize, h_m: f32) {
-        let (Some(last), Some(step)) = (
-            self.last_h_m.get_mut(k).and_then(|s| s.get_mut(j)),
-            self.step_h_m.get_mut(k).and_then(|s| s.get_mut(j)),
-        ) else {
+        let Some(slot) = self.history_m.get_mut(k).and_then(|s| s.get_mut(j)) else {
             return;
         };
-        *step = if last.is_finite() && h_m.is_finite() {
-            h_m - *last
+        let last = slot[0];
+        let step = if last.is_finite() && h_m.is_finite() {
+            h_m - last
         } else {
             0.0
         };
-        *last = h_m;
+        *slot = [h_m, step];
     }
 
     /// Whether the ray's points from h + dh_lo to h + dh_hi (linear in h from the grid

@@ -238,3 +238,195 @@ fn the_incidence_bounds_the_true_one() {
     }
     std::eprintln!("incidence: {checked} rays, tan^2 at least {worst_margin:.2e} above the true");
 }
+
+/// Grid coordinates (row, column) of the point where the line r + s d meets the
+/// ellipsoid raised by h, in f64: the raised ellipsoid's normal latitude and the
+/// longitude (the footprint's coordinates, `DemGround::grid_at`'s, exactly).
+fn grid_at_height(grid: &DemGrid, r: [f64; 3], d: [f64; 3], h_m: f64) -> Option<(f64, f64)> {
+    let (a, b) = (EARTH.a_m + h_m, EARTH.b_m() + h_m);
+    let (a2, b2) = (a * a, b * b);
+    let alpha = (d[0] * d[0] + d[1] * d[1]) / a2 + d[2] * d[2] / b2;
+    let beta = (r[0] * d[0] + r[1] * d[1]) / a2 + r[2] * d[2] / b2;
+    let gamma = (r[0] * r[0] + r[1] * r[1]) / a2 + r[2] * r[2] / b2 - 1.0;
+    let disc = beta * beta - alpha * gamma;
+    if disc <= 0.0 {
+        return None;
+    }
+    let s = (-beta - disc.sqrt()) / alpha;
+    let x: [f64; 3] = core::array::from_fn(|i| r[i] + s * d[i]);
+    let p = (x[0] * x[0] + x[1] * x[1]).sqrt();
+    let lat = (a2 / b2 * x[2] / p).atan().to_degrees();
+    let lon = x[1].atan2(x[0]).to_degrees();
+    Some((
+        (lat - grid.lat0_deg) / grid.dlat_deg,
+        (lon - grid.lon0_deg) / grid.dlon_deg,
+    ))
+}
+
+/// Rotation of v about the unit axis k by angle (rad): Rodrigues.
+fn rotate(v: [f64; 3], k: [f64; 3], angle: f64) -> [f64; 3] {
+    let (c, s) = (angle.cos(), angle.sin());
+    let kv = cross(k, v);
+    let kd = k[0] * v[0] + k[1] * v[1] + k[2] * v[2];
+    core::array::from_fn(|i| v[i] * c + kv[i] * s + k[i] * kd * (1.0 - c))
+}
+
+/// A segment's footprint carried from the update that made it
+/// (`DemGround::carried_footprint`, docs/controller.md, "The DEM ground") against the
+/// truth in f64. The rows look across the tile's east edge (partly on it), wholly past
+/// it, and past its north-west corner; the satellite then moves along its orbit (7.5
+/// km/s) and the camera turns (about its own x and y axes, to 0.2 rad/s, the scene
+/// envelope's limit) for 1 ms to 2 s. Wherever the carried footprint is taken:
+/// - each end of the row has truly moved, in grid coordinates at mid-band, by no more
+///   than the bound the footprint was widened for (w / (1.1 + 4 bow_share) cells): a
+///   move beyond it must make the footprint again;
+/// - every sample (129 across the row) it puts off the tile has no ground on the tile
+///   by `DemTile::first_crossing` in f64 (the reference's ground), and where it puts
+///   the whole row beyond an edge, none of the row's samples has.
+#[test]
+fn a_carried_footprint_holds_within_its_bound() {
+    let (lat_c, lon_c, side, step) = (45.0, 10.0, 61usize, 0.02);
+    let half = 0.5 * (side - 1) as f64 * step;
+    let grid = DemGrid {
+        lat0_deg: lat_c - half,
+        lon0_deg: lon_c - half,
+        dlat_deg: step,
+        dlon_deg: step,
+        nrows: side,
+        ncols: side,
+    };
+    let heights: Vec<i16> = (0..side * side)
+        .map(|k| {
+            let (i, j) = ((k / side) as f64, (k % side) as f64);
+            (2_000.0 + 1_500.0 * (0.4 * i).sin() * (0.3 * j).cos()) as i16
+        })
+        .collect();
+    let tile = DemTile::new(grid, Box::leak(heights.into_boxed_slice())).unwrap();
+    let mut ground = DemGround::new(&tile).unwrap();
+    let h_mid = 0.5 * f64::from(ground.frame.lo_m + ground.frame.hi_m);
+    let share = 1.1 + 4.0 * f64::from(ground.frame.bow_share);
+    let focal = 0.555f64;
+    // The row's ends: p2 over +-30 mm, about +-45 km on the ground.
+    let (a_m, b_m) = (-0.03f32, 0.03f32);
+    let (mut taken, mut refused, mut skipped, mut wholly) = (0, 0, 0, 0);
+    let mut tightest = 0f64;
+    // Where the row looks: across the east edge, 1.5 deg east of it, past the
+    // north-west corner.
+    for (look_lat, look_lon) in [
+        (lat_c, lon_c + half),
+        (lat_c, lon_c + half + 1.5),
+        (lat_c + half + 0.4, lon_c - half - 0.4),
+    ] {
+        let t = itrf(look_lat, look_lon, 2_000.0);
+        let up = unit(t);
+        let east = unit([-t[1], t[0], 0.0]);
+        let north = cross(up, east);
+        let (c, s) = (30f64.to_radians().cos(), 30f64.to_radians().sin());
+        // 30 deg from the vertical, looking north-east.
+        let look = unit(core::array::from_fn(|i| {
+            -c * up[i] + s * (0.6 * north[i] + 0.8 * east[i])
+        }));
+        let r0: [f64; 3] = core::array::from_fn(|i| t[i] - 700e3 / c * look[i]);
+        let z = look.map(|v| -v);
+        let ez = east[0] * z[0] + east[1] * z[1] + east[2] * z[2];
+        let y = unit(core::array::from_fn(|i| east[i] - ez * z[i]));
+        let x = cross(y, z);
+        let velocity = unit(cross(r0, east)).map(|v| v * 7_500.0);
+        let frame_of = |r: [f64; 3], x: [f64; 3], y: [f64; 3], z: [f64; 3]| ItrfFrame {
+            position_m: r.map(|v| v as f32),
+            camera_to_itrf: core::array::from_fn(|i| [x[i] as f32, y[i] as f32, z[i] as f32]),
+        };
+        let rays_of = |ground: &DemGround, frame: &ItrfFrame, r: [f64; 3]| {
+            let r2 = r.iter().map(|v| v * v).sum::<f64>();
+            SegmentRays::new(
+                ground,
+                tile.heights_m(),
+                frame,
+                0.0,
+                focal as f32,
+                (focal * focal) as f32,
+                (r2 - EARTH.a_m * EARTH.a_m) as f32,
+            )
+        };
+        // d = B (0, p2, -f).
+        let d_of = |y: [f64; 3], z: [f64; 3], p2: f64| -> [f64; 3] {
+            core::array::from_fn(|i| y[i] * p2 - z[i] * focal)
+        };
+        let frame0 = frame_of(r0, x, y, z);
+        let made = {
+            let rays = rays_of(&ground, &frame0, r0);
+            ground
+                .footprint(0, &rays, a_m, b_m)
+                .expect("the row's ends place")
+        };
+        // The bound is set at the first update that looks at the carried footprint.
+        let (d0, dy) = SegmentRays::directions(&frame0, 0.0, focal as f32);
+        let carried = ground
+            .carried_footprint(0, &frame0.position_m, &d0, &dy, a_m, b_m)
+            .expect("an unmoved footprint is carried");
+        let w = f64::from(carried.row_margin - 1.1 * made.row_margin);
+        let allowed_cells = w / share;
+        let ends0 = [a_m, b_m]
+            .map(|p2| grid_at_height(&grid, r0, d_of(y, z, f64::from(p2)), h_mid).unwrap());
+        for axis in [0usize, 1] {
+            for rate_rad_s in [0.0, 0.01, 0.2] {
+                for dt_s in [1e-3, 3e-3, 1e-2, 2e-2, 5e-2, 0.1, 0.2, 0.5, 1.0, 2.0] {
+                    let k = if axis == 0 { x } else { y };
+                    let angle = rate_rad_s * dt_s;
+                    let (x1, y1, z1) = (
+                        rotate(x, k, angle),
+                        rotate(y, k, angle),
+                        rotate(z, k, angle),
+                    );
+                    let r1: [f64; 3] = core::array::from_fn(|i| r0[i] + velocity[i] * dt_s);
+                    let frame1 = frame_of(r1, x1, y1, z1);
+                    let (d0, dy) = SegmentRays::directions(&frame1, 0.0, focal as f32);
+                    let moved_cells = [a_m, b_m]
+                        .iter()
+                        .zip(ends0)
+                        .map(|(&p2, (row0, col0))| {
+                            let d = d_of(y1, z1, f64::from(p2));
+                            let (row, col) = grid_at_height(&grid, r1, d, h_mid).unwrap();
+                            (row - row0).abs().max((col - col0).abs())
+                        })
+                        .fold(0f64, f64::max);
+                    let Some(f) =
+                        ground.carried_footprint(0, &frame1.position_m, &d0, &dy, a_m, b_m)
+                    else {
+                        refused += 1;
+                        continue;
+                    };
+                    taken += 1;
+                    assert!(
+                        moved_cells <= allowed_cells,
+                        "look ({look_lat}, {look_lon}), axis {axis}, {rate_rad_s} rad/s over \
+                         {dt_s} s: the ends moved {moved_cells} cells, the bound {allowed_cells}"
+                    );
+                    tightest = tightest.max(moved_cells / allowed_cells);
+                    let all_off = f.off_tile_over(a_m, b_m);
+                    wholly += usize::from(all_off);
+                    for n in -64..=64 {
+                        let p2 = f32::from(n as i8) / 64.0 * b_m;
+                        if !(all_off || f.off_tile(p2)) {
+                            continue;
+                        }
+                        skipped += 1;
+                        let d = d_of(y1, z1, f64::from(p2));
+                        let want = tile.first_crossing::<f64>(&EARTH, r1, d);
+                        assert!(
+                            matches!(want, Err(ModelError::OutsideDem)),
+                            "look ({look_lat}, {look_lon}), axis {axis}, {rate_rad_s} rad/s \
+                             over {dt_s} s, p2 {p2}: skipped, the reference finds {want:?}"
+                        );
+                    }
+                }
+            }
+        }
+    }
+    std::eprintln!(
+        "carried footprints: {taken} taken ({wholly} wholly off the tile), {refused} made \
+         again; the ends moved at most {tightest:.3} of the bound; {skipped} samples \
+         skipped, none with ground on the tile by the reference"
+    );
+    assert!(taken > 0 && refused > 0 && wholly > 0 && skipped > 0);
+}

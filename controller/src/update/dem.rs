@@ -21,26 +21,39 @@ pub(super) fn dem_extremes(
     terrain_h_m: f32,
 ) -> Result<Extremes, Fault> {
     let r = &seg.row;
-    let rays = SegmentRays::new(
+    let (d0, dy) = SegmentRays::directions(frame, r.p1_m, r.focal_m);
+    let ends = match (seg.samples.get(1), seg.samples.last()) {
+        (Some(a), Some(b)) if !dem.all_on_tile(k, seg.samples.len()) => Some((a.p2_m, b.p2_m)),
+        _ => None,
+    };
+    // The footprint carried from an earlier update while the rays stay within its
+    // bound, else made again from the rays.
+    let mut footprint =
+        ends.and_then(|(a, b)| dem.carried_footprint(k, &frame.position_m, &d0, &dy, a, b));
+    // A segment wholly off the tile is the flat route's, at its TERRAIN height.
+    if let (Some(f), Some((a, b))) = (&footprint, ends) {
+        if f.off_tile_over(a, b) {
+            dem.segment_off_tile(k, seg.samples.len());
+            return extremes(update, seg);
+        }
+    }
+    let made = footprint.is_none();
+    let rays = SegmentRays::from_directions(
         dem,
         heights_m,
-        frame,
-        r.p1_m,
-        r.focal_m,
+        frame.position_m,
+        d0,
+        dy,
         r.uu0_m2,
         r2_minus_a2_m2,
     );
-    let footprint = match (seg.samples.get(1), seg.samples.last()) {
-        (Some(a), Some(b)) if !dem.all_on_tile(k, seg.samples.len()) => {
-            dem.footprint(&rays, a.p2_m, b.p2_m)
-        }
-        _ => None,
-    };
-    // A segment wholly off the tile is the flat route's, at its TERRAIN height.
-    if let (Some(f), Some(a), Some(b)) = (&footprint, seg.samples.get(1), seg.samples.last()) {
-        if f.off_tile_over(a.p2_m, b.p2_m) {
-            dem.segment_off_tile(k, seg.samples.len());
-            return extremes(update, seg);
+    if made {
+        if let Some((a, b)) = ends {
+            footprint = dem.footprint(k, &rays, a, b);
+            if footprint.is_some_and(|f| f.off_tile_over(a, b)) {
+                dem.segment_off_tile(k, seg.samples.len());
+                return extremes(update, seg);
+            }
         }
     }
     let row = GENERAL_F32.row_motion(update, &seg.row);
@@ -73,7 +86,8 @@ impl Controller {
             Some(t) => t.heights_m(),
             None => self.dem.heights_in_force().unwrap_or(&[]),
         };
-        let (Some(dem), Some(seg)) = (self.dem_ground.as_mut(), self.plan.segments.get(k)) else {
+        let dem = &mut self.dem_ground;
+        let (true, Some(seg)) = (dem.active(), self.plan.segments.get(k)) else {
             return Err(Fault::InvalidScene);
         };
         dem_extremes(
@@ -98,12 +112,11 @@ impl Controller {
         &mut self,
         tile: Option<core_math::earth::dem::DemTile<'static, i16>>,
     ) -> Result<(), TileRefusal> {
-        let ground = match &tile {
-            Some(t) => Some(DemGround::new(t)?),
-            None => None,
-        };
+        match &tile {
+            Some(t) => self.dem_ground.install(t)?,
+            None => self.dem_ground.clear(),
+        }
         self.dem_given = tile;
-        self.dem_ground = ground;
         if self.dem_given.is_none() {
             self.refresh_dem_ground();
         }
@@ -118,18 +131,23 @@ impl Controller {
     #[inline(never)]
     pub(crate) fn refresh_dem_ground(&mut self) {
         let tile = self.dem_given.or_else(|| self.dem.tile());
-        self.dem_ground = tile.and_then(|t| DemGround::new(&t).ok());
+        // In place (`DemGround::blank`): a refused tile leaves no route.
+        if tile.is_none_or(|t| self.dem_ground.install(&t).is_err()) {
+            self.dem_ground.clear();
+        }
     }
 
     /// The DEM tile the update's ground comes from, if any: None also when the route
     /// refused the tile in force.
     pub fn dem_tile_in_force(&self) -> Option<core_math::earth::dem::DemTile<'_, i16>> {
-        self.dem_ground.as_ref()?;
+        if !self.dem_ground.active() {
+            return None;
+        }
         self.dem_given.or_else(|| self.dem.tile())
     }
 
     /// How the DEM route found the samples' ground since the tile was set.
     pub fn dem_stats(&self) -> Option<DemStats> {
-        self.dem_ground.as_ref().map(|d| d.stats)
+        self.dem_ground.active().then_some(self.dem_ground.stats)
     }
 }

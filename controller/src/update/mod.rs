@@ -141,11 +141,7 @@ impl Controller {
         // Output slots by `get` (`index` < MAX_SEGMENTS by construction of the plan): no
         // panic path (docs/no-panic.md).
         // The DEM's route needs a tile in force and the ITRF of the instant.
-        let dem_frame = if self.dem_ground.is_some() {
-            itrf
-        } else {
-            None
-        };
+        let dem_frame = if self.dem_ground.active() { itrf } else { None };
         for k in 0..self.plan.segments.len() {
             let Some(seg) = self.plan.segments.get(k) else {
                 break;
