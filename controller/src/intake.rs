@@ -26,6 +26,9 @@ impl Controller {
     /// to [`MAX_TIME_TAG_US`] before the first frame). A tag outside it is refused, but
     /// remembered: if the very next frame is valid and lies after it by at most the
     /// jump, the two agree on a new time line and the clock re-synchronises to it.
+    // Out of line: inlined, the frame checks shared the session's per-byte closure
+    // and its registers (docs/target.md, flash).
+    #[inline(never)]
     pub fn on_frame(&mut self, frame: &Frame<'_>) {
         let t = frame.time_us;
         let candidate = self.resync_candidate_us.take();

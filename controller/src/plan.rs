@@ -113,6 +113,9 @@ pub struct Plan {
 /// Calls `f` with the update of every instant of the probe grid, at the lowest and the
 /// highest ground (432 updates; the grid is walked once, never stored: a scene upload
 /// costs no stack for it).
+// Out of line, as the scene's checks: inlined into the plan build, which holds many
+// values across it, they took more flash than as calls (docs/target.md, flash).
+#[inline(never)]
 fn for_each_probe(env: &AttitudeEnvelope, config: &Config, mut f: impl FnMut(&GeneralUpdate<f32>)) {
     let (r, p) = (f64::from(env.max_roll_rad), f64::from(env.max_pitch_rad));
     let (h_lo, h_hi) = config.altitude_range_m;

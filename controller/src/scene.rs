@@ -178,6 +178,8 @@ impl Scene {
     /// Everything a plan needs to hold: the optics, the clock, the floor, the envelope,
     /// each segment; and every pixel must see the Earth from the highest orbit of
     /// `altitude_max_m` at zero attitude (a segment that cannot is no use to image).
+    // Out of line: smaller than inlined into the plan build (docs/target.md, flash).
+    #[inline(never)]
     pub fn validate(&self, ellipsoid: &Ellipsoid, altitude_max_m: f64) -> Result<(), Fault> {
         self.camera.validate().map_err(|_| Fault::InvalidScene)?;
         let clock_ok = self.line_clock_hz.is_finite()
