@@ -22,17 +22,7 @@ impl Footprint {
     /// By how many cells beyond its margins the footprint from p2 `a_m` to `b_m` lies
     /// beyond one edge of the tile (below zero: it reaches the tile).
     pub(super) fn beyond(&self, a_m: f32, b_m: f32) -> f32 {
-        let (da, db) = (a_m - self.a_m, b_m - self.a_m);
-        let (ra, rb) = (
-            self.row + self.row_per_m * da,
-            self.row + self.row_per_m * db,
-        );
-        let (ca, cb) = (
-            self.col + self.col_per_m * da,
-            self.col + self.col_per_m * db,
-        );
-        let (r_lo, r_hi) = if ra < rb { (ra, rb) } else { (rb, ra) };
-        let (c_lo, c_hi) = if ca < cb { (ca, cb) } else { (cb, ca) };
+        let [r_lo, r_hi, c_lo, c_hi] = self.spans(a_m, b_m);
         let larger = |p: f32, q: f32| if p > q { p } else { q };
         larger(
             larger(
@@ -44,6 +34,24 @@ impl Footprint {
                 c_lo - self.col_margin - self.last_col,
             ),
         )
+    }
+
+    /// The rows and columns the footprint from p2 `a_m` to `b_m` spans, without its
+    /// margins: [row low, row high, column low, column high] (affine in p2: its ends').
+    #[inline(always)]
+    fn spans(&self, a_m: f32, b_m: f32) -> [f32; 4] {
+        let (da, db) = (a_m - self.a_m, b_m - self.a_m);
+        let (ra, rb) = (
+            self.row + self.row_per_m * da,
+            self.row + self.row_per_m * db,
+        );
+        let (ca, cb) = (
+            self.col + self.col_per_m * da,
+            self.col + self.col_per_m * db,
+        );
+        let (r_lo, r_hi) = if ra < rb { (ra, rb) } else { (rb, ra) };
+        let (c_lo, c_hi) = if ca < cb { (ca, cb) } else { (cb, ca) };
+        [r_lo, r_hi, c_lo, c_hi]
     }
 
     /// Whether the sample at p2 sees ground off the tile.
@@ -63,17 +71,7 @@ impl Footprint {
     /// put every pixel between them there.
     #[inline(always)]
     pub(crate) fn off_tile_over(&self, a_m: f32, b_m: f32) -> bool {
-        let (da, db) = (a_m - self.a_m, b_m - self.a_m);
-        let (ra, rb) = (
-            self.row + self.row_per_m * da,
-            self.row + self.row_per_m * db,
-        );
-        let (ca, cb) = (
-            self.col + self.col_per_m * da,
-            self.col + self.col_per_m * db,
-        );
-        let (r_lo, r_hi) = if ra < rb { (ra, rb) } else { (rb, ra) };
-        let (c_lo, c_hi) = if ca < cb { (ca, cb) } else { (cb, ca) };
+        let [r_lo, r_hi, c_lo, c_hi] = self.spans(a_m, b_m);
         r_hi + self.row_margin < 0.0
             || r_lo - self.row_margin > self.last_row
             || c_hi + self.col_margin < 0.0
