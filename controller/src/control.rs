@@ -68,16 +68,9 @@ pub struct SegmentOutput {
 /// blank session clears it at once (built from `default()` in place, it was a store
 /// per field of each slot: docs/target.md, flash).
 const NO_OUTPUTS: [SegmentOutput; MAX_SEGMENTS] = [SegmentOutput {
-    index: 0,
-    ticks: 0,
     worst_mismatch: 0.0,
-    mtf: 0.0,
-    max_stages: 0,
-    drift_rad: 0.0,
-    worst_drift_rad: 0.0,
-    residual_drift_rad: 0.0,
-    reversed: false,
     held: false,
+    ..SegmentOutput::no_period(0)
 }; MAX_SEGMENTS];
 
 impl SegmentOutput {
