@@ -42,6 +42,19 @@ pub const TURN_ARCSEC: f64 = 1_296_000.0;
 /// Days in a Julian century (SOFA's `DJC`).
 pub const DAYS_PER_JULIAN_CENTURY: f64 = 36_525.0;
 
+/// c0 + (c1 + (c2 + (c3 + (c4 + c5 t) t) t) t) t: SOFA's nesting of its polynomials in
+/// t, the same operations in the same order (so the same bits). Out of line: the
+/// precession angles, the obliquity and s each held a copy of the soft-float chain
+/// (docs/target.md, flash).
+#[inline(never)]
+pub(crate) fn poly5(t: f64, c: &[f64; 6]) -> f64 {
+    let mut acc = c[5];
+    for ck in c[..5].iter().rev() {
+        acc = ck + acc * t;
+    }
+    acc
+}
+
 /// x mod y with the sign of x, as C's `fmod`, for finite x and finite y > 0 (NaN
 /// otherwise): exact, so equal to `libm::fmod` wherever that is defined, but without
 /// its panic paths (libm 0.2.16's generic `fmod` keeps a division-by-zero panic that
