@@ -167,27 +167,27 @@ struct Curvature {
 }
 
 impl Curvature {
-    fn new(scene: &Scene, spec: &SegmentSpec) -> Result<Curvature, Fault> {
+    /// `spec`'s probe pixels, nothing observed yet, written into `slot` (in place: a
+    /// curvature is 300 bytes). On an error `slot` holds a part-built one.
+    // Out of line: inlined into the plan build, it and its copies took more flash.
+    #[inline(never)]
+    fn start(slot: &mut Option<Curvature>, scene: &Scene, spec: &SegmentSpec) -> Result<(), Fault> {
         let camera = scene.earth_camera(spec);
         let width = f64::from(spec.last_px) - f64::from(spec.first_px);
         let spacing_px = width / (PROBES - 1) as f64;
-        let pixel = |j: usize| {
-            let n = f64::from(spec.first_px) + spacing_px * j as f64;
-            GENERAL_F32
-                .pixel(&camera, n)
-                .map_err(|_| Fault::InvalidScene)
-        };
-        let first = pixel(0)?;
-        let mut pixels = [first; PROBES];
-        for (j, p) in pixels.iter_mut().enumerate().skip(1) {
-            *p = pixel(j)?;
-        }
-        Ok(Curvature {
-            pixels,
+        let c = slot.insert(Curvature {
+            pixels: [BLANK_PIXEL; PROBES],
             spacing_px,
             c: 0.0,
             v_min: f64::INFINITY,
-        })
+        });
+        for (j, p) in c.pixels.iter_mut().enumerate() {
+            let n = f64::from(spec.first_px) + spacing_px * j as f64;
+            *p = GENERAL_F32
+                .pixel(&camera, n)
+                .map_err(|_| Fault::InvalidScene)?;
+        }
+        Ok(())
     }
 
     fn observe(&mut self, u: &GeneralUpdate<f32>) {
@@ -273,7 +273,7 @@ impl Plan {
         let mut curvatures: [Option<Curvature>; MAX_SEGMENTS] = [None; MAX_SEGMENTS];
         for (slot, spec) in curvatures.iter_mut().zip(scene.table()) {
             if exhaustive || spec.active {
-                *slot = Some(Curvature::new(scene, spec)?);
+                Curvature::start(slot, scene, spec)?;
             }
         }
         for_each_probe(&scene.envelope, config, |u| {
