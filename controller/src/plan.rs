@@ -303,10 +303,7 @@ impl Plan {
                 .result()?;
             let c = CURVATURE_SAFETY * c;
             let width = f64::from(spec.last_px) - f64::from(spec.first_px);
-            let error = |k: usize| {
-                let spacing = width / (k - 1) as f64;
-                c * spacing * spacing / 8.0
-            };
+            let error = |k: usize| interpolation_error(c, width, k);
             // Smallest K >= 2 with c (width / (K - 1))^2 / 8 <= budget x v_min.
             let mut k = if exhaustive { MAX_SAMPLES } else { 2usize };
             while k < MAX_SAMPLES && error(k) > budget * v_min {
@@ -398,6 +395,15 @@ impl Plan {
     pub fn active(&self) -> &[SegmentPlan] {
         &self.segments
     }
+}
+
+/// How far v1 may leave the samples' range between `k` samples equally spaced over
+/// `width` pixels, with |v1''| at most `c` per pixel^2: c (width / (k - 1))^2 / 8.
+// Out of line: the plan's search over k was unrolled, a copy of it for each k.
+#[inline(never)]
+fn interpolation_error(c: f64, width: f64, k: usize) -> f64 {
+    let spacing = width / (k - 1) as f64;
+    c * spacing * spacing / 8.0
 }
 
 /// Largest speed/circular-speed ratio squared a NAV state may have, |v|^2 |r| / mu:
