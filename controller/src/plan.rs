@@ -205,7 +205,7 @@ impl Curvature {
         let h = self.spacing_px;
         if h > 0.0 {
             for w in v.windows(3) {
-                self.c = self.c.max(libm::fabs(w[0] - 2.0 * w[1] + w[2]) / (h * h));
+                self.c = max_second_difference(self.c, [w[0], w[1], w[2]], h);
             }
         }
     }
@@ -395,6 +395,15 @@ impl Plan {
     pub fn active(&self) -> &[SegmentPlan] {
         &self.segments
     }
+}
+
+/// The larger of `c` and |a - 2 b + d| / h^2, the second difference of three values h
+/// pixels apart (per pixel^2).
+// Out of line: the probe's loop over its seven windows was unrolled, a soft-float
+// copy of this in each.
+#[inline(never)]
+fn max_second_difference(c: f64, [a, b, d]: [f64; 3], h: f64) -> f64 {
+    c.max(libm::fabs(a - 2.0 * b + d) / (h * h))
 }
 
 /// How far v1 may leave the samples' range between `k` samples equally spaced over
