@@ -99,12 +99,19 @@ pub fn pole_for(
 /// The quaternion's own check, before any blend: its norm within 1e-3 of one
 /// (`bad_quaternion`), finite (`non_finite`).
 pub fn check_quaternion(a: &StarAttitude) -> Result<(), Fault> {
-    quaternion_matrix(a.q.map(f64::from), Param::Quaternion)
-        .map(|_| ())
-        .map_err(|e| match e {
-            ModelError::NonFinite(_) => Fault::NonFinite,
-            _ => Fault::BadQuaternion,
-        })
+    rotation(&a.q, Param::Quaternion).map(|_| ())
+}
+
+/// R(q) of an f32 quaternion (`param` the attitude's or the mounting's), with the
+/// frame's refusals: `non_finite`, `bad_quaternion` for a norm off by more than 1e-3.
+// Out of line: the check and the derivation's two held a copy each (docs/target.md,
+// flash).
+#[inline(never)]
+fn rotation(q: &[f32; 4], param: Param) -> Result<[[f64; 3]; 3], Fault> {
+    quaternion_matrix(q.map(f64::from), param).map_err(|e| match e {
+        ModelError::NonFinite(_) => Fault::NonFinite,
+        _ => Fault::BadQuaternion,
+    })
 }
 
 impl AttitudeState {
@@ -118,14 +125,8 @@ impl AttitudeState {
         scales: &TimeScales,
         orbit: Option<&GnssState>,
     ) -> Result<AttitudeState, Fault> {
-        let quaternion = |q: &[f32; 4], p: Param| {
-            quaternion_matrix(q.map(f64::from), p).map_err(|e| match e {
-                ModelError::NonFinite(_) => Fault::NonFinite,
-                _ => Fault::BadQuaternion,
-            })
-        };
-        let body = quaternion(&a.q, Param::Quaternion)?;
-        let mount = quaternion(mounting_q, Param::CameraQuaternion)?;
+        let body = rotation(&a.q, Param::Quaternion)?;
+        let mount = rotation(mounting_q, Param::CameraQuaternion)?;
         let c2t = pole
             .c2t(gps_s(a.valid_us), scales)
             .map_err(|_| Fault::FixTime)?;
