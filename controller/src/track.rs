@@ -27,7 +27,9 @@
 //! ERA's own rate differs from `w` by 1e-8 of it, 1.5e-12 rad). No trigonometry.
 
 use core_math::earth::bus::quaternion_matrix;
-use core_math::earth::frames::{mat_mul, CelestialPole, TimeScales, POLE_MAX_AGE_S};
+use core_math::earth::frames::{
+    mat_mul, row_times as row_times_f64, CelestialPole, TimeScales, POLE_MAX_AGE_S,
+};
 use core_math::earth::{GeneralInstant, InertialAttitude};
 use core_math::{ModelError, Param, StateVector, GENERAL_F32};
 
@@ -132,8 +134,7 @@ impl AttitudeState {
             .map_err(|_| Fault::FixTime)?;
         let b = mat_mul(&c2t, &mat_mul(&body, &mount));
         let w = a.body_rate_rad_s.map(f64::from);
-        let omega: [f64; 3] =
-            core::array::from_fn(|j| mount[0][j] * w[0] + mount[1][j] * w[1] + mount[2][j] * w[2]);
+        let omega = row_times_f64(&w, &mount);
         let (b, omega) = (b.map(|row| row.map(|x| x as f32)), omega.map(|x| x as f32));
         // The orbit's state in I at the time of validity: the fix's carried over the
         // fix's age dt (at most `gnss_stale_after`, 2 s) by r + v dt - mu r dt^2 / (2 r^3),

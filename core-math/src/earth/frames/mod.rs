@@ -29,7 +29,7 @@ pub use c2t::{
     c2t, c2t_from_cio, c2t_from_dates, CelestialPole, C2T_TOLERANCE_RAD, POLE_MAX_AGE_S,
 };
 pub use geodetic::{geodetic_from_itrf, itrf_from_geodetic};
-pub use rot::{mul as mat_mul, Mat3};
+pub use rot::{mul as mat_mul, row_times, Mat3};
 pub use time::{JulianDays, TimeScales};
 
 /// Arcseconds to radians (SOFA's `DAS2R`, 4.848136811095359935899141e-6, to the nearest

@@ -21,6 +21,11 @@ pub fn mul(a: &Mat3, b: &Mat3) -> Mat3 {
     m
 }
 
+/// The row `r` times `b` (r^T b): the same sums as [`mul`]'s rows.
+pub fn row_times(r: &[f64; 3], b: &Mat3) -> [f64; 3] {
+    core::array::from_fn(|j| row_dot_column(r, b, j))
+}
+
 /// Row `r` times column `j` of `b`, the same sum as [`dot`]. Out of line: inlined, the
 /// nine soft-float dot products were most of [`mul`]'s size (docs/target.md, flash),
 /// and no controller update multiplies matrices.
