@@ -135,7 +135,7 @@ impl AttitudeState {
         let b = mat_mul(&c2t, &mat_mul(&body, &mount));
         let w = a.body_rate_rad_s.map(f64::from);
         let omega = row_times_f64(&w, &mount);
-        let (b, omega) = (b.map(|row| row.map(|x| x as f32)), omega.map(|x| x as f32));
+        let (b, omega) = (rounded(&b), omega.map(|x| x as f32));
         // The orbit's state in I at the time of validity: the fix's carried over the
         // fix's age dt (at most `gnss_stale_after`, 2 s) by r + v dt - mu r dt^2 / (2 r^3),
         // v - mu r dt / r^3 (the next terms move the orbital frame's axes by below 1e-8
@@ -158,7 +158,7 @@ impl AttitudeState {
             let turn = |x: [f32; 3]| [x[0] + s * x[1], x[1] - s * x[0], x[2]];
             euler_accel(&b, omega, turn(r_t), turn(v_t))
         });
-        let m = mount.map(|row| row.map(|x| x as f32));
+        let m = rounded(&mount);
         Ok(AttitudeState {
             received: *a,
             camera_to_inertial: b,
@@ -205,6 +205,13 @@ impl AttitudeBlend {
             ..*new
         }
     }
+}
+
+/// A matrix rounded to f32.
+// Out of line: the derivation rounded two, each inlined.
+#[inline(never)]
+fn rounded(m: &[[f64; 3]; 3]) -> [[f32; 3]; 3] {
+    m.map(|row| row.map(|x| x as f32))
 }
 
 /// Hamilton product.
