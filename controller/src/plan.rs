@@ -181,11 +181,9 @@ impl Curvature {
             c: 0.0,
             v_min: f64::INFINITY,
         });
+        let first = f64::from(spec.first_px);
         for (j, p) in c.pixels.iter_mut().enumerate() {
-            let n = f64::from(spec.first_px) + spacing_px * j as f64;
-            *p = GENERAL_F32
-                .pixel(&camera, n)
-                .map_err(|_| Fault::InvalidScene)?;
+            probe_pixel(p, &camera, first, spacing_px, j)?;
         }
         Ok(())
     }
@@ -404,6 +402,23 @@ impl Plan {
 #[inline(never)]
 fn max_second_difference(c: f64, [a, b, d]: [f64; 3], h: f64) -> f64 {
     c.max(libm::fabs(a - 2.0 * b + d) / (h * h))
+}
+
+/// Probe pixel `j` into `p`: `first_px + spacing_px j` of `camera`.
+// Out of line: the probe loop was unrolled, each of its nine copies moving the pixel's
+// result three times.
+#[inline(never)]
+fn probe_pixel(
+    p: &mut GeneralPixel<f32>,
+    camera: &core_math::EarthCamera,
+    first_px: f64,
+    spacing_px: f64,
+    j: usize,
+) -> Result<(), Fault> {
+    *p = GENERAL_F32
+        .pixel(camera, first_px + spacing_px * j as f64)
+        .map_err(|_| Fault::InvalidScene)?;
+    Ok(())
 }
 
 /// How far v1 may leave the samples' range between `k` samples equally spaced over
