@@ -176,6 +176,17 @@ impl Scene {
         same_camera && chip(self).is_some() && chip(self) == chip(old)
     }
 
+    /// Clears `kept[k]` for each segment k whose output under `old` does not hold
+    /// under this scene ([`Scene::keeps_output_of`]).
+    // Out of line with its loop: inlined into the install, the loop was unrolled, a
+    // call and its test per segment (docs/target.md, flash).
+    #[inline(never)]
+    pub fn keep_outputs_of(&self, old: &Scene, kept: &mut [bool]) {
+        for (k, kept) in kept.iter_mut().enumerate() {
+            *kept = *kept && self.keeps_output_of(old, k);
+        }
+    }
+
     /// The table's entries (active or not).
     pub fn table(&self) -> &[SegmentSpec] {
         &self.segments[..usize::from(self.count).min(MAX_SEGMENTS)]
