@@ -87,14 +87,23 @@ fn rem_trunc(x: f64, y: f64) -> (f64, bool) {
         }
         while s >= y {
             // The last step, s = y, is the quotient's lowest bit.
-            odd = r >= s;
-            if odd {
-                r -= s;
-            }
+            (r, odd) = take_away(r, s);
             s *= 0.5;
         }
     }
     (libm::copysign(r, x), odd)
+}
+
+/// One step of [`rem_trunc`]'s long division: r - s and true if s <= r, else r and
+/// false. Out of line: a call in the loop keeps LLVM from unrolling it (four soft-float
+/// copies of the step before: docs/target.md, flash).
+#[inline(never)]
+fn take_away(r: f64, s: f64) -> (f64, bool) {
+    if r >= s {
+        (r - s, true)
+    } else {
+        (r, false)
+    }
 }
 
 /// x - n y with n the integer nearest x / y, ties to even, as IEEE 754's (and C's)
