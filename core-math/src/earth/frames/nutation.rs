@@ -193,9 +193,15 @@ fn fundamental_argument(t: f64, c0: f64, c1: f64) -> f64 {
 pub(crate) fn argument(n: &[i8; 5], fa: &[f64; 5]) -> f64 {
     let mut a = 0.0;
     for (k, x) in n.iter().zip(fa.iter()) {
-        a += f64::from(*k) * x;
+        a = plus_multiple(a, *k, *x);
     }
     super::fmod(a, TWO_PI)
+}
+
+/// a + k x. Out of line: [`argument`]'s five steps were a soft-float copy each.
+#[inline(never)]
+fn plus_multiple(a: f64, k: i8, x: f64) -> f64 {
+    a + f64::from(k) * x
 }
 
 /// Nutation in longitude and obliquity (dpsi, deps) (rad), IAU 2000B, at `t` Julian
