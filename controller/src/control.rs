@@ -248,9 +248,7 @@ impl Controller {
     /// ([`SegmentOutput::no_period`]).
     fn install(&mut self, scene: Scene) {
         core::mem::swap(&mut self.plan, &mut self.spare_plan);
-        for (k, kept) in self.has_output.iter_mut().enumerate() {
-            *kept = *kept && scene.keeps_output_of(&self.scene, k);
-        }
+        scene.keep_outputs_of(&self.scene, &mut self.has_output);
         self.heights_m = scene.segments.map(|s| s.ground_h_m);
         let remount = scene.mounting_q != self.scene.mounting_q;
         self.scene = scene;

@@ -119,21 +119,28 @@ impl Propagator {
         // a = -mu r / |r|^3; j = da/dt = -mu (v - 3 (r.v / |r|^2) r) / |r|^3.
         let mu_r3 = GM_M3_S2 / (r2 * rn);
         let rv_r2 = (r[0] * v[0] + r[1] * v[1] + r[2] * v[2]) / r2;
-        let hi = |x: f64| x as f32;
-        let lo = |x: f64| (x - f64::from(x as f32)) as f32;
         let a_m = crate::EARTH.a_m;
-        Propagator {
+        let mut p = Propagator {
             state: *state,
-            position_hi_m: r.map(hi),
-            position_lo_m: r.map(lo),
-            velocity_hi_mps: v.map(hi),
-            velocity_lo_mps: v.map(lo),
+            position_hi_m: [0.0; 3],
+            position_lo_m: [0.0; 3],
+            velocity_hi_mps: [0.0; 3],
+            velocity_lo_mps: [0.0; 3],
             r2_minus_a2_m2: (r2 - a_m * a_m) as f32,
-            half_accel_mps2: r.map(|x| (-0.5 * mu_r3 * x) as f32),
-            sixth_jerk_mps3: core::array::from_fn(|k| {
-                (-mu_r3 * (v[k] - 3.0 * rv_r2 * r[k]) / 6.0) as f32
-            }),
+            half_accel_mps2: [0.0; 3],
+            sixth_jerk_mps3: [0.0; 3],
+        };
+        for k in 0..3 {
+            [
+                p.position_hi_m[k],
+                p.position_lo_m[k],
+                p.velocity_hi_mps[k],
+                p.velocity_lo_mps[k],
+                p.half_accel_mps2[k],
+                p.sixth_jerk_mps3[k],
+            ] = axis_terms(r[k], v[k], mu_r3, rv_r2);
         }
+        p
     }
 
     /// The series' increments of position and velocity `dt_s` after the NAV instant,
@@ -178,6 +185,24 @@ impl Propagator {
             r2_minus_a2_m2: self.r2_minus_a2_m2 + grow,
         }
     }
+}
+
+/// One axis of a [`Propagator`] from its r and v (m, m/s), mu / |r|^3 and
+/// r.v / |r|^2: r and v as f32 pairs (value, remainder), a / 2 and j / 6 (m/s^2,
+/// m/s^3).
+// Out of line: the three axes were unrolled, a soft-float copy for each.
+#[inline(never)]
+fn axis_terms(r: f64, v: f64, mu_r3: f64, rv_r2: f64) -> [f32; 6] {
+    let hi = |x: f64| x as f32;
+    let lo = |x: f64| (x - f64::from(x as f32)) as f32;
+    [
+        hi(r),
+        lo(r),
+        hi(v),
+        lo(v),
+        (-0.5 * mu_r3 * r) as f32,
+        (-mu_r3 * (v - 3.0 * rv_r2 * r) / 6.0) as f32,
+    ]
 }
 
 /// The attitude `dt_s` after its NAV instant: each angle at its own rate.

@@ -167,27 +167,25 @@ struct Curvature {
 }
 
 impl Curvature {
-    fn new(scene: &Scene, spec: &SegmentSpec) -> Result<Curvature, Fault> {
+    /// `spec`'s probe pixels, nothing observed yet, written into `slot` (in place: a
+    /// curvature is 300 bytes). On an error `slot` holds a part-built one.
+    // Out of line: inlined into the plan build, it and its copies took more flash.
+    #[inline(never)]
+    fn start(slot: &mut Option<Curvature>, scene: &Scene, spec: &SegmentSpec) -> Result<(), Fault> {
         let camera = scene.earth_camera(spec);
         let width = f64::from(spec.last_px) - f64::from(spec.first_px);
         let spacing_px = width / (PROBES - 1) as f64;
-        let pixel = |j: usize| {
-            let n = f64::from(spec.first_px) + spacing_px * j as f64;
-            GENERAL_F32
-                .pixel(&camera, n)
-                .map_err(|_| Fault::InvalidScene)
-        };
-        let first = pixel(0)?;
-        let mut pixels = [first; PROBES];
-        for (j, p) in pixels.iter_mut().enumerate().skip(1) {
-            *p = pixel(j)?;
-        }
-        Ok(Curvature {
-            pixels,
+        let c = slot.insert(Curvature {
+            pixels: [BLANK_PIXEL; PROBES],
             spacing_px,
             c: 0.0,
             v_min: f64::INFINITY,
-        })
+        });
+        let first = f64::from(spec.first_px);
+        for (j, p) in c.pixels.iter_mut().enumerate() {
+            probe_pixel(p, &camera, first, spacing_px, j)?;
+        }
+        Ok(())
     }
 
     fn observe(&mut self, u: &GeneralUpdate<f32>) {
@@ -205,7 +203,7 @@ impl Curvature {
         let h = self.spacing_px;
         if h > 0.0 {
             for w in v.windows(3) {
-                self.c = self.c.max(libm::fabs(w[0] - 2.0 * w[1] + w[2]) / (h * h));
+                self.c = max_second_difference(self.c, [w[0], w[1], w[2]], h);
             }
         }
     }
@@ -273,7 +271,7 @@ impl Plan {
         let mut curvatures: [Option<Curvature>; MAX_SEGMENTS] = [None; MAX_SEGMENTS];
         for (slot, spec) in curvatures.iter_mut().zip(scene.table()) {
             if exhaustive || spec.active {
-                *slot = Some(Curvature::new(scene, spec)?);
+                Curvature::start(slot, scene, spec)?;
             }
         }
         for_each_probe(&scene.envelope, config, |u| {
@@ -303,10 +301,7 @@ impl Plan {
                 .result()?;
             let c = CURVATURE_SAFETY * c;
             let width = f64::from(spec.last_px) - f64::from(spec.first_px);
-            let error = |k: usize| {
-                let spacing = width / (k - 1) as f64;
-                c * spacing * spacing / 8.0
-            };
+            let error = |k: usize| interpolation_error(c, width, k);
             // Smallest K >= 2 with c (width / (K - 1))^2 / 8 <= budget x v_min.
             let mut k = if exhaustive { MAX_SAMPLES } else { 2usize };
             while k < MAX_SAMPLES && error(k) > budget * v_min {
@@ -398,6 +393,41 @@ impl Plan {
     pub fn active(&self) -> &[SegmentPlan] {
         &self.segments
     }
+}
+
+/// The larger of `c` and |a - 2 b + d| / h^2, the second difference of three values h
+/// pixels apart (per pixel^2).
+// Out of line: the probe's loop over its seven windows was unrolled, a soft-float
+// copy of this in each.
+#[inline(never)]
+fn max_second_difference(c: f64, [a, b, d]: [f64; 3], h: f64) -> f64 {
+    c.max(libm::fabs(a - 2.0 * b + d) / (h * h))
+}
+
+/// Probe pixel `j` into `p`: `first_px + spacing_px j` of `camera`.
+// Out of line: the probe loop was unrolled, each of its nine copies moving the pixel's
+// result three times.
+#[inline(never)]
+fn probe_pixel(
+    p: &mut GeneralPixel<f32>,
+    camera: &core_math::EarthCamera,
+    first_px: f64,
+    spacing_px: f64,
+    j: usize,
+) -> Result<(), Fault> {
+    *p = GENERAL_F32
+        .pixel(camera, first_px + spacing_px * j as f64)
+        .map_err(|_| Fault::InvalidScene)?;
+    Ok(())
+}
+
+/// How far v1 may leave the samples' range between `k` samples equally spaced over
+/// `width` pixels, with |v1''| at most `c` per pixel^2: c (width / (k - 1))^2 / 8.
+// Out of line: the plan's search over k was unrolled, a copy of it for each k.
+#[inline(never)]
+fn interpolation_error(c: f64, width: f64, k: usize) -> f64 {
+    let spacing = width / (k - 1) as f64;
+    c * spacing * spacing / 8.0
 }
 
 /// Largest speed/circular-speed ratio squared a NAV state may have, |v|^2 |r| / mu:

@@ -89,6 +89,22 @@ pub struct Scene {
     pub mounting_q: [f32; 4],
 }
 
+/// Pixel `n` of `camera` looks inside the limb whose tangent (off the optical axis) is
+/// `tan_limb`; refused (`invalid_scene`) otherwise or if the pixel is off its optics'
+/// domain.
+// Out of line: the scene's check of each segment's two ends held a copy each.
+#[inline(never)]
+fn inside_limb(camera: &EarthCamera, n: i32, tan_limb: f64) -> Result<(), Fault> {
+    let (p1, p2) = camera
+        .focal_plane_m(f64::from(n))
+        .map_err(|_| Fault::InvalidScene)?;
+    let tan_off_axis = core_math::sqrt_f64(p1 * p1 + p2 * p2) / camera.focal_m;
+    if !(tan_off_axis < tan_limb) {
+        return Err(Fault::InvalidScene);
+    }
+    Ok(())
+}
+
 impl Scene {
     /// The paper's camera: f 555 mm, 13 um pixels, 60 000 pixels as 10 chips of 6 000
     /// on one line (no stagger), all active, 16 TDI stages, MTF floor 0.95, a 10 MHz line
@@ -160,6 +176,17 @@ impl Scene {
         same_camera && chip(self).is_some() && chip(self) == chip(old)
     }
 
+    /// Clears `kept[k]` for each segment k whose output under `old` does not hold
+    /// under this scene ([`Scene::keeps_output_of`]).
+    // Out of line with its loop: inlined into the install, the loop was unrolled, a
+    // call and its test per segment (docs/target.md, flash).
+    #[inline(never)]
+    pub fn keep_outputs_of(&self, old: &Scene, kept: &mut [bool]) {
+        for (k, kept) in kept.iter_mut().enumerate() {
+            *kept = *kept && self.keeps_output_of(old, k);
+        }
+    }
+
     /// The table's entries (active or not).
     pub fn table(&self) -> &[SegmentSpec] {
         &self.segments[..usize::from(self.count).min(MAX_SEGMENTS)]
@@ -228,14 +255,7 @@ impl Scene {
             }
             previous_last = Some(s.last_px);
             for n in [s.first_px, s.last_px] {
-                let camera = self.earth_camera(s);
-                let (p1, p2) = camera
-                    .focal_plane_m(f64::from(n))
-                    .map_err(|_| Fault::InvalidScene)?;
-                let tan_off_axis = core_math::sqrt_f64(p1 * p1 + p2 * p2) / f;
-                if !(tan_off_axis < tan_limb) {
-                    return Err(Fault::InvalidScene);
-                }
+                inside_limb(&self.earth_camera(s), n, tan_limb)?;
             }
         }
         Ok(())

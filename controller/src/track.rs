@@ -27,7 +27,9 @@
 //! ERA's own rate differs from `w` by 1e-8 of it, 1.5e-12 rad). No trigonometry.
 
 use core_math::earth::bus::quaternion_matrix;
-use core_math::earth::frames::{mat_mul, CelestialPole, TimeScales, POLE_MAX_AGE_S};
+use core_math::earth::frames::{
+    mat_mul, row_times as row_times_f64, CelestialPole, TimeScales, POLE_MAX_AGE_S,
+};
 use core_math::earth::{GeneralInstant, InertialAttitude};
 use core_math::{ModelError, Param, StateVector, GENERAL_F32};
 
@@ -99,12 +101,19 @@ pub fn pole_for(
 /// The quaternion's own check, before any blend: its norm within 1e-3 of one
 /// (`bad_quaternion`), finite (`non_finite`).
 pub fn check_quaternion(a: &StarAttitude) -> Result<(), Fault> {
-    quaternion_matrix(a.q.map(f64::from), Param::Quaternion)
-        .map(|_| ())
-        .map_err(|e| match e {
-            ModelError::NonFinite(_) => Fault::NonFinite,
-            _ => Fault::BadQuaternion,
-        })
+    rotation(&a.q, Param::Quaternion).map(|_| ())
+}
+
+/// R(q) of an f32 quaternion (`param` the attitude's or the mounting's), with the
+/// frame's refusals: `non_finite`, `bad_quaternion` for a norm off by more than 1e-3.
+// Out of line: the check and the derivation's two held a copy each (docs/target.md,
+// flash).
+#[inline(never)]
+fn rotation(q: &[f32; 4], param: Param) -> Result<[[f64; 3]; 3], Fault> {
+    quaternion_matrix(q.map(f64::from), param).map_err(|e| match e {
+        ModelError::NonFinite(_) => Fault::NonFinite,
+        _ => Fault::BadQuaternion,
+    })
 }
 
 impl AttitudeState {
@@ -118,22 +127,15 @@ impl AttitudeState {
         scales: &TimeScales,
         orbit: Option<&GnssState>,
     ) -> Result<AttitudeState, Fault> {
-        let quaternion = |q: &[f32; 4], p: Param| {
-            quaternion_matrix(q.map(f64::from), p).map_err(|e| match e {
-                ModelError::NonFinite(_) => Fault::NonFinite,
-                _ => Fault::BadQuaternion,
-            })
-        };
-        let body = quaternion(&a.q, Param::Quaternion)?;
-        let mount = quaternion(mounting_q, Param::CameraQuaternion)?;
+        let body = rotation(&a.q, Param::Quaternion)?;
+        let mount = rotation(mounting_q, Param::CameraQuaternion)?;
         let c2t = pole
             .c2t(gps_s(a.valid_us), scales)
             .map_err(|_| Fault::FixTime)?;
         let b = mat_mul(&c2t, &mat_mul(&body, &mount));
         let w = a.body_rate_rad_s.map(f64::from);
-        let omega: [f64; 3] =
-            core::array::from_fn(|j| mount[0][j] * w[0] + mount[1][j] * w[1] + mount[2][j] * w[2]);
-        let (b, omega) = (b.map(|row| row.map(|x| x as f32)), omega.map(|x| x as f32));
+        let omega = row_times_f64(&w, &mount);
+        let (b, omega) = (rounded(&b), omega.map(|x| x as f32));
         // The orbit's state in I at the time of validity: the fix's carried over the
         // fix's age dt (at most `gnss_stale_after`, 2 s) by r + v dt - mu r dt^2 / (2 r^3),
         // v - mu r dt / r^3 (the next terms move the orbital frame's axes by below 1e-8
@@ -156,7 +158,7 @@ impl AttitudeState {
             let turn = |x: [f32; 3]| [x[0] + s * x[1], x[1] - s * x[0], x[2]];
             euler_accel(&b, omega, turn(r_t), turn(v_t))
         });
-        let m = mount.map(|row| row.map(|x| x as f32));
+        let m = rounded(&mount);
         Ok(AttitudeState {
             received: *a,
             camera_to_inertial: b,
@@ -203,6 +205,13 @@ impl AttitudeBlend {
             ..*new
         }
     }
+}
+
+/// A matrix rounded to f32.
+// Out of line: the derivation rounded two, each inlined.
+#[inline(never)]
+fn rounded(m: &[[f64; 3]; 3]) -> [[f32; 3]; 3] {
+    m.map(|row| row.map(|x| x as f32))
 }
 
 /// Hamilton product.

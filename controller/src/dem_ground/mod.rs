@@ -198,14 +198,10 @@ impl DemGround {
         let lat_c = (g.lat0_deg + 0.5 * rows * g.dlat_deg).to_radians();
         let lon_c = (g.lon0_deg + 0.5 * cols * g.dlon_deg).to_radians();
         let (min_m, max_m) = tile.height_range_m();
-        let (sl, cl) = (
-            core_math::trig_f64::sin(lat_c),
-            core_math::trig_f64::cos(lat_c),
-        );
-        let (so, co) = (
-            core_math::trig_f64::sin(lon_c),
-            core_math::trig_f64::cos(lon_c),
-        );
+        // One sin_cos each (the same bits as `sin` and `cos` apart, which the flight
+        // binary then does not link: docs/target.md, flash).
+        let (sl, cl) = core_math::trig_f64::sin_cos(lat_c);
+        let (so, co) = core_math::trig_f64::sin_cos(lon_c);
         let f = EARTH.flattening;
         let e2 = f * (2.0 - f);
         let w = libm::sqrt(1.0 - e2 * sl * sl);

@@ -37,7 +37,6 @@ pub fn s06(t: f64, x: f64, y: f64) -> f64 {
     // `iauS06`'s t^0 terms 1 and 2 and its t^2 term 1 (microarcseconds).
     let w0 = SP[0] + (-2640.73 * s1 + 0.39 * c1) + (-63.53 * s2 + 0.02 * c2);
     let w2 = SP[2] + (743.52 * s1 - 0.17 * c1);
-    let (w1, w3, w4, w5) = (SP[1], SP[3], SP[4], SP[5]);
-    (w0 + (w1 + (w2 + (w3 + (w4 + w5 * t) * t) * t) * t) * t) * (ARCSEC_TO_RAD * 1.0e-6)
-        - x * y / 2.0
+    let w = [w0, SP[1], w2, SP[3], SP[4], SP[5]];
+    super::poly5(t, &w) * (ARCSEC_TO_RAD * 1.0e-6) - x * y / 2.0
 }

@@ -16,42 +16,54 @@ pub struct FwAngles {
     pub epsa_rad: f64,
 }
 
+/// The angles' polynomials in t (arcseconds, t^0..t^5), as `iauObl06` and `iauPfw06`
+/// state them.
+const OBL06: [f64; 6] = [
+    84_381.406,
+    -46.836_769,
+    -0.000_183_1,
+    0.002_003_40,
+    -0.000_000_576,
+    -0.000_000_043_4,
+];
+const GAMB: [f64; 6] = [
+    -0.052_928,
+    10.556_378,
+    0.493_204_4,
+    -0.000_312_38,
+    -0.000_002_788,
+    0.000_000_026_0,
+];
+const PHIB: [f64; 6] = [
+    84_381.412_819,
+    -46.811_016,
+    0.051_126_8,
+    0.000_532_89,
+    -0.000_000_440,
+    -0.000_000_017_6,
+];
+const PSIB: [f64; 6] = [
+    -0.041_775,
+    5_038.481_484,
+    1.558_417_5,
+    -0.000_185_22,
+    -0.000_026_452,
+    -0.000_000_014_8,
+];
+
 /// Mean obliquity of the ecliptic, IAU 2006 (rad), at `t` Julian centuries TT since
 /// J2000.0 (SOFA `iauObl06`).
 pub fn obl06(t: f64) -> f64 {
-    (84_381.406
-        + (-46.836_769
-            + (-0.000_183_1 + (0.002_003_40 + (-0.000_000_576 + (-0.000_000_043_4) * t) * t) * t)
-                * t)
-            * t)
-        * ARCSEC_TO_RAD
+    super::poly5(t, &OBL06) * ARCSEC_TO_RAD
 }
 
 /// The P03 bias-precession angles at `t` Julian centuries TT since J2000.0 (SOFA
 /// `iauPfw06`).
 pub fn pfw06(t: f64) -> FwAngles {
-    let gamb = (-0.052_928
-        + (10.556_378
-            + (0.493_204_4 + (-0.000_312_38 + (-0.000_002_788 + (0.000_000_026_0) * t) * t) * t)
-                * t)
-            * t)
-        * ARCSEC_TO_RAD;
-    let phib = (84_381.412_819
-        + (-46.811_016
-            + (0.051_126_8 + (0.000_532_89 + (-0.000_000_440 + (-0.000_000_017_6) * t) * t) * t)
-                * t)
-            * t)
-        * ARCSEC_TO_RAD;
-    let psib = (-0.041_775
-        + (5_038.481_484
-            + (1.558_417_5 + (-0.000_185_22 + (-0.000_026_452 + (-0.000_000_014_8) * t) * t) * t)
-                * t)
-            * t)
-        * ARCSEC_TO_RAD;
     FwAngles {
-        gamb_rad: gamb,
-        phib_rad: phib,
-        psib_rad: psib,
+        gamb_rad: super::poly5(t, &GAMB) * ARCSEC_TO_RAD,
+        phib_rad: super::poly5(t, &PHIB) * ARCSEC_TO_RAD,
+        psib_rad: super::poly5(t, &PSIB) * ARCSEC_TO_RAD,
         epsa_rad: obl06(t),
     }
 }

@@ -29,7 +29,7 @@ pub use c2t::{
     c2t, c2t_from_cio, c2t_from_dates, CelestialPole, C2T_TOLERANCE_RAD, POLE_MAX_AGE_S,
 };
 pub use geodetic::{geodetic_from_itrf, itrf_from_geodetic};
-pub use rot::{mul as mat_mul, Mat3};
+pub use rot::{mul as mat_mul, row_times, Mat3};
 pub use time::{JulianDays, TimeScales};
 
 /// Arcseconds to radians (SOFA's `DAS2R`, 4.848136811095359935899141e-6, to the nearest
@@ -41,6 +41,19 @@ pub const TWO_PI: f64 = core::f64::consts::TAU;
 pub const TURN_ARCSEC: f64 = 1_296_000.0;
 /// Days in a Julian century (SOFA's `DJC`).
 pub const DAYS_PER_JULIAN_CENTURY: f64 = 36_525.0;
+
+/// c0 + (c1 + (c2 + (c3 + (c4 + c5 t) t) t) t) t: SOFA's nesting of its polynomials in
+/// t, the same operations in the same order (so the same bits). Out of line: the
+/// precession angles, the obliquity and s each held a copy of the soft-float chain
+/// (docs/target.md, flash).
+#[inline(never)]
+pub(crate) fn poly5(t: f64, c: &[f64; 6]) -> f64 {
+    let mut acc = c[5];
+    for ck in c[..5].iter().rev() {
+        acc = ck + acc * t;
+    }
+    acc
+}
 
 /// x mod y with the sign of x, as C's `fmod`, for finite x and finite y > 0 (NaN
 /// otherwise): exact, so equal to `libm::fmod` wherever that is defined, but without
@@ -74,14 +87,23 @@ fn rem_trunc(x: f64, y: f64) -> (f64, bool) {
         }
         while s >= y {
             // The last step, s = y, is the quotient's lowest bit.
-            odd = r >= s;
-            if odd {
-                r -= s;
-            }
+            (r, odd) = take_away(r, s);
             s *= 0.5;
         }
     }
     (libm::copysign(r, x), odd)
+}
+
+/// One step of [`rem_trunc`]'s long division: r - s and true if s <= r, else r and
+/// false. Out of line: a call in the loop keeps LLVM from unrolling it (four soft-float
+/// copies of the step before: docs/target.md, flash).
+#[inline(never)]
+fn take_away(r: f64, s: f64) -> (f64, bool) {
+    if r >= s {
+        (r - s, true)
+    } else {
+        (r, false)
+    }
 }
 
 /// x - n y with n the integer nearest x / y, ties to even, as IEEE 754's (and C's)

@@ -167,7 +167,7 @@ fn unpack(m: u16, [c0, c3]: [i32; 2], [c1, c2, d0, d1]: [i16; 4]) -> Term {
 /// The five Delaunay arguments l, l', F, D, Om (rad) at `t` Julian centuries TT since
 /// J2000.0, linear in t (Simon et al. 1994), as `iauNut00b` computes them.
 pub fn delaunay(t: f64) -> [f64; 5] {
-    let arg = |c0: f64, c1: f64| super::fmod(c0 + c1 * t, TURN_ARCSEC) * ARCSEC_TO_RAD;
+    let arg = |c0: f64, c1: f64| fundamental_argument(t, c0, c1);
     [
         // Mean anomaly of the Moon.
         arg(485_868.249_036, 1_717_915_923.217_8),
@@ -182,13 +182,26 @@ pub fn delaunay(t: f64) -> [f64; 5] {
     ]
 }
 
+/// c0 + c1 t arcseconds reduced to one turn, in radians: one Delaunay argument.
+// Out of line: the five arguments held a soft-float copy each (docs/target.md, flash).
+#[inline(never)]
+fn fundamental_argument(t: f64, c0: f64, c1: f64) -> f64 {
+    super::fmod(c0 + c1 * t, TURN_ARCSEC) * ARCSEC_TO_RAD
+}
+
 /// The argument sum n . fa of a term, reduced to (-2 pi, 2 pi).
 pub(crate) fn argument(n: &[i8; 5], fa: &[f64; 5]) -> f64 {
     let mut a = 0.0;
     for (k, x) in n.iter().zip(fa.iter()) {
-        a += f64::from(*k) * x;
+        a = plus_multiple(a, *k, *x);
     }
     super::fmod(a, TWO_PI)
+}
+
+/// a + k x. Out of line: [`argument`]'s five steps were a soft-float copy each.
+#[inline(never)]
+fn plus_multiple(a: f64, k: i8, x: f64) -> f64 {
+    a + f64::from(k) * x
 }
 
 /// Nutation in longitude and obliquity (dpsi, deps) (rad), IAU 2000B, at `t` Julian

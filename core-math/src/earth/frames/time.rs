@@ -120,6 +120,9 @@ pub fn check_gps_s(gps_s: f64) -> Result<(), ModelError> {
 /// which the offset makes the date: 51.184 s for TT, UT1 - GPS for UT1). `gps_s` is split
 /// exactly into whole days and seconds of the day (fmod is exact, and so is the
 /// subtraction), so the offset and the half day move the small part only.
+// Out of line: the pole's TT and the ATTITUDE frame's UT1 each inlined it
+// (docs/target.md, flash).
+#[inline(never)]
 fn split_days(gps_s: f64, offset_s: f64) -> JulianDays {
     let sec_of_day = super::fmod(gps_s, DAY_S);
     let whole = (gps_s - sec_of_day) / DAY_S;
