@@ -145,6 +145,12 @@ struct Flight {
     /// without it.
     drift_dem_rad: f64,
     drift_terrain_rad: f64,
+    /// Every tenth update: the segments whose reported worst mismatch falls short of
+    /// the programmed period's worst over every 100th pixel on the DEM reference, of
+    /// those checked; the largest shortfall (relative mismatch).
+    bound_short: usize,
+    bound_checked: usize,
+    bound_shortfall: f64,
     stats: Option<controller::dem_ground::DemStats>,
 }
 
@@ -266,6 +272,30 @@ fn fly_scene(bus: &Bus, tile: DemTile<'static, i16>, ground: Ground, flown: Scen
                 gs.drift_rad
             );
             flight.drift_dem_rad = flight.drift_dem_rad.max(drift_error(o));
+            if k % 10 == 0 {
+                let tile = with.dem_tile_in_force().unwrap();
+                let scene = with.scene();
+                let (lo, hi) = golden::bus_v1_span_on_dem(
+                    scene,
+                    with.heights_m(),
+                    &g,
+                    &a,
+                    &SCALES,
+                    t,
+                    &tile,
+                    o.index,
+                    100.0,
+                )
+                .unwrap();
+                let v_line = scene.camera.pixel_m * scene.line_clock_hz / f64::from(o.ticks);
+                let worst = (v_line / lo - 1.0).abs().max((1.0 - v_line / hi).abs());
+                let short = worst - f64::from(o.worst_mismatch);
+                flight.bound_checked += 1;
+                if short > 0.0 {
+                    flight.bound_short += 1;
+                    flight.bound_shortfall = flight.bound_shortfall.max(short);
+                }
+            }
             flight.drift_terrain_rad = flight.drift_terrain_rad.max(drift_error(o_flat));
             flight.worst_terrain = flight.worst_terrain.max(rel(o_flat.ticks));
         }
@@ -294,7 +324,7 @@ fn report(name: &str, f: &Flight) {
          heights alone {:.2e}); yaw request {:.2e} rad ({:.2e}); drift {:.2e} rad ({:.2e}); \
          samples: {} searched in \
          {} evaluations ({:.2} each), {} traced, {} unresolved, {} off the tile, {} settled \
-         at its edge",
+         at its edge; worst-mismatch bound short in {} of {} segments checked, by up to {:.2e}",
         f.updates,
         f.worst_dem,
         f.worst_terrain,
@@ -308,7 +338,10 @@ fn report(name: &str, f: &Flight) {
         s.traced,
         s.unresolved,
         s.outside,
-        s.edges
+        s.edges,
+        f.bound_short,
+        f.bound_checked,
+        f.bound_shortfall
     );
 }
 
