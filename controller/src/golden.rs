@@ -160,6 +160,87 @@ fn bus_update_on(
     t_us: u64,
     tile: Option<&DemTile<'_, i16>>,
 ) -> Result<UpdateGolden, ModelError> {
+    with_bus_motion(
+        scene,
+        gnss,
+        attitude,
+        scales,
+        t_us,
+        tile,
+        |state, evaluate| {
+            let (segments, yaw_request_rad) = segments_of(scene, plan, heights_m, evaluate)?;
+            Ok(UpdateGolden {
+                segments,
+                yaw_request_rad,
+                state,
+                // The roll-pitch-yaw attitude is Part I's; the bus's is a quaternion.
+                attitude: Attitude::default(),
+            })
+        },
+    )
+}
+
+/// The smallest and largest |v1| (m/s) over the pixels of segment `index` from its
+/// first to its last, every `step_px` and the last, on the bus's data at `t_us` with the
+/// ground on `tile` (else, and where it does not cover a pixel, the segment's height in
+/// `heights_m`): what the plan's samples and its interpolation bound stand for.
+#[allow(clippy::too_many_arguments)]
+pub fn bus_v1_span_on_dem(
+    scene: &Scene,
+    heights_m: &[f32],
+    gnss: &Gnss,
+    attitude: &StarAttitude,
+    scales: &TimeScales,
+    t_us: u64,
+    tile: &DemTile<'_, i16>,
+    index: u8,
+    step_px: f64,
+) -> Result<(f64, f64), ModelError> {
+    let spec = scene
+        .segments
+        .get(usize::from(index))
+        .ok_or(ModelError::DegenerateState)?;
+    let camera = scene.earth_camera(spec);
+    let h_m = heights_m.get(usize::from(index)).copied().unwrap_or(0.0);
+    let (first, last) = (f64::from(spec.first_px), f64::from(spec.last_px));
+    with_bus_motion(
+        scene,
+        gnss,
+        attitude,
+        scales,
+        t_us,
+        Some(tile),
+        |_, evaluate| {
+            let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
+            let mut n = first;
+            loop {
+                let v1 = libm::fabs(evaluate(&camera, h_m, n.min(last))?.v1_mps);
+                (lo, hi) = (lo.min(v1), hi.max(v1));
+                if n >= last {
+                    return Ok((lo, hi));
+                }
+                n += step_px;
+            }
+        },
+    )
+}
+
+/// The reference's image motion on the bus's data at `t_us`, handed to `then` with the
+/// state there: `evaluate(camera, ground height, pixel)`, on `tile` where it covers the
+/// pixel.
+#[allow(clippy::too_many_arguments)]
+fn with_bus_motion<R>(
+    scene: &Scene,
+    gnss: &Gnss,
+    attitude: &StarAttitude,
+    scales: &TimeScales,
+    t_us: u64,
+    tile: Option<&DemTile<'_, i16>>,
+    then: impl FnOnce(
+        StateVector,
+        &dyn Fn(&EarthCamera, f32, f64) -> Result<ImageMotion<f64>, ModelError>,
+    ) -> Result<R, ModelError>,
+) -> Result<R, ModelError> {
     let secs = |us: u64| us as f64 * 1e-6;
     let t_s = secs(t_us);
     let (r, v, w) = (gnss.position_m, gnss.velocity_mps, EARTH_RATE_RAD_S);
@@ -255,14 +336,7 @@ fn bus_update_on(
                 Some(found) => found,
             }
         };
-    let (segments, yaw_request_rad) = segments_of(scene, plan, heights_m, evaluate)?;
-    Ok(UpdateGolden {
-        segments,
-        yaw_request_rad,
-        state,
-        // The roll-pitch-yaw attitude is Part I's; the bus's is a quaternion.
-        attitude: Attitude::default(),
-    })
+    then(state, &evaluate)
 }
 
 /// The camera's axes and angular velocity `dt_s` after `at` (in I of that instant,

@@ -101,6 +101,10 @@ pub struct Plan {
     /// still formed over that ground and flagged valid (docs/controller.md, "Per
     /// update"; `controller/tests/yaw_request.rs`).
     pub boresight_segment: u8,
+    /// The plan segment and sample whose pixel is the boresight (a row at p1 = 0 with a
+    /// sample at p2 = 0, as in a single row of butted segments), if any: over a DEM
+    /// tile the yaw request's ground is then that sample's, searched once.
+    pub boresight_sample: Option<(u8, u8)>,
     pub pixel_m: f32,
     pub line_clock_hz: f32,
     pub stage_rule: StageRule<f32>,
@@ -227,6 +231,7 @@ impl Plan {
             segments: Vec::new(),
             boresight: BLANK_PIXEL,
             boresight_segment: 0,
+            boresight_sample: None,
             pixel_m: 0.0,
             line_clock_hz: 0.0,
             stage_rule: StageRule::none(),
@@ -288,6 +293,7 @@ impl Plan {
             .pixel(&boresight_camera, 0.0)
             .map_err(|_| Fault::InvalidScene)?;
         self.segments.clear();
+        let mut boresight_sample = None;
         let table = scene.table().iter().enumerate();
         for (index, spec) in table.filter(|(_, s)| exhaustive || s.active) {
             let camera = scene.earth_camera(spec);
@@ -324,6 +330,12 @@ impl Plan {
             #[cfg(feature = "earth-fixed")]
             let mut fixed = Vec::new();
             for n in pixels {
+                // The boresight (p1 = p2 = 0, either zero's sign): compared as bits,
+                // without the f64 comparison's software call.
+                if (camera.p1_m.to_bits() | n.to_bits()) << 1 == 0 {
+                    boresight_sample
+                        .get_or_insert((self.segments.len() as u8, samples.len() as u8));
+                }
                 // Checked like any pixel: the row form then needs no check of its own.
                 // (`focal_plane_m` alone checks the same but, inlined, costs 280 bytes of
                 // flash more: `cargo xtask size`.)
@@ -381,6 +393,7 @@ impl Plan {
             .map_or(0, |(k, _)| k as u8);
         self.boresight = boresight;
         self.boresight_segment = boresight_segment;
+        self.boresight_sample = boresight_sample;
         self.pixel_m = scene.camera.pixel_m as f32;
         self.line_clock_hz = scene.line_clock_hz as f32;
         self.stage_rule = stage_rule;

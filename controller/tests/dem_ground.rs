@@ -23,6 +23,11 @@ use core_math::{EarthReference, EARTH_RATE_RAD_S};
 const WGS84: core_math::Ellipsoid = core_math::Ellipsoid::WGS84;
 /// The issue's budget on the periods against the DEM truth (relative).
 const BUDGET: f64 = 1e-4;
+/// The yaw request and each centre's drift against the DEM reference's (rad): the
+/// route's height tolerance, `HEIGHT_TOLERANCE_M` (5 m), times their change per metre
+/// of ground height in these flights, at most about 4e-6 rad/m (over the TERRAIN
+/// heights, up to about 3 km off the DEM, they are off by up to 6.4e-3 and 1.6e-2 rad).
+const YAW_BUDGET_RAD: f64 = 2e-5;
 
 /// What the bus sends: a Kepler orbit in I at T0, the camera at `roll`, `pitch` (deg)
 /// relative to the orbital frame at T0 and mounted as the body, then turning at the
@@ -133,18 +138,36 @@ struct Flight {
     /// without it (TERRAIN heights) against the same DEM reference.
     worst_dem: f64,
     worst_terrain: f64,
+    /// Largest |yaw request - reference| (rad): with the DEM, and without it.
+    yaw_dem_rad: f64,
+    yaw_terrain_rad: f64,
+    /// Largest |drift at a segment's centre - reference| (rad): with the DEM, and
+    /// without it.
+    drift_dem_rad: f64,
+    drift_terrain_rad: f64,
+    /// Every tenth update: the segments whose reported worst mismatch falls short of
+    /// the programmed period's worst over every 100th pixel on the DEM reference, of
+    /// those checked; the largest shortfall (relative mismatch).
+    bound_short: usize,
+    bound_checked: usize,
+    bound_shortfall: f64,
     stats: Option<controller::dem_ground::DemStats>,
 }
 
 /// 2 s of bus data over `tile`: GNSS at 1 Hz, attitude at 10 Hz, updates every 20 ms,
 /// every update checked against the DEM reference.
 fn fly(bus: &Bus, tile: DemTile<'static, i16>, ground: Ground) -> Flight {
+    fly_scene(bus, tile, ground, scene())
+}
+
+/// [`fly`] with the scene `flown`.
+fn fly_scene(bus: &Bus, tile: DemTile<'static, i16>, ground: Ground, flown: Scene) -> Flight {
     // Two controllers fed the same frames (a controller is not `Clone`: it may hold
     // the DEM upload's tile memory).
     let start = || {
         let mut c = Controller::new(Config::default(), Scene::paper_default()).unwrap();
         let mut p = [0u8; 512];
-        let n = scene().encode(&mut p).unwrap();
+        let n = flown.encode(&mut p).unwrap();
         feed(&mut c, &frame(kind::SCENE, 1, T0_US - 500_000, &p[..n]));
         let n = encode_time_scales(18, 0.125, &mut p).unwrap();
         feed(
@@ -239,8 +262,55 @@ fn fly(bus: &Bus, tile: DemTile<'static, i16>, ground: Ground) -> Flight {
                 rel(o.ticks)
             );
             flight.worst_dem = flight.worst_dem.max(rel(o.ticks));
+            let drift_error =
+                |o: &controller::SegmentOutput| (f64::from(o.drift_rad) - gs.drift_rad).abs();
+            assert!(
+                drift_error(o) <= YAW_BUDGET_RAD,
+                "t {t}: segment {}: drift {} vs {}",
+                o.index,
+                o.drift_rad,
+                gs.drift_rad
+            );
+            flight.drift_dem_rad = flight.drift_dem_rad.max(drift_error(o));
+            if k % 10 == 0 {
+                let tile = with.dem_tile_in_force().unwrap();
+                let scene = with.scene();
+                let (lo, hi) = golden::bus_v1_span_on_dem(
+                    scene,
+                    with.heights_m(),
+                    &g,
+                    &a,
+                    &SCALES,
+                    t,
+                    &tile,
+                    o.index,
+                    100.0,
+                )
+                .unwrap();
+                let v_line = scene.camera.pixel_m * scene.line_clock_hz / f64::from(o.ticks);
+                let worst = (v_line / lo - 1.0).abs().max((1.0 - v_line / hi).abs());
+                let short = worst - f64::from(o.worst_mismatch);
+                flight.bound_checked += 1;
+                if short > 0.0 {
+                    flight.bound_short += 1;
+                    flight.bound_shortfall = flight.bound_shortfall.max(short);
+                }
+            }
+            flight.drift_terrain_rad = flight.drift_terrain_rad.max(drift_error(o_flat));
             flight.worst_terrain = flight.worst_terrain.max(rel(o_flat.ticks));
         }
+        let yaw_error = |c: &Controller| match (c.yaw_request_rad(), gold.yaw_request_rad) {
+            (Some(y), Some(g)) => (f64::from(y) - g).abs(),
+            _ => f64::INFINITY,
+        };
+        assert!(
+            yaw_error(&with) <= YAW_BUDGET_RAD,
+            "t {t}: yaw request {:?} vs {:?}",
+            with.yaw_request_rad(),
+            gold.yaw_request_rad
+        );
+        flight.yaw_dem_rad = flight.yaw_dem_rad.max(yaw_error(&with));
+        flight.yaw_terrain_rad = flight.yaw_terrain_rad.max(yaw_error(&without));
         flight.updates += 1;
     }
     flight.stats = with.dem_stats();
@@ -251,18 +321,27 @@ fn report(name: &str, f: &Flight) {
     let s = f.stats.unwrap();
     eprintln!(
         "{name}: {} updates, periods vs the DEM reference {:.2e} relative (TERRAIN \
-         heights alone {:.2e}); samples: {} searched in {} evaluations ({:.2} each), {} \
-         traced, {} unresolved, {} off the tile, {} settled at its edge",
+         heights alone {:.2e}); yaw request {:.2e} rad ({:.2e}); drift {:.2e} rad ({:.2e}); \
+         samples: {} searched in \
+         {} evaluations ({:.2} each), {} traced, {} unresolved, {} off the tile, {} settled \
+         at its edge; worst-mismatch bound short in {} of {} segments checked, by up to {:.2e}",
         f.updates,
         f.worst_dem,
         f.worst_terrain,
+        f.yaw_dem_rad,
+        f.yaw_terrain_rad,
+        f.drift_dem_rad,
+        f.drift_terrain_rad,
         s.searched,
         s.evaluations,
         s.evaluations as f64 / s.searched.max(1) as f64,
         s.traced,
         s.unresolved,
         s.outside,
-        s.edges
+        s.edges,
+        f.bound_short,
+        f.bound_checked,
+        f.bound_shortfall
     );
 }
 
@@ -279,6 +358,28 @@ fn roll_slew_over_mountains_matches_the_dem_reference() {
     assert!(s.searched >= 500 && s.outside > 100, "{s:?}");
     // The test can tell: without the DEM the periods are far off.
     assert!(f.worst_terrain > 10.0 * BUDGET, "{f:?}");
+}
+
+/// The yaw request over the DEM where the boresight is no plan sample: every segment's
+/// row 2 mm along the track from it, so that its ray is searched in the route's own
+/// slot (in the other flights it is a sample, pixel 0 at p1 = 0, found ahead).
+#[test]
+fn the_yaw_request_is_over_the_dem_where_the_boresight_is_no_sample() {
+    let bus = bus(15.0, 0.0, [0.012, -0.002, 0.001]);
+    let tile = tile_at(boresight_ground_deg(&bus), 250, 0.02, rugged);
+    let mut flown = scene();
+    for seg in flown.segments.iter_mut().take(10) {
+        seg.p1_m = 2e-3;
+    }
+    let probe = Controller::new(Config::default(), flown).unwrap();
+    assert_eq!(probe.plan().boresight_sample, None);
+    let default = Controller::new(Config::default(), scene()).unwrap();
+    assert!(default.plan().boresight_sample.is_some());
+    let f = fly_scene(&bus, tile, Ground::Given, flown);
+    report("roll slew, ridges and cliffs, rows off the boresight", &f);
+    assert!(f.updates >= 90);
+    // The test can tell: over the TERRAIN heights the request is far off.
+    assert!(f.yaw_terrain_rad > 100.0 * YAW_BUDGET_RAD, "{f:?}");
 }
 
 /// The stereo pitch (-20 deg, pitching at 0.4 deg/s) with a little roll over the same

@@ -7,8 +7,30 @@ use super::*;
 impl DemGround {
     /// The ground of sample `j` of plan segment `k` at pixel p2 (m) on `rays`: see the
     /// module. `terrain_h_m` starts the search on the first update.
-    #[inline(never)]
+    #[inline(always)]
     pub(crate) fn sample(
+        &mut self,
+        k: usize,
+        j: usize,
+        rays: &SegmentRays,
+        p2_m: f32,
+        terrain_h_m: f32,
+    ) -> Result<SampleGround, ModelError> {
+        if k * MAX_SAMPLES + j == self.ahead_slot {
+            self.ahead_slot = usize::MAX;
+            let s = self.ahead_range;
+            return Ok(if s.is_nan() {
+                SampleGround::Outside
+            } else {
+                SampleGround::Range(s)
+            });
+        }
+        self.find(k, j, rays, p2_m, terrain_h_m)
+    }
+
+    /// [`DemGround::sample`]'s work, where no answer was found ahead.
+    #[inline(never)]
+    fn find(
         &mut self,
         k: usize,
         j: usize,
@@ -43,6 +65,28 @@ impl DemGround {
             return self.search(k, j, rays, &ray, last + step);
         }
         self.search(k, j, rays, &ray, terrain_h_m)
+    }
+
+    /// [`DemGround::sample`] of sample `j` of plan segment `k` now, ahead of its
+    /// segment (for the yaw request, when the boresight is that sample): its segment's
+    /// sweep then takes this answer instead of searching again, in this update.
+    #[inline(never)]
+    pub(crate) fn sample_ahead(
+        &mut self,
+        k: usize,
+        j: usize,
+        rays: &SegmentRays,
+        terrain_h_m: f32,
+    ) -> Option<f32> {
+        self.ahead_slot = usize::MAX;
+        // A refusal is left for the segment's own search to meet.
+        let found = match self.find(k, j, rays, 0.0, terrain_h_m).ok()? {
+            SampleGround::Range(s) => Some(s),
+            SampleGround::Outside => None,
+        };
+        self.ahead_slot = k * MAX_SAMPLES + j;
+        self.ahead_range = found.unwrap_or(f32::NAN);
+        found
     }
 
     /// [`DemGround::sample`]'s search from the height `start` (m).

@@ -153,12 +153,22 @@ impl Controller {
     #[cfg(not(feature = "earth-fixed"))]
     #[inline(always)]
     pub(super) fn steer_and_ground(
-        &self,
+        &mut self,
         instant: &GeneralInstant<f32>,
+        dem: Option<&ItrfFrame>,
     ) -> (Steer, f32, Result<Ground, Fault>) {
         let boresight_h = self.height(self.plan.boresight_segment);
         let ground = self.make_ground(instant, boresight_h, None);
-        let steer = ground.as_ref().ok().and_then(|g| self.steer_f32(g));
+        let steer = ground.as_ref().ok().and_then(|g| {
+            let on_dem = match dem {
+                Some(_) => self.dem_boresight(dem, g, instant.r2_minus_a2_m2, boresight_h),
+                None => None,
+            };
+            match on_dem {
+                Some(m) => steer_from(m.v1_mps, m.v2_mps, atan_reduced(m.v2_mps / m.v1_mps)),
+                None => self.steer_f32(g),
+            }
+        });
         (steer, boresight_h, ground)
     }
 
@@ -170,17 +180,30 @@ impl Controller {
     #[cfg(feature = "earth-fixed")]
     #[inline(always)]
     pub(super) fn steer_and_ground(
-        &self,
+        &mut self,
         instant: &GeneralInstant<f32>,
+        dem: Option<&ItrfFrame>,
     ) -> (Steer, f32, Result<Ground, Fault>) {
         let boresight_h = self.height(self.plan.boresight_segment);
         let mut ground = self.make_ground(instant, boresight_h, None);
+        // Over a DEM tile, the boresight's ground on it (the f32 route's, soft float on
+        // a core without an FPU, as the DEM's samples are).
+        let on_dem = match (&ground, dem) {
+            (Ok(g), Some(_)) => {
+                self.dem_boresight(dem, &g.float, instant.r2_minus_a2_m2, boresight_h)
+            }
+            _ => None,
+        };
         if !self.fixed_pixels() {
-            let steer = ground.as_ref().ok().and_then(|g| self.steer_f32(&g.float));
+            let steer = ground.as_ref().ok().and_then(|g| match on_dem {
+                Some(m) => steer_from(m.v1_mps, m.v2_mps, atan_reduced(m.v2_mps / m.v1_mps)),
+                None => self.steer_f32(&g.float),
+            });
             return (steer, boresight_h, ground);
         }
-        let steer = match &ground {
-            Ok(Ground { fixed: Some(f), .. }) => {
+        let steer = match (&ground, on_dem) {
+            (Ok(_), Some(m)) => steer_from(m.v1_mps, m.v2_mps, atan_pair_rad(m.v2_mps, m.v1_mps)),
+            (Ok(Ground { fixed: Some(f), .. }), None) => {
                 f.boresight_over_focal().ok().and_then(|(vf1, vf2)| {
                     // Q63 rad/s, below 2^63: their squares stay inside f32's range.
                     let (v1, v2) = (

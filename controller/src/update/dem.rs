@@ -71,7 +71,7 @@ pub(super) fn dem_extremes(
 
 impl Controller {
     /// [`dem_extremes`] of plan segment `k`, whose TERRAIN height `update` is made for.
-    #[inline(never)]
+    #[inline(always)]
     pub(super) fn dem_segment(
         &mut self,
         k: usize,
@@ -80,12 +80,7 @@ impl Controller {
         instant: &GeneralInstant<f32>,
         terrain_h_m: f32,
     ) -> Result<Extremes, Fault> {
-        // The route's tile's heights: the one given (tests, bench) or the upload's in
-        // force; the route was made for that tile (`refresh_dem_ground`).
-        let heights_m = match &self.dem_given {
-            Some(t) => t.heights_m(),
-            None => self.dem.heights_in_force().unwrap_or(&[]),
-        };
+        let heights_m = tile_heights(&self.dem_given, &self.dem);
         let dem = &mut self.dem_ground;
         let (true, Some(seg)) = (dem.active(), self.plan.segments.get(k)) else {
             return Err(Fault::InvalidScene);
@@ -100,6 +95,64 @@ impl Controller {
             instant.r2_minus_a2_m2,
             terrain_h_m,
         )
+    }
+
+    /// The boresight's motion with its ground on the DEM tile in force, for the yaw
+    /// request (atan(v2/v1) at the boresight over the ground it sees), at that ground's
+    /// range (`General::motion_at_inv_range`). Where the boresight is a plan sample
+    /// (`Plan::boresight_sample`) that sample is searched ahead of its segment, which
+    /// then takes the answer; else its own ray is searched as a sample's, in the slot
+    /// [`BORESIGHT_SLOT`] (`DemGround::sample_ahead` either way). None without a tile or the ITRF of the instant, or where the
+    /// tile does not cover the boresight: the request is then over the boresight
+    /// segment's TERRAIN height `terrain_h_m`, which `update` is made for.
+    #[inline(never)]
+    pub(super) fn dem_boresight(
+        &mut self,
+        frame: Option<&ItrfFrame>,
+        update: &GeneralUpdate<f32>,
+        r2_minus_a2_m2: f32,
+        terrain_h_m: f32,
+    ) -> Option<ImageMotion<f32>> {
+        let frame = frame?;
+        let heights_m = tile_heights(&self.dem_given, &self.dem);
+        let dem = &mut self.dem_ground;
+        if !dem.active() {
+            return None;
+        }
+        let px = &self.plan.boresight;
+        // The boresight's ray is its row's (p1 = 0) at p2 = 0: a plan row's exactly
+        // where it is a plan sample, so that the answer found ahead is the one its
+        // segment would find; else the route's own slot, which no segment reads.
+        let (k, j, p1_m, focal_m, uu0_m2, h_m) = match self
+            .plan
+            .boresight_sample
+            .and_then(|(k, j)| Some((k, j, self.plan.segments.get(usize::from(k))?)))
+        {
+            Some((k, j, seg)) => (
+                usize::from(k),
+                usize::from(j),
+                seg.row.p1_m,
+                seg.row.focal_m,
+                seg.row.uu0_m2,
+                self.heights_m
+                    .get(usize::from(seg.index))
+                    .copied()
+                    .unwrap_or(0.0),
+            ),
+            None => (BORESIGHT_SLOT, 0, 0.0, -px.u_m[2], px.uu_m2, terrain_h_m),
+        };
+        let (d0, dy) = SegmentRays::directions(frame, p1_m, focal_m);
+        let rays = SegmentRays::from_directions(
+            dem,
+            heights_m,
+            frame.position_m,
+            d0,
+            dy,
+            uu0_m2,
+            r2_minus_a2_m2,
+        );
+        let s = dem.sample_ahead(k, j, &rays, h_m)?;
+        GENERAL_F32.motion_at_inv_range(update, px, 1.0 / s).ok()
     }
 
     /// Puts `tile` in force as the ground of every plan sample it covers, in place of
@@ -149,5 +202,17 @@ impl Controller {
     /// How the DEM route found the samples' ground since the tile was set.
     pub fn dem_stats(&self) -> Option<DemStats> {
         self.dem_ground.active().then_some(self.dem_ground.stats)
+    }
+}
+
+/// The heights of the tile the DEM route was made for: the one given (tests, bench) or
+/// the upload's in force (`Controller::refresh_dem_ground`).
+fn tile_heights<'a>(
+    given: &'a Option<core_math::earth::dem::DemTile<'static, i16>>,
+    store: &'a crate::dem::Dem,
+) -> &'a [i16] {
+    match given {
+        Some(t) => t.heights_m(),
+        None => store.heights_in_force().unwrap_or(&[]),
     }
 }

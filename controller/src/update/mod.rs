@@ -12,7 +12,7 @@ use core_math::{nearest_ticks, smear_mtf, Backend, Real, GENERAL_F32};
 use crate::config::{EARTH, EARTH_RATE_RAD_S, MAX_TIME_TAG_US};
 use crate::control::{Controller, Mode, SegmentOutput};
 use crate::dem_ground::{
-    motion_at_range, DemGround, DemStats, SampleGround, SegmentRays, TileRefusal,
+    motion_at_range, DemGround, DemStats, SampleGround, SegmentRays, TileRefusal, BORESIGHT_SLOT,
 };
 use crate::fault::Fault;
 use crate::nav::attitude_at;
@@ -136,12 +136,13 @@ impl Controller {
         // Segments over the same ground height share its update: made once per height
         // in a row (a flat scene makes one, terrain one per segment). It stays in one
         // place in memory, which the out-of-line `segment` and `extremes` read.
-        let (steer, mut ground_h_m, mut ground) = self.steer_and_ground(&instant);
+        // The DEM's route needs a tile in force and the ITRF of the instant.
+        let dem_frame = if self.dem_ground.active() { itrf } else { None };
+        let (steer, mut ground_h_m, mut ground) =
+            self.steer_and_ground(&instant, dem_frame.as_ref());
         self.yaw_request_rad = steer.map(|(_, _, rad)| rad);
         // Output slots by `get` (`index` < MAX_SEGMENTS by construction of the plan): no
         // panic path (docs/no-panic.md).
-        // The DEM's route needs a tile in force and the ITRF of the instant.
-        let dem_frame = if self.dem_ground.active() { itrf } else { None };
         for k in 0..self.plan.segments.len() {
             let Some(seg) = self.plan.segments.get(k) else {
                 break;

@@ -610,8 +610,11 @@ pub fn build(m: Manoeuvres, dem: (DemGrid, Vec<i16>), tick_us: u64) -> Result<Pa
         c2t0: earth.c2t(gps0_s as f64),
         earth,
     };
-    let controller = controller::Controller::new(controller::Config::default(), scene)
+    let mut controller = controller::Controller::new(controller::Config::default(), scene)
         .map_err(|f| anyhow!("the default scene was refused: {}", f.name()))?;
+    // The DEM upload's memory, as the firmware's: the yaw requests the attitude follows
+    // are then over the tile, as the firmware's are.
+    controller.attach_dem(Box::leak(Box::new(controller::dem::DemStore::new())));
     let mut session = controller::session::Session::new(controller);
     let mut frames = Frames::default();
     let feed = |session: &mut controller::session::Session, frame: Vec<u8>| {
