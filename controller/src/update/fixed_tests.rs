@@ -154,9 +154,10 @@ fn period_and_mismatch_match_f64() {
 }
 
 /// The drift angle of an integer pair (the Cortex-M3's segments) against atan in f64 of
-/// the same integers: within 7e-9 rad (the polynomial's 4.2e-9 and the ratio's
-/// truncation to Q30 with its three of 2^-31) plus half an f32 ulp of the result, over
-/// pairs of every magnitude and ratio, and the edge cases.
+/// the same integers: within 3.5e-9 rad (the operands' truncation to 32 bits, the
+/// quotient's to Q32, the polynomial with its roundings and pi/4, pi/2 in Q30:
+/// docs/fixed-point.md) plus half an f32 ulp of the result, over pairs of every
+/// magnitude and ratio (so both sides of tan(pi/8)), and the edge cases.
 #[test]
 fn integer_pair_drift_angle_matches_atan() {
     use super::sweep::{atan_pair_rad, atan_ratio_rad};
@@ -167,7 +168,7 @@ fn integer_pair_drift_angle_matches_atan() {
         let want = libm::atan(num as f64 / den as f64) * if negative { -1.0 } else { 1.0 };
         let err = libm::fabs(got - want);
         assert!(
-            err <= 7e-9 + 0.5 * f64::from(f32::EPSILON) * libm::fabs(want),
+            err <= 3.5e-9 + 0.5 * f64::from(f32::EPSILON) * libm::fabs(want),
             "atan({num} / {den}) = {got} vs {want}"
         );
         worst = worst.max(err - 0.5 * f64::from(f32::EPSILON) * libm::fabs(want));
@@ -186,6 +187,10 @@ fn integer_pair_drift_angle_matches_atan() {
         (1, u64::MAX),
         (1 << 63, (1 << 63) - 1),
         (7, 1 << 40),
+        // Either side of tan(pi/8) (1 779 033 703.95 in Q32).
+        (1_779_033_703, 1 << 32),
+        (1_779_033_704, 1 << 32),
+        (1 << 32, 1_779_033_704),
     ] {
         check(num, den, false);
         check(num, den, true);
