@@ -142,6 +142,36 @@ pub fn sin_cos_int(x: f32) -> (f32, f32) {
     }
 }
 
+/// (sin x, cos x) in Q30 for x in Q30 on [0, pi/2] (the Cortex-M3's yaw request, from
+/// its integer drift angle): x or pi/2 - x, whichever is at most pi/4, then
+/// [`sin_cos_int`]'s polynomials in Q30, r S(r^2) one 32 x 32 product. Within 3 units of
+/// Q30 (`core-math/tests/trig.rs`); x is clamped to [0, pi/2].
+pub fn sin_cos_q30(x_q30: i32) -> (i32, i32) {
+    const HALF_PI_Q30: i32 = 1_686_629_713;
+    const QUARTER_PI_Q30: i32 = 843_314_857;
+    let x = x_q30.clamp(0, HALF_PI_Q30);
+    let (r, swap) = if x > QUARTER_PI_Q30 {
+        (HALF_PI_Q30 - x, true)
+    } else {
+        (x, false)
+    };
+    let z = ((i64::from(r) * i64::from(r)) >> 30) as i32;
+    let horner = |c: &[i32]| {
+        let mut acc = c[c.len() - 1];
+        for &ck in c[..c.len() - 1].iter().rev() {
+            acc = ((i64::from(acc) * i64::from(z) + (1 << 29)) >> 30) as i32 + ck;
+        }
+        acc
+    };
+    let s = ((i64::from(r) * i64::from(horner(&SIN_Q30)) + (1 << 29)) >> 30) as i32;
+    let c = horner(&COS_Q30);
+    if swap {
+        (c, s)
+    } else {
+        (s, c)
+    }
+}
+
 /// pi/4 and pi/2 in Q60, rounded.
 const QUARTER_PI_Q60: u64 = 905_502_432_259_640_355;
 const HALF_PI_Q60: u64 = 1_811_004_864_519_280_711;

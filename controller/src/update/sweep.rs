@@ -192,16 +192,30 @@ pub(super) fn atan_pair_rad(num: f32, den: f32) -> f32 {
     )
 }
 
-/// atan(`num` / `den`) (rad) of two integer magnitudes, negated when `negative`: the
-/// larger's leading one shifted to bit 63, both truncated to their top 32 bits, then
-/// [`atan_norm_rad`] (docs/fixed-point.md, "The update on the Cortex-M3"). A zero
-/// `den`: [`atan_pair_rad`] of the two as f32.
+/// atan(`num` / `den`) (rad) of two integer magnitudes, negated when `negative`:
+/// [`atan_ratio_q30`] rounded once to f32. A zero `den`: [`atan_pair_rad`] of the two as
+/// f32.
 #[cfg(feature = "earth-fixed")]
 #[inline(never)]
 pub(super) fn atan_ratio_rad(num: u64, den: u64, negative: bool) -> f32 {
+    match atan_ratio_q30(num, den) {
+        Some(q) => signed_q30_to_f32(q, negative),
+        None => {
+            let sign = if negative { -1.0 } else { 1.0 };
+            atan_pair_rad(u64_to_f32(num, 0), sign * u64_to_f32(den, 0))
+        }
+    }
+}
+
+/// atan(`num` / `den`) in Q30 (in [0, pi/2]) of two integer magnitudes: the larger's
+/// leading one shifted to bit 63, both truncated to their top 32 bits, then
+/// [`atan_norm_q30`] (docs/fixed-point.md, "The update on the Cortex-M3"). None for a
+/// zero `den`.
+#[cfg(feature = "earth-fixed")]
+#[inline(always)]
+pub(super) fn atan_ratio_q30(num: u64, den: u64) -> Option<i32> {
     if den == 0 {
-        let sign = if negative { -1.0 } else { 1.0 };
-        return atan_pair_rad(u64_to_f32(num, 0), sign * u64_to_f32(den, 0));
+        return None;
     }
     let (small, big, past_one) = if num <= den {
         (num, den, false)
@@ -210,18 +224,37 @@ pub(super) fn atan_ratio_rad(num: u64, den: u64, negative: bool) -> f32 {
     };
     let lz = big.leading_zeros();
     let top = |x: u64| ((x << lz) >> 32) as u32;
-    atan_norm_rad(top(small), top(big), past_one, negative)
+    Some(atan_norm_q30(top(small), top(big), past_one))
 }
 
-/// The tail both integer arctangents share: atan(`s` / `b`) for `s` <= `b` and `b` in
-/// [2^31, 2^32), its complement when the ratio was `past_one`, rounded once to f32 and
-/// negated when `negative`. Past tan(pi/8) the ratio x is reduced to (1 - x) / (1 + x),
-/// atan x = pi/4 - atan((1 - x) / (1 + x)), formed from the integers before the one
-/// division, so that the odd polynomial covers only [0, tan(pi/8)].
-// Out of line: inlined, the polynomial was a copy in each of the two.
+/// `q` 2^-30 (>= 0) as f32, negated when `negative`.
+#[cfg(feature = "earth-fixed")]
+#[inline(always)]
+pub(super) fn signed_q30_to_f32(q: i32, negative: bool) -> f32 {
+    let rad = q30_to_f32(q.max(0) as u32);
+    if negative {
+        -rad
+    } else {
+        rad
+    }
+}
+
+/// [`atan_norm_q30`] rounded once to f32, negated when `negative`.
+#[cfg(feature = "earth-fixed")]
+#[inline(always)]
+fn atan_norm_rad(s: u32, b: u32, past_one: bool, negative: bool) -> f32 {
+    signed_q30_to_f32(atan_norm_q30(s, b, past_one), negative)
+}
+
+/// The tail both integer arctangents share: atan(`s` / `b`) in Q30 for `s` <= `b` and
+/// `b` in [2^31, 2^32), its complement pi/2 - atan when the ratio was `past_one`. Past
+/// tan(pi/8) the ratio x is reduced to (1 - x) / (1 + x), atan x = pi/4 - atan((1 - x) /
+/// (1 + x)), formed from the integers before the one division, so that the odd
+/// polynomial covers only [0, tan(pi/8)].
+// Out of line: inlined, the polynomial was a copy in each caller.
 #[cfg(feature = "earth-fixed")]
 #[inline(never)]
-fn atan_norm_rad(s: u32, b: u32, past_one: bool, negative: bool) -> f32 {
+fn atan_norm_q30(s: u32, b: u32, past_one: bool) -> i32 {
     use core_math::wide::div_64_32;
     // s / b > tan(pi/8), compared exactly in u64.
     let reduced = u64::from(s) << 32 > u64::from(TAN_PI_8_Q32) * u64::from(b);
@@ -240,12 +273,10 @@ fn atan_norm_rad(s: u32, b: u32, past_one: bool, negative: bool) -> f32 {
     };
     let at = atan_small_q30(x_q32.min(TAN_PI_8_Q32) as i32);
     let at = if reduced { QUARTER_PI_Q30 - at } else { at };
-    let q = if past_one { HALF_PI_Q30 - at } else { at };
-    let rad = q30_to_f32(q.max(0) as u32);
-    if negative {
-        -rad
+    if past_one {
+        HALF_PI_Q30 - at
     } else {
-        rad
+        at
     }
 }
 
