@@ -273,8 +273,8 @@ fn q30_sin_cos_within_three_units() {
         x ^= x << 13;
         x ^= x >> 17;
         x ^= x << 5;
-        check((u64::from(x) * half_pi_q30 as u64 >> 32) as i32);
-        check((u64::from(i) * half_pi_q30 as u64 >> 20) as i32);
+        check(((u64::from(x) * half_pi_q30 as u64) >> 32) as i32);
+        check(((u64::from(i) * half_pi_q30 as u64) >> 20) as i32);
     }
     for x in [
         0,
