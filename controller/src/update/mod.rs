@@ -29,11 +29,11 @@ impl Controller {
         cfg!(feature = "fixed-only") || self.config.fixed_point_pixels
     }
 
-    /// The general form's per-instant constants of the NAV route: the attitude's sines
-    /// and cosines in integers with fixed-point pixels (a core without an FPU, where
-    /// each f32 operation is a software call), else in f32; either way through an
-    /// out-of-line form that the plan build calls too (inlined here, it was a second
-    /// copy: docs/target.md, flash).
+    /// The general form's per-instant constants of the NAV route: with fixed-point pixels
+    /// (a core without an FPU, where each f32 operation is a software call) in integers,
+    /// rounded once to f32 ([`instant::instant_int`]), else in f32 through an out-of-line
+    /// form that the plan build calls too (inlined here, it was a second copy:
+    /// docs/target.md, flash).
     #[inline(always)]
     fn nav_instant(
         &self,
@@ -44,14 +44,7 @@ impl Controller {
         let w = EARTH_RATE_RAD_S as f32;
         #[cfg(feature = "earth-fixed")]
         if self.fixed_pixels() {
-            return GENERAL_F32.instant_parts_with(
-                r,
-                v,
-                r2_minus_a2,
-                attitude,
-                w,
-                core_math::trig::sin_cos_int,
-            );
+            return instant::instant_int(r, v, r2_minus_a2, attitude, w);
         }
         GENERAL_F32.instant_parts(r, v, r2_minus_a2, attitude, w)
     }
@@ -319,6 +312,8 @@ mod backend;
 mod dem;
 #[cfg(feature = "earth-fixed")]
 mod fixed;
+#[cfg(feature = "earth-fixed")]
+mod instant;
 mod sweep;
 
 use backend::*;
