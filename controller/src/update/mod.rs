@@ -49,6 +49,19 @@ impl Controller {
         GENERAL_F32.instant_parts(r, v, r2_minus_a2, attitude, w)
     }
 
+    /// The NAV state `dt_s` after its frame: with fixed-point pixels in integers
+    /// ([`crate::nav::Propagator::parts_at_int`]) where its formats hold, else in f32.
+    #[inline(always)]
+    fn nav_state(&self, p: &crate::nav::Propagator, dt_s: f32) -> crate::nav::StateParts {
+        #[cfg(feature = "earth-fixed")]
+        if self.fixed_pixels() {
+            if let Some(s) = p.parts_at_int(dt_s) {
+                return s;
+            }
+        }
+        p.parts_at(dt_s)
+    }
+
     /// Moves the clock to `now_us` (from the time source) and runs the update that is due,
     /// if any, writing periods to `sink`. Returns true when an update ran.
     pub fn advance<S: LinePeriodSink>(&mut self, now_us: u64, sink: &mut S) -> bool {
@@ -94,7 +107,7 @@ impl Controller {
         let instant = match (&self.nav, &self.gnss, &self.attitude) {
             (Some(nav), _, _) if self.update_mode != Mode::Stale => {
                 let dt_s = seconds_since(t_us, nav.time_us);
-                let state = nav.propagator.parts_at(dt_s);
+                let state = self.nav_state(&nav.propagator, dt_s);
                 let attitude = attitude_at(&nav.attitude, dt_s);
                 self.nav_instant(&state, &attitude)
             }
@@ -317,6 +330,8 @@ mod instant;
 mod sweep;
 
 use backend::*;
+#[cfg(feature = "earth-fixed")]
+pub(crate) use fixed::i64_to_f32 as i64_to_f32_scaled;
 #[cfg(feature = "earth-fixed")]
 use fixed::*;
 pub use sweep::drift_angle_rad;
