@@ -4,7 +4,7 @@
 //! each field rounded once to f32 at the end (docs/fixed-point.md, "The update on the
 //! Cortex-M3"). The f32 route where a quantity leaves the formats.
 
-use core_math::earth::{check_state, Attitude, General, GeneralInstant};
+use core_math::earth::{Attitude, General, GeneralInstant};
 use core_math::wide::div_64_32;
 use core_math::ModelError;
 
@@ -91,13 +91,12 @@ const MAX_RATE_Q35: i64 = 1 << 31;
 /// largest |r| of the fixed backend's envelope), inside 2^31.
 const MAX_V_OVER_R_Q39: i64 = 1 << 31;
 
-/// `General::<f32>::instant_parts_by` for the NAV route, in integers: the same state
-/// checks first (`check_state` in f32: the same refusals), then the orbital frame, the
+/// `General::<f32>::instant_parts_by` for the NAV route, in integers: the orbital frame, the
 /// attitude, W_B and V_B as the general form forms them but over |r| and in Q30 (unit
 /// vectors, the attitude matrix) and Q39 (rates), each field rounded once to f32. A state
 /// or attitude outside the formats (|v| / |r| >= 2^-8 rad/s, an orbit rate below 2^-19
-/// rad/s, an angle of 4 rad or more, a rate of 2^-4 rad/s or more, |r| of 2^24 m or
-/// more) takes the f32 route.
+/// rad/s, an angle of 4 rad or more, a rate of 2^-4 rad/s or more, |r| of 2^23.5 m or
+/// more) takes the f32 route, with its state checks.
 #[inline(never)]
 pub(super) fn instant_int(
     r: [f32; 3],
@@ -106,7 +105,11 @@ pub(super) fn instant_int(
     attitude: &Attitude<f32>,
     earth_rate_rad_s: f32,
 ) -> Result<GeneralInstant<f32>, ModelError> {
-    check_state(r, v)?;
+    // No `check_state` here: every state the formats take lies well inside its
+    // acceptance (|r| < 2^23.5 m against 1e9 m; each |v_k| / |r| < 2^-8 rad/s, so |v| <
+    // 80 km/s against 100 km/s; an orbit rate of at least 2^-19 rad/s, so a flight-path
+    // sine above 2.8e-4 against 1e-6), far beyond its f32 rounding: its f32 form passes
+    // each one. The others take the f32 route, which checks.
     match instant_q(r, v, r2_minus_a2, attitude, earth_rate_rad_s) {
         Some(i) => Ok(i),
         None => instant_f32(r, v, r2_minus_a2, attitude, earth_rate_rad_s),
@@ -155,7 +158,7 @@ fn instant_q(
     }
     // M = r2q 2^z in [2^62, 2^64), z even; |r| = s 2^h with s in [2^31, 2^32] (within 2
     // units), and 1/|r| = inv 2^(-62 - h), inv in (2^30, 2^31].
-    if r2q == 0 {
+    if r2q == 0 || r2q >= 1 << 61 {
         return None;
     }
     let z = r2q.leading_zeros() & !1;
@@ -274,6 +277,7 @@ fn instant_q(
 mod tests {
     extern crate std;
     use super::*;
+    use core_math::earth::check_state;
     use core_math::sample::SplitMix64;
 
     /// The integer instant against the general form in f64 (libm's sines) on the same
@@ -334,6 +338,7 @@ mod tests {
                 })
                 .expect("inside the envelope");
             let got = instant_q(r, v, r2ma2_32, &att32, w32).expect("inside the formats");
+            assert!(check_state(r, v).is_ok());
             let float = instant_f32(r, v, r2ma2_32, &att32, w32).unwrap();
             let norm = |x: [f64; 3]| libm::sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
             let vectors = |i: &GeneralInstant<f32>| {
@@ -406,5 +411,22 @@ mod tests {
             Err(ModelError::DegenerateState)
         );
         assert!(instant_q(r, v, 1e13, &att, w).is_some());
+        // The formats' corners pass the f32 state checks: |r| and |v| at their bounds,
+        // and the slowest orbit rate the integers take with the fastest velocity.
+        let r_max = [11_860_000.0f32, 0.0, 0.0];
+        let v_max = [46_000.0f32, 46_000.0, 46_000.0];
+        assert!(instant_q(r_max, v_max, 1e13, &att, w).is_some());
+        assert!(check_state(r_max, v_max).is_ok());
+        assert!(instant_q([11_870_000.0, 0.0, 0.0], v_max, 1e13, &att, w).is_none());
+        // Non-finite states take the f32 route and its refusal.
+        for bad in [f32::NAN, f32::INFINITY] {
+            let rb = [bad, r[1], r[2]];
+            assert!(instant_q(rb, v, 1e13, &att, w).is_none());
+            assert_eq!(
+                instant_int(rb, v, 1e13, &att, w),
+                instant_f32(rb, v, 1e13, &att, w)
+            );
+            assert!(instant_int(rb, v, 1e13, &att, w).is_err());
+        }
     }
 }
