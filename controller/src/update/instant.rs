@@ -10,7 +10,8 @@ use core_math::ModelError;
 
 use super::fixed::i64_to_f32;
 
-/// A finite f32 as m 2^e exactly (m signed, |m| < 2^24; zero and subnormals as 0).
+/// A finite f32 as m 2^e exactly (m signed, |m| < 2^24; zero and subnormals as 0; a
+/// non-finite one as a mantissa times 2^105, past every format, so the f32 route).
 #[inline(always)]
 fn parts(x: f32) -> (i64, i32) {
     let bits = x.to_bits();
