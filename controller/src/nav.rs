@@ -276,11 +276,11 @@ impl Propagator {
 #[cfg(feature = "earth-fixed")]
 impl Propagator {
     /// [`Propagator::parts_at`] in integers, for a core without an FPU: the same series
-    /// by Horner's rule on [`SeriesInt`] with dt in Q24 (s), each product truncated once
+    /// by Horner's rule on `SeriesInt` with dt in Q24 (s), each product truncated once
     /// to its format, the increments added to the state exactly, |r|^2 - a^2 +
     /// dr.(2 r0 + dr) with 2 r0 + dr rounded to the metre, each output rounded once to
     /// f32 (docs/fixed-point.md, "The update on the Cortex-M3"). None where |dt| >= 4 s
-    /// or the NAV state left [`SeriesInt`]'s bounds: the caller takes
+    /// or the NAV state left `SeriesInt`'s bounds: the caller takes
     /// [`Propagator::parts_at`].
     pub fn parts_at_int(&self, dt_s: f32) -> Option<StateParts> {
         let p = self.int.as_ref()?;
