@@ -142,6 +142,81 @@ pub fn sin_cos_int(x: f32) -> (f32, f32) {
     }
 }
 
+/// (sin x, cos x) in Q30 for x in Q30 on [0, pi/2] (the Cortex-M3's yaw request, from
+/// its integer drift angle): x or pi/2 - x, whichever is at most pi/4, then
+/// [`sin_cos_int`]'s polynomials in Q30, r S(r^2) one 32 x 32 product. Within 3 units of
+/// Q30 (`core-math/tests/trig.rs`); x is clamped to [0, pi/2].
+pub fn sin_cos_q30(x_q30: i32) -> (i32, i32) {
+    const HALF_PI_Q30: i32 = 1_686_629_713;
+    const QUARTER_PI_Q30: i32 = 843_314_857;
+    let x = x_q30.clamp(0, HALF_PI_Q30);
+    let (r, swap) = if x > QUARTER_PI_Q30 {
+        (HALF_PI_Q30 - x, true)
+    } else {
+        (x, false)
+    };
+    let (s, c) = sin_cos_reduced_q30(r);
+    if swap {
+        (c, s)
+    } else {
+        (s, c)
+    }
+}
+
+/// (sin x, cos x) in Q30 of an f32 angle |x| < 4 rad (the Cortex-M3's per-instant
+/// attitude, `controller/src/update/instant.rs`): [`sin_cos_int`]'s reduction by pi/2 in
+/// Q60, r rounded to Q30, then [`sin_cos_q30`]'s polynomials. Within 4 units of Q30
+/// (`core-math/tests/trig.rs`); None for |x| >= 4 and non-finite x.
+// Out of line: the attitude's three angles, each a copy inlined.
+#[inline(never)]
+pub fn sin_cos_f32_q30(x: f32) -> Option<(i32, i32)> {
+    let bits = x.to_bits();
+    let biased = (bits >> 23) & 0xff;
+    if biased >= 129 {
+        return None;
+    }
+    // |x| in Q60 (a left shift of 0 to 38; below 2^-20 the shift is right, and r's
+    // rounding to Q30 below makes sin x = x, cos x = 1 within a unit).
+    let mant = u64::from((bits & 0x7f_ffff) | 0x80_0000);
+    let a = if biased == 0 {
+        0
+    } else if biased >= 90 {
+        mant << (biased - 90)
+    } else {
+        mant.checked_shr(90 - biased).unwrap_or(0)
+    };
+    let k = (a > QUARTER_PI_Q60) as u64
+        + (a > 3 * QUARTER_PI_Q60) as u64
+        + (a > 5 * QUARTER_PI_Q60) as u64;
+    let r = a as i64 - (k * HALF_PI_Q60) as i64;
+    let r30 = ((r + (1 << 29)) >> 30) as i32;
+    let (s_r, c_r) = sin_cos_reduced_q30(r30);
+    let (s, c) = match k {
+        0 => (s_r, c_r),
+        1 => (c_r, -s_r),
+        2 => (-s_r, -c_r),
+        _ => (-c_r, s_r),
+    };
+    Some(if bits >> 31 != 0 { (-s, c) } else { (s, c) })
+}
+
+/// (sin r, cos r) in Q30 for r in Q30 with |r| <= pi/4: the Taylor polynomials of
+/// [`sin_cos_int`], r S(r^2) one 32 x 32 product. Out of line: one copy for
+/// [`sin_cos_q30`] and [`sin_cos_f32_q30`].
+#[inline(never)]
+fn sin_cos_reduced_q30(r: i32) -> (i32, i32) {
+    let z = ((i64::from(r) * i64::from(r)) >> 30) as i32;
+    let horner = |c: &[i32]| {
+        let mut acc = c[c.len() - 1];
+        for &ck in c[..c.len() - 1].iter().rev() {
+            acc = ((i64::from(acc) * i64::from(z) + (1 << 29)) >> 30) as i32 + ck;
+        }
+        acc
+    };
+    let s = ((i64::from(r) * i64::from(horner(&SIN_Q30)) + (1 << 29)) >> 30) as i32;
+    (s, horner(&COS_Q30))
+}
+
 /// pi/4 and pi/2 in Q60, rounded.
 const QUARTER_PI_Q60: u64 = 905_502_432_259_640_355;
 const HALF_PI_Q60: u64 = 1_811_004_864_519_280_711;

@@ -1,6 +1,6 @@
 //! The f32 sine/cosine against f64 libm, and the f64 sine/cosine against libm's.
 
-use core_math::trig::{atan_f32, sin_cos_f32, sin_cos_int};
+use core_math::trig::{atan_f32, sin_cos_f32, sin_cos_f32_q30, sin_cos_int, sin_cos_q30};
 use core_math::trig_f64;
 
 fn ulp_err(got: f32, exact: f64) -> f64 {
@@ -256,4 +256,91 @@ fn integer_sin_cos_within_1e8_and_the_rounding() {
             "{x}"
         );
     }
+}
+
+/// The Q30 sine and cosine on [0, pi/2] against f64 libm of the same Q30 argument: within
+/// 3 units of Q30 (the polynomials' truncation below 9e-12, six roundings of half a
+/// unit each through factors below 1, r^2's truncation), over 2^20 arguments and the
+/// ends.
+#[test]
+fn q30_sin_cos_within_three_units() {
+    let half_pi_q30 = 1_686_629_713i32;
+    let mut worst = 0f64;
+    let mut check = |x: i32| {
+        let (s, c) = sin_cos_q30(x);
+        let xf = f64::from(x) / (1u64 << 30) as f64;
+        for (got, want) in [(s, libm::sin(xf)), (c, libm::cos(xf))] {
+            let err = (f64::from(got) - want * (1u64 << 30) as f64).abs();
+            assert!(err <= 3.0, "sin_cos_q30({x}): {got} vs {want}");
+            worst = worst.max(err);
+        }
+    };
+    let mut x = 0x9E37_79B9u32;
+    for i in 0..(1u32 << 20) {
+        x ^= x << 13;
+        x ^= x >> 17;
+        x ^= x << 5;
+        check(((u64::from(x) * half_pi_q30 as u64) >> 32) as i32);
+        check(((u64::from(i) * half_pi_q30 as u64) >> 20) as i32);
+    }
+    for x in [
+        0,
+        1,
+        843_314_856,
+        843_314_857,
+        843_314_858,
+        half_pi_q30 - 1,
+        half_pi_q30,
+    ] {
+        check(x);
+    }
+    std::eprintln!("sin_cos_q30: worst {worst:.2} units of Q30");
+}
+
+/// The Q30 sine and cosine of an f32 angle against f64 libm of the same f32: within 4
+/// units of Q30 (the reduction's r rounded to Q30, then `sin_cos_q30`'s three), over 2^21
+/// angles below 4 rad of either sign, tiny and subnormal ones, and the quadrant edges;
+/// None from 4 rad on and for non-finite angles.
+#[test]
+fn f32_angle_q30_sin_cos_within_four_units() {
+    let mut worst = 0f64;
+    let mut check = |x: f32| {
+        let (s, c) = sin_cos_f32_q30(x).expect("below 4 rad");
+        let xf = f64::from(x);
+        for (got, want) in [(s, libm::sin(xf)), (c, libm::cos(xf))] {
+            let err = (f64::from(got) - want * (1u64 << 30) as f64).abs();
+            assert!(err <= 4.0, "sin_cos_f32_q30({x:e}): {got} vs {want}");
+            worst = worst.max(err);
+        }
+    };
+    let mut u = 0x9E37_79B9u32;
+    for _ in 0..(1u32 << 21) {
+        u ^= u << 13;
+        u ^= u >> 17;
+        u ^= u << 5;
+        let x = (f64::from(u) / f64::from(u32::MAX) * 8.0 - 4.0) as f32;
+        if x.abs() < 4.0 {
+            check(x);
+        }
+        // Every magnitude below 1.
+        check(f32::from_bits(u % 0x3f80_0000));
+        check(-f32::from_bits(u % 0x3f80_0000));
+    }
+    for x in [
+        0.0f32,
+        -0.0,
+        1e-30,
+        1e-45,
+        core::f32::consts::FRAC_PI_4,
+        2.356_194_5,
+        3.926_990_8,
+        3.999_999_8,
+    ] {
+        check(x);
+        check(-x);
+    }
+    for x in [4.0f32, -4.0, 100.0, f32::NAN, f32::INFINITY] {
+        assert!(sin_cos_f32_q30(x).is_none(), "{x}");
+    }
+    std::eprintln!("sin_cos_f32_q30: worst {worst:.2} units of Q30");
 }

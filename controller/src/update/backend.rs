@@ -201,27 +201,23 @@ impl Controller {
             });
             return (steer, boresight_h, ground);
         }
-        let steer = match (&ground, on_dem) {
-            (Ok(_), Some(m)) => steer_from(m.v1_mps, m.v2_mps, atan_pair_rad(m.v2_mps, m.v1_mps)),
-            (Ok(Ground { fixed: Some(f), .. }), None) => {
-                f.boresight_over_focal().ok().and_then(|(vf1, vf2)| {
-                    // Q63 rad/s, below 2^63: their squares stay inside f32's range.
-                    let (v1, v2) = (
-                        super::fixed::i64_to_f32(vf1, 0),
-                        super::fixed::i64_to_f32(vf2, 0),
-                    );
-                    steer_from(v1, v2, atan_pair_rad(v2, v1))
-                })
-            }
+        let turn = match (&ground, on_dem) {
+            // Over the DEM, the request from the boresight's f32 motion there.
+            (Ok(_), Some(m)) => steer_from(m.v1_mps, m.v2_mps, atan_pair_rad(m.v2_mps, m.v1_mps))
+                .map(|(sin, cos, rad)| (q30(sin), q30(cos), (sin, cos, rad))),
+            (Ok(Ground { fixed: Some(f), .. }), None) => f
+                .boresight_over_focal()
+                .ok()
+                .and_then(|(vf1, vf2)| steer_fixed(vf1, vf2)),
             _ => None,
         };
-        if let (Ok(g), Some((sin, cos, _))) = (&mut ground, steer) {
+        if let (Ok(g), Some((sin_q30, cos_q30, _))) = (&mut ground, turn) {
             g.yawed = g
                 .fixed
                 .as_ref()
-                .and_then(|f| f.yawed(q30(sin), q30(cos)).ok());
+                .and_then(|f| f.yawed(sin_q30, cos_q30).ok());
         }
-        (steer, boresight_h, ground)
+        (turn.map(|t| t.2), boresight_h, ground)
     }
 
     /// The yaw request from the boresight's motion in f32 on `ground`, the boresight
@@ -286,11 +282,48 @@ pub(super) fn steer_from(v1: f32, v2: f32, rad: f32) -> Option<(f32, f32, f32)> 
     (sin.is_finite() && cos.is_finite()).then_some((sin, cos, rad))
 }
 
-/// A sine or cosine in Q30 (|x| <= 1 to f32's rounding: inside i32).
+/// The yaw request from the boresight's (v1/f, v2/f) in Q63 (`vf1` not 0), in integers:
+/// the angle atan(v2/v1) in Q30 ([`atan_ratio_q30`]), its sine and cosine in Q30
+/// (`trig::sin_cos_q30`: sin = sign(v1) v2 / |v|, cos = |v1| / |v|, as [`steer_from`]
+/// forms them), and the f32 (sin, cos, angle) of [`Steer`], each rounded once from Q30.
+#[cfg(feature = "earth-fixed")]
+#[inline(always)]
+pub(super) fn steer_fixed(vf1: i64, vf2: i64) -> Option<(i32, i32, (f32, f32, f32))> {
+    let negative = (vf1 < 0) != (vf2 < 0);
+    let q = atan_ratio_q30(vf2.unsigned_abs(), vf1.unsigned_abs())?;
+    let (s, c) = core_math::trig::sin_cos_q30(q);
+    let s = if negative { -s } else { s };
+    let f32_of = |x: i32| signed_q30_to_f32(x.saturating_abs(), x < 0);
+    Some((s, c, (f32_of(s), f32_of(c), signed_q30_to_f32(q, negative))))
+}
+
+/// A sine or cosine in Q30, truncated toward zero: `(x * 2^30) as i32` from the f32's
+/// bits, without the software product and conversion (the same value for every |x| < 2,
+/// and 0 for NaN; `controller/src/update/fixed_tests.rs`).
 #[cfg(feature = "earth-fixed")]
 #[inline(always)]
 pub(super) fn q30(x: f32) -> i32 {
-    (x * (1u32 << 30) as f32) as i32
+    let bits = x.to_bits();
+    let biased = ((bits >> 23) & 0xff) as i32;
+    // |x| 2^30 = m 2^(biased - 120), m the 24-bit mantissa.
+    let m = (bits & 0x7f_ffff) | 0x80_0000;
+    let mag = match biased - 120 {
+        _ if biased == 0 => 0,
+        _ if biased == 0xff => {
+            if bits & 0x7f_ffff != 0 {
+                return 0;
+            }
+            u32::MAX
+        }
+        sh if sh >= 8 => u32::MAX,
+        sh if sh >= 0 => m << sh,
+        sh => m.checked_shr(sh.unsigned_abs()).unwrap_or(0),
+    };
+    if bits >> 31 != 0 {
+        (mag.min(1 << 31) as i32).wrapping_neg()
+    } else {
+        mag.min(i32::MAX as u32) as i32
+    }
 }
 
 /// What the segments over one ground height are evaluated from: the f32 general form's

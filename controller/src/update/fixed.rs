@@ -11,14 +11,14 @@ use core_math::ModelError;
 /// exactly, without the software conversion and product. For |x| 2^`exp2` inside f32's
 /// normal range (the callers': `exp2` 0 or -40, I24F40 bits).
 #[inline(always)]
-pub(super) fn i64_to_f32(x: i64, exp2: i32) -> f32 {
+pub(crate) fn i64_to_f32(x: i64, exp2: i32) -> f32 {
     let sign = if x < 0 { 1 << 31 } else { 0 };
     f32::from_bits(u64_to_f32(x.unsigned_abs(), exp2).to_bits() | sign)
 }
 
 /// [`i64_to_f32`] of a magnitude.
 #[inline(always)]
-pub(super) fn u64_to_f32(x: u64, exp2: i32) -> f32 {
+pub(crate) fn u64_to_f32(x: u64, exp2: i32) -> f32 {
     if x == 0 {
         return 0.0;
     }

@@ -154,9 +154,10 @@ fn period_and_mismatch_match_f64() {
 }
 
 /// The drift angle of an integer pair (the Cortex-M3's segments) against atan in f64 of
-/// the same integers: within 7e-9 rad (the polynomial's 4.2e-9 and the ratio's
-/// truncation to Q30 with its three of 2^-31) plus half an f32 ulp of the result, over
-/// pairs of every magnitude and ratio, and the edge cases.
+/// the same integers: within 3.5e-9 rad (the operands' truncation to 32 bits, the
+/// quotient's to Q32, the polynomial with its roundings and pi/4, pi/2 in Q30:
+/// docs/fixed-point.md) plus half an f32 ulp of the result, over pairs of every
+/// magnitude and ratio (so both sides of tan(pi/8)), and the edge cases.
 #[test]
 fn integer_pair_drift_angle_matches_atan() {
     use super::sweep::{atan_pair_rad, atan_ratio_rad};
@@ -167,7 +168,7 @@ fn integer_pair_drift_angle_matches_atan() {
         let want = libm::atan(num as f64 / den as f64) * if negative { -1.0 } else { 1.0 };
         let err = libm::fabs(got - want);
         assert!(
-            err <= 7e-9 + 0.5 * f64::from(f32::EPSILON) * libm::fabs(want),
+            err <= 3.5e-9 + 0.5 * f64::from(f32::EPSILON) * libm::fabs(want),
             "atan({num} / {den}) = {got} vs {want}"
         );
         worst = worst.max(err - 0.5 * f64::from(f32::EPSILON) * libm::fabs(want));
@@ -186,6 +187,10 @@ fn integer_pair_drift_angle_matches_atan() {
         (1, u64::MAX),
         (1 << 63, (1 << 63) - 1),
         (7, 1 << 40),
+        // Either side of tan(pi/8) (1 779 033 703.95 in Q32).
+        (1_779_033_703, 1 << 32),
+        (1_779_033_704, 1 << 32),
+        (1 << 32, 1_779_033_704),
     ] {
         check(num, den, false);
         check(num, den, true);
@@ -195,4 +200,85 @@ fn integer_pair_drift_angle_matches_atan() {
     assert_eq!(atan_ratio_rad(5, 0, true), atan_pair_rad(5.0, -0.0));
     assert!(atan_ratio_rad(0, 0, false).is_nan());
     std::eprintln!("integer pair drift angle: worst error beyond the f32 rounding {worst:.2e} rad");
+}
+
+/// `q30` from the bits gives what the product and the saturating conversion give, for
+/// every sign, magnitude and special value drawn.
+#[test]
+fn q30_from_bits_is_the_conversion() {
+    use super::backend::q30;
+    let mut rng = SplitMix64(0x5EED_2026_1127_0011);
+    let scale = (1u32 << 30) as f32;
+    let check = |x: f32| assert_eq!(q30(x), (x * scale) as i32, "{x:e} ({:#x})", x.to_bits());
+    for _ in 0..2_000_000 {
+        check(f32::from_bits(rng.next_u64() as u32));
+        // Mostly |x| <= 1, the sines and cosines it is given.
+        check(rng.uniform(-1.0, 1.0) as f32);
+    }
+    for x in [
+        0.0,
+        -0.0,
+        1.0,
+        -1.0,
+        2.0,
+        -2.0,
+        1.999_999_9,
+        -1.999_999_9,
+        f32::MIN_POSITIVE,
+        1e-40,
+        f32::INFINITY,
+        f32::NEG_INFINITY,
+        f32::NAN,
+    ] {
+        check(x);
+    }
+}
+
+/// The yaw request in integers from the boresight's (v1/f, v2/f) against f64 of the same
+/// integers: the sine and cosine (sign(v1) v2 / |v|, |v1| / |v|) within 7e-9 in Q30 (the
+/// angle's 3.5e-9 and sin_cos_q30's three units), their f32 forms and the angle within
+/// the same plus half an f32 ulp, over pairs of every magnitude, sign and ratio.
+#[test]
+fn integer_yaw_request_matches_f64() {
+    use super::backend::steer_fixed;
+    let mut rng = SplitMix64(0x5EED_2026_1127_0012);
+    let mut worst = 0f64;
+    let q30 = (1u64 << 30) as f64;
+    for i in 0..300_000 {
+        let vf1 = (draw_u64(&mut rng) >> 1).max(1) as i64;
+        let ratio = libm::exp(rng.uniform(-12.0, 12.0));
+        let vf2 = (vf1 as f64 * ratio).min(9.2e18) as i64;
+        let (vf1, vf2) = (
+            if i % 2 == 0 { vf1 } else { -vf1 },
+            if i % 3 == 0 { vf2 } else { -vf2 },
+        );
+        let (v1, v2) = (vf1 as f64, vf2 as f64);
+        let speed = libm::sqrt(v1 * v1 + v2 * v2);
+        let sign = if v1 < 0.0 { -1.0 } else { 1.0 };
+        let (want_sin, want_cos, want_rad) =
+            (sign * v2 / speed, sign * v1 / speed, libm::atan(v2 / v1));
+        let (s, c, (sf, cf, rad)) = steer_fixed(vf1, vf2).expect("v1 != 0");
+        let half_ulp = |x: f64| 0.5 * f64::from(f32::EPSILON) * libm::fabs(x);
+        for (got, want) in [
+            (f64::from(s) / q30, want_sin),
+            (f64::from(c) / q30, want_cos),
+        ] {
+            let err = libm::fabs(got - want);
+            assert!(err <= 7e-9, "({vf1}, {vf2}): {got} vs {want}");
+            worst = worst.max(err);
+        }
+        for (got, want, bound) in [
+            (sf, want_sin, 7e-9),
+            (cf, want_cos, 7e-9),
+            (rad, want_rad, 3.5e-9),
+        ] {
+            let err = libm::fabs(f64::from(got) - want);
+            assert!(
+                err <= bound + half_ulp(want),
+                "({vf1}, {vf2}): {got} vs {want}"
+            );
+        }
+    }
+    assert!(steer_fixed(0, 5).is_none());
+    std::eprintln!("integer yaw request: sine and cosine within {worst:.2e} in Q30");
 }

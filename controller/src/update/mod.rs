@@ -29,11 +29,11 @@ impl Controller {
         cfg!(feature = "fixed-only") || self.config.fixed_point_pixels
     }
 
-    /// The general form's per-instant constants of the NAV route: the attitude's sines
-    /// and cosines in integers with fixed-point pixels (a core without an FPU, where
-    /// each f32 operation is a software call), else in f32; either way through an
-    /// out-of-line form that the plan build calls too (inlined here, it was a second
-    /// copy: docs/target.md, flash).
+    /// The general form's per-instant constants of the NAV route: with fixed-point pixels
+    /// (a core without an FPU, where each f32 operation is a software call) in integers,
+    /// rounded once to f32 ([`instant::instant_int`]), else in f32 through an out-of-line
+    /// form that the plan build calls too (inlined here, it was a second copy:
+    /// docs/target.md, flash).
     #[inline(always)]
     fn nav_instant(
         &self,
@@ -44,16 +44,22 @@ impl Controller {
         let w = EARTH_RATE_RAD_S as f32;
         #[cfg(feature = "earth-fixed")]
         if self.fixed_pixels() {
-            return GENERAL_F32.instant_parts_with(
-                r,
-                v,
-                r2_minus_a2,
-                attitude,
-                w,
-                core_math::trig::sin_cos_int,
-            );
+            return instant::instant_int(r, v, r2_minus_a2, attitude, w);
         }
         GENERAL_F32.instant_parts(r, v, r2_minus_a2, attitude, w)
+    }
+
+    /// The NAV state `dt_s` after its frame: with fixed-point pixels in integers
+    /// ([`crate::nav::Propagator::parts_at_int`]) where its formats hold, else in f32.
+    #[inline(always)]
+    fn nav_state(&self, p: &crate::nav::Propagator, dt_s: f32) -> crate::nav::StateParts {
+        #[cfg(feature = "earth-fixed")]
+        if self.fixed_pixels() {
+            if let Some(s) = p.parts_at_int(dt_s) {
+                return s;
+            }
+        }
+        p.parts_at(dt_s)
     }
 
     /// Moves the clock to `now_us` (from the time source) and runs the update that is due,
@@ -101,7 +107,7 @@ impl Controller {
         let instant = match (&self.nav, &self.gnss, &self.attitude) {
             (Some(nav), _, _) if self.update_mode != Mode::Stale => {
                 let dt_s = seconds_since(t_us, nav.time_us);
-                let state = nav.propagator.parts_at(dt_s);
+                let state = self.nav_state(&nav.propagator, dt_s);
                 let attitude = attitude_at(&nav.attitude, dt_s);
                 self.nav_instant(&state, &attitude)
             }
@@ -320,9 +326,13 @@ mod backend;
 mod dem;
 #[cfg(feature = "earth-fixed")]
 mod fixed;
+#[cfg(feature = "earth-fixed")]
+mod instant;
 mod sweep;
 
 use backend::*;
+#[cfg(feature = "earth-fixed")]
+pub(crate) use fixed::i64_to_f32 as i64_to_f32_scaled;
 #[cfg(feature = "earth-fixed")]
 use fixed::*;
 pub use sweep::drift_angle_rad;

@@ -165,11 +165,8 @@ pub fn drift_angle_rad(t: f32) -> f32 {
 }
 
 /// atan(`num` / `den`) (rad) in integers, for a core without an FPU: the two f32
-/// mantissas divided in Q40, the odd polynomial of degree 19 on [0, 1] in Q30 (fitted
-/// to atan by weighted least squares, within 4.2e-9 evaluated this way), the octant
-/// past 1 by pi/2 - atan(den/num); then rounded once to f32 (docs/fixed-point.md, "The
-/// update on the Cortex-M3"). Non-finite inputs and a zero `den`: `atan_f32` of the
-/// f32 quotient.
+/// mantissas aligned to 32 bits (the smaller truncated), then [`atan_norm_rad`]. Non-finite
+/// inputs and a zero `den`: `atan_f32` of the f32 quotient.
 #[cfg(feature = "earth-fixed")]
 #[inline(never)]
 pub(super) fn atan_pair_rad(num: f32, den: f32) -> f32 {
@@ -179,7 +176,7 @@ pub(super) fn atan_pair_rad(num: f32, den: f32) -> f32 {
     }
     // For positive finite f32s the bits order as the values.
     let (small, big, past_one) = if a <= b { (a, b, false) } else { (b, a, true) };
-    let mantissa = |x: u32| u64::from((x & 0x7f_ffff) | 0x80_0000);
+    let mantissa = |x: u32| ((x & 0x7f_ffff) | 0x80_0000) << 8;
     // A subnormal or zero numerator counts as 0 (its ratio is below 2^-100).
     let m_small = if small < 0x0080_0000 {
         0
@@ -187,60 +184,99 @@ pub(super) fn atan_pair_rad(num: f32, den: f32) -> f32 {
         mantissa(small)
     };
     let shift = (big >> 23) - (small >> 23).max(1);
-    // m_small / m_big (< 2) in Q40 by five steps of long division, 8 bits each, in the
-    // core's 32-bit divide (the remainder stays below 2^24: no 64-bit division call);
-    // then over 2^shift, in Q30 rounded.
-    let m_big = mantissa(big) as u32;
-    let (mut q, mut rem) = (0u64, m_small as u32);
-    for _ in 0..5 {
-        let n = rem << 8;
-        let d = n.checked_div(m_big).unwrap_or(0);
-        q = (q << 8) + u64::from(d);
-        rem = n - d * m_big;
-    }
-    let r = (q.checked_shr(shift).unwrap_or(0) + (1 << 9)) >> 10;
-    let r = r.min(1 << 30) as i32;
-    atan_q30_rad(r, past_one, (num.to_bits() ^ den.to_bits()) >> 31 != 0)
+    atan_norm_rad(
+        m_small.checked_shr(shift).unwrap_or(0),
+        mantissa(big),
+        past_one,
+        (num.to_bits() ^ den.to_bits()) >> 31 != 0,
+    )
 }
 
-/// atan(`num` / `den`) (rad) of two integer magnitudes, negated when `negative`: the
-/// ratio of the smaller over the larger in [`Wide`], truncated to Q30, then
-/// [`atan_pair_rad`]'s polynomial and rounding (docs/fixed-point.md, "The update on the
-/// Cortex-M3"). A zero `den`: [`atan_pair_rad`] of the two as f32.
+/// atan(`num` / `den`) (rad) of two integer magnitudes, negated when `negative`:
+/// [`atan_ratio_q30`] rounded once to f32. A zero `den`: [`atan_pair_rad`] of the two as
+/// f32.
 #[cfg(feature = "earth-fixed")]
 #[inline(never)]
 pub(super) fn atan_ratio_rad(num: u64, den: u64, negative: bool) -> f32 {
-    use core_math::wide::Wide;
+    match atan_ratio_q30(num, den) {
+        Some(q) => signed_q30_to_f32(q, negative),
+        None => {
+            let sign = if negative { -1.0 } else { 1.0 };
+            atan_pair_rad(u64_to_f32(num, 0), sign * u64_to_f32(den, 0))
+        }
+    }
+}
+
+/// atan(`num` / `den`) in Q30 (in [0, pi/2]) of two integer magnitudes: the larger's
+/// leading one shifted to bit 63, both truncated to their top 32 bits, then
+/// [`atan_norm_q30`] (docs/fixed-point.md, "The update on the Cortex-M3"). None for a
+/// zero `den`.
+#[cfg(feature = "earth-fixed")]
+#[inline(always)]
+pub(super) fn atan_ratio_q30(num: u64, den: u64) -> Option<i32> {
     if den == 0 {
-        let sign = if negative { -1.0 } else { 1.0 };
-        return atan_pair_rad(u64_to_f32(num, 0), sign * u64_to_f32(den, 0));
+        return None;
     }
     let (small, big, past_one) = if num <= den {
         (num, den, false)
     } else {
         (den, num, true)
     };
-    // <= 1 in Q30.
-    let r = (Wide::from_u64(small, 0) / Wide::from_u64(big, 0))
-        .to_u64_scaled(30)
-        .min(1 << 30) as i32;
-    atan_q30_rad(r, past_one, negative)
+    let lz = big.leading_zeros();
+    let top = |x: u64| ((x << lz) >> 32) as u32;
+    Some(atan_norm_q30(top(small), top(big), past_one))
 }
 
-/// The tail both integer arctangents share: atan(`r`) of the ratio `r` in Q30 on [0, 1],
-/// its complement when the ratio was `past_one`, rounded once to f32 and negated when
-/// `negative`.
-// Out of line: inlined, the unrolled polynomial was a copy in each of the two.
+/// `q` 2^-30 (>= 0) as f32, negated when `negative`.
 #[cfg(feature = "earth-fixed")]
-#[inline(never)]
-fn atan_q30_rad(r: i32, past_one: bool, negative: bool) -> f32 {
-    let at = atan_unit_q30(r);
-    let q = if past_one { HALF_PI_Q30 - at } else { at };
+#[inline(always)]
+pub(super) fn signed_q30_to_f32(q: i32, negative: bool) -> f32 {
     let rad = q30_to_f32(q.max(0) as u32);
     if negative {
         -rad
     } else {
         rad
+    }
+}
+
+/// [`atan_norm_q30`] rounded once to f32, negated when `negative`.
+#[cfg(feature = "earth-fixed")]
+#[inline(always)]
+fn atan_norm_rad(s: u32, b: u32, past_one: bool, negative: bool) -> f32 {
+    signed_q30_to_f32(atan_norm_q30(s, b, past_one), negative)
+}
+
+/// The tail both integer arctangents share: atan(`s` / `b`) in Q30 for `s` <= `b` and
+/// `b` in [2^31, 2^32), its complement pi/2 - atan when the ratio was `past_one`. Past
+/// tan(pi/8) the ratio x is reduced to (1 - x) / (1 + x), atan x = pi/4 - atan((1 - x) /
+/// (1 + x)), formed from the integers before the one division, so that the odd
+/// polynomial covers only [0, tan(pi/8)].
+// Out of line: inlined, the polynomial was a copy in each caller.
+#[cfg(feature = "earth-fixed")]
+#[inline(never)]
+fn atan_norm_q30(s: u32, b: u32, past_one: bool) -> i32 {
+    use core_math::wide::div_64_32;
+    // s / b > tan(pi/8), compared exactly in u64.
+    let reduced = u64::from(s) << 32 > u64::from(TAN_PI_8_Q32) * u64::from(b);
+    // The ratio in Q32, truncated (< 0.4143: inside i32). Each division's high word is
+    // below its divisor, which is normalised, as `div_64_32` needs.
+    let x_q32 = if !reduced {
+        // s < b here (s = b is past tan(pi/8)).
+        div_64_32(s, 0, b)
+    } else {
+        let (n, d) = (b - s, u64::from(b) + u64::from(s));
+        match u32::try_from(d) {
+            Ok(d) => div_64_32(n, 0, d),
+            // d in [2^32, 2^33): its last bit dropped, n / d = (n / 2) / (d / 2).
+            Err(_) => div_64_32(n >> 1, n << 31, (d >> 1) as u32),
+        }
+    };
+    let at = atan_small_q30(x_q32.min(TAN_PI_8_Q32) as i32);
+    let at = if reduced { QUARTER_PI_Q30 - at } else { at };
+    if past_one {
+        HALF_PI_Q30 - at
+    } else {
+        at
     }
 }
 
@@ -251,38 +287,40 @@ fn atan_pair_cold(num: f32, den: f32) -> f32 {
     drift_angle_rad(num / den)
 }
 
-/// pi/2 in Q30, rounded.
+/// pi/2 and pi/4 in Q30, rounded.
 #[cfg(feature = "earth-fixed")]
 const HALF_PI_Q30: i32 = 1_686_629_713;
-
-/// atan(x) / x as a polynomial in x^2 on [0, 1], Q30 (a weighted least-squares fit:
-/// `docs/fixed-point.md`, "The update on the Cortex-M3").
 #[cfg(feature = "earth-fixed")]
-const ATAN_Q30: [i32; 10] = [
-    1_073_741_803,
-    -357_912_299,
-    214_710_104,
-    -152_978_376,
-    116_801_687,
-    -88_194_453,
-    59_085_752,
-    -30_591_534,
-    10_272_750,
-    -1_620_580,
+const QUARTER_PI_Q30: i32 = 843_314_857;
+
+/// tan(pi/8) in Q32, rounded.
+#[cfg(feature = "earth-fixed")]
+const TAN_PI_8_Q32: u32 = 1_779_033_704;
+
+/// atan(x) / x as a polynomial in x^2 on [0, tan(pi/8)], Q30: a weighted least-squares
+/// fit, within 1.2e-10 of atan (`docs/fixed-point.md`, "The update on the Cortex-M3").
+#[cfg(feature = "earth-fixed")]
+const ATAN_Q30: [i32; 6] = [
+    1_073_741_820,
+    -357_913_270,
+    214_716_287,
+    -152_729_047,
+    112_523_387,
+    -62_656_717,
 ];
 
-/// atan(x) for x in Q30 on [0, 1], in Q30: every partial sum below 1.1 in Q30, so
+/// atan(x) in Q30 for x in Q32 on [0, tan(pi/8)]: every partial sum below 1 in Q30, so
 /// each step is one 32 x 32 -> 64 product.
 #[cfg(feature = "earth-fixed")]
 #[inline(always)]
-fn atan_unit_q30(x: i32) -> i32 {
+fn atan_small_q30(x_q32: i32) -> i32 {
     let mul = |a: i32, b: i32| ((i64::from(a) * i64::from(b) + (1 << 29)) >> 30) as i32;
-    let z = ((i64::from(x) * i64::from(x)) >> 30) as i32;
-    let mut acc = ATAN_Q30[9];
-    for &c in ATAN_Q30[..9].iter().rev() {
+    let z = ((i64::from(x_q32) * i64::from(x_q32)) >> 34) as i32;
+    let mut acc = ATAN_Q30[5];
+    for &c in ATAN_Q30[..5].iter().rev() {
         acc = mul(acc, z) + c;
     }
-    mul(x, acc)
+    ((i64::from(x_q32) * i64::from(acc) + (1 << 31)) >> 32) as i32
 }
 
 /// `q` 2^-30 as f32, rounded to nearest (ties away from zero), without the software

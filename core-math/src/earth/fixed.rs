@@ -607,7 +607,7 @@ fn times_focal(x: i64, px: &EarthFixedPixel) -> i64 {
 /// one Newton step for 1/sqrt(f) (r1, Q29), s = f r1 (Q31), one Heron correction with
 /// xn's full 64 bits; sqrt(x) = 2 y 2^(-z/2), y = sqrt(xn 2^-64) in Q31.
 #[inline(always)]
-fn sqrt_u64(x: u64) -> u64 {
+pub fn sqrt_u64(x: u64) -> u64 {
     if x == 0 {
         return 0;
     }
