@@ -75,6 +75,8 @@ pub struct StarAttitude {
 }
 
 impl StarAttitude {
+    // Out of line: the frame's check and the restart's restore of the blend's seed.
+    #[inline(never)]
     pub fn decode(payload: &[u8]) -> Result<StarAttitude, Fault> {
         if payload.len() != ATTITUDE_LEN {
             return Err(Fault::BadLength);
@@ -98,7 +100,8 @@ impl StarAttitude {
     pub fn encode(&self, out: &mut [u8]) -> Option<usize> {
         let mut w = Writer::new(out);
         w.put(&self.valid_us.to_le_bytes())?;
-        for x in self.q.iter().chain(&self.body_rate_rad_s) {
+        let (q, b) = (self.q, self.body_rate_rad_s);
+        for x in [q[0], q[1], q[2], q[3], b[0], b[1], b[2]] {
             w.put(&x.to_le_bytes())?;
         }
         Some(w.len())

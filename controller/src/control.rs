@@ -124,6 +124,9 @@ pub struct Controller {
     /// in force ([`crate::track`]).
     pub(crate) gnss: Option<GnssState>,
     pub(crate) attitude: Option<AttitudeState>,
+    /// The attitude estimate kept across a reset (`restart`): the blend's last estimate
+    /// until an ATTITUDE frame is in force again.
+    pub(crate) blend_seed: Option<crate::bus::StarAttitude>,
     /// GPS - UTC and UT1 - UTC in force (TIME_SCALES; the contract's defaults, 18 s
     /// and 0, from boot).
     pub(crate) time_scales: TimeScales,
@@ -204,6 +207,7 @@ impl Controller {
             nav: None,
             gnss: None,
             attitude: None,
+            blend_seed: None,
             time_scales: TimeScales::DEFAULT,
             pole: None,
             last_time_us: None,

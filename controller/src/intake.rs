@@ -236,9 +236,13 @@ impl Controller {
         // Blended only once it passed the quaternion's own check: a bad one is refused as
         // it came.
         crate::track::check_quaternion(&received)?;
-        let taken = match &self.attitude {
-            Some(last) => self.config.attitude_blend.blend(last, &received),
-            None => received,
+        // The last attitude carried, else the estimate kept across a reset (its rates'
+        // change is not kept: the first blend after it carries the rates alone).
+        let blend = &self.config.attitude_blend;
+        let taken = match (&self.attitude, &self.blend_seed) {
+            (Some(last), _) => blend.blend(&last.received, last.body_accel_rad_s2, &received),
+            (None, Some(seed)) => blend.blend(seed, [0.0; 3], &received),
+            (None, None) => received,
         };
         let state = AttitudeState::derive(
             &taken,

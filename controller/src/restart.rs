@@ -11,7 +11,7 @@
 //! scene is planned and the heights put back; every period stays flagged held until
 //! the first update on fresh telemetry (docs/target.md, "Faults and resets").
 
-use crate::bus::{decode_time_scales, encode_time_scales};
+use crate::bus::{decode_time_scales, encode_time_scales, StarAttitude};
 use crate::control::{Controller, SegmentOutput};
 use crate::fault::Fault;
 use crate::frame::MAX_PAYLOAD;
@@ -106,6 +106,11 @@ pub struct Snapshot {
     pub time_scales: Payload,
     /// The outputs in force (a PERIODS payload).
     pub periods: Payload,
+    /// The attitude estimate in force (an ATTITUDE payload: the blended quaternion,
+    /// its body rates and time of validity; empty before the first): the attitude
+    /// blend goes on from it after a reset, so that a reset that loses no frame changes
+    /// no period once fresh frames arrive.
+    pub attitude: Payload,
 }
 
 impl Snapshot {
@@ -114,6 +119,7 @@ impl Snapshot {
         terrain: Payload::EMPTY,
         time_scales: Payload::EMPTY,
         periods: Payload::EMPTY,
+        attitude: Payload::EMPTY,
     };
 }
 
@@ -148,6 +154,15 @@ impl Controller {
     /// Writes the outputs in force into `out` (after every update).
     pub fn snapshot_periods(&self, out: &mut Payload) -> bool {
         out.fill(|b| encode_periods(self, b))
+    }
+
+    /// Writes the attitude estimate in force into `out` (empty without one; after
+    /// every update, with the periods).
+    pub fn snapshot_attitude(&self, out: &mut Payload) -> bool {
+        match &self.attitude {
+            Some(a) => out.fill(|b| a.received.encode(b)),
+            None => out.fill(|_| Some(0)),
+        }
     }
 
     /// Puts `snapshot` back after a reset: [`write_kept_periods`], then
@@ -194,6 +209,11 @@ impl Controller {
             }
         }
         self.yaw_request_rad = periods.yaw_request_rad;
+        // The blend's seed, checked as an ATTITUDE frame's payload is; none when empty
+        // or refused (the blend then starts from the first frame).
+        self.blend_seed = StarAttitude::decode(snapshot.attitude.as_slice())
+            .ok()
+            .filter(|a| crate::track::check_quaternion(a).is_ok());
         Ok(Restored {
             periods: written.iter().filter(|w| **w).count(),
         })

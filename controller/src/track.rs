@@ -179,18 +179,24 @@ impl AttitudeBlend {
         max_gap_us: 0,
     };
 
-    /// `new` blended with `last` carried to its time of validity (in f32: the
-    /// quaternions' rounding, 6e-8, is a thirtieth of the blended estimate's noise at a
-    /// 4-arcsecond star tracker). `new` is later than `last` (the intake's checks).
-    pub fn blend(&self, last: &AttitudeState, new: &StarAttitude) -> StarAttitude {
-        let gap_us = new.valid_us.saturating_sub(last.received.valid_us);
+    /// `new` blended with `last` carried to its time of validity at its body rates and
+    /// their change `accel_rad_s2` (body axes) (in f32: the quaternions' rounding, 6e-8,
+    /// is a thirtieth of the blended estimate's noise at a 4-arcsecond star tracker).
+    /// `new` is later than `last` (the intake's checks).
+    pub fn blend(
+        &self,
+        last: &StarAttitude,
+        accel_rad_s2: [f32; 3],
+        new: &StarAttitude,
+    ) -> StarAttitude {
+        let gap_us = new.valid_us.saturating_sub(last.valid_us);
         if !(self.gain < 1.0 && gap_us <= self.max_gap_us) {
             return *new;
         }
         let dt_s = gap_us as f32 * 1e-6;
-        let (w, accel) = (last.received.body_rate_rad_s, last.body_accel_rad_s2);
+        let (w, accel) = (last.body_rate_rad_s, accel_rad_s2);
         let turn: [f32; 3] = core::array::from_fn(|i| (w[i] + 0.5 * accel[i] * dt_s) * dt_s);
-        let predicted = q_unit(q_mul(last.received.q, q_exp(turn)));
+        let predicted = q_unit(q_mul(last.q, q_exp(turn)));
         let inverse = [predicted[0], -predicted[1], -predicted[2], -predicted[3]];
         let mut d = q_mul(inverse, q_unit(new.q));
         if d[0] < 0.0 {

@@ -44,7 +44,7 @@ struct Record {
 }
 
 const MAGIC: u32 = 0x5444_4952; // "TDIR"
-const VERSION: u32 = 3;
+const VERSION: u32 = 4;
 
 impl Record {
     // Out of line: the boot, the HardFault handler and the cause's note all seal or
@@ -75,8 +75,8 @@ impl Record {
 }
 
 /// The region's contents: the record, then the snapshot with its two CRCs (one for the
-/// scene and heights, written when they change; one for the periods, written after
-/// every update), each over the payloads' lengths and bytes. `repr(C)`; the snapshot's
+/// scene and heights, written when they change; one for the periods and the attitude
+/// estimate, written after every update), each over the payloads' lengths and bytes. `repr(C)`; the snapshot's
 /// fields are `u16`s and bytes, so any contents are a valid value, checked before use.
 #[repr(C)]
 struct Region {
@@ -139,10 +139,13 @@ fn payload_crc(parts: &[&Payload]) -> u32 {
 pub struct Kept {
     inputs_generation: Option<u32>,
     updates: Option<u32>,
+    /// The attitude estimate's time of validity (an ATTITUDE frame changes it).
+    attitude_us: Option<u64>,
 }
 
 /// Keeps the controller's snapshot up to date in retained RAM: the scene and heights
-/// when they have changed, the periods after each update.
+/// when they have changed, the periods and the attitude estimate after each update and
+/// each new attitude.
 pub fn keep(c: &Controller, kept: &mut Kept) {
     // SAFETY: the loop is the only user of the region while it runs (`region`).
     let region = unsafe { region() };
@@ -163,13 +166,13 @@ pub fn keep(c: &Controller, kept: &mut Kept) {
             ])
         };
     }
-    if kept.updates != Some(c.updates) {
-        kept.updates = Some(c.updates);
-        region.periods_crc = if c.snapshot_periods(&mut region.snapshot.periods) {
-            payload_crc(&[&region.snapshot.periods])
-        } else {
-            !payload_crc(&[&region.snapshot.periods])
-        };
+    let attitude_us = c.bus_attitude().map(|a| a.received.valid_us);
+    if kept.updates != Some(c.updates) || kept.attitude_us != attitude_us {
+        (kept.updates, kept.attitude_us) = (Some(c.updates), attitude_us);
+        let s = &mut region.snapshot;
+        let written = c.snapshot_periods(&mut s.periods) && c.snapshot_attitude(&mut s.attitude);
+        let crc = payload_crc(&[&s.periods, &s.attitude]);
+        region.periods_crc = if written { crc } else { !crc };
     }
 }
 
@@ -186,7 +189,8 @@ pub fn snapshot(boot: &Boot) -> Option<&'static Snapshot> {
                 &region.snapshot.terrain,
                 &region.snapshot.time_scales,
             ])
-        && region.periods_crc == payload_crc(&[&region.snapshot.periods]);
+        && region.periods_crc
+            == payload_crc(&[&region.snapshot.periods, &region.snapshot.attitude]);
     ok.then_some(&region.snapshot)
 }
 

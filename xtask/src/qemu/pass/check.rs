@@ -225,7 +225,8 @@ fn restarted(
 ) -> Result<Controller> {
     let mut snapshot = controller::restart::Snapshot::EMPTY;
     let kept = before.controller.snapshot_inputs(&mut snapshot)
-        && before.controller.snapshot_periods(&mut snapshot.periods);
+        && before.controller.snapshot_periods(&mut snapshot.periods)
+        && before.controller.snapshot_attitude(&mut snapshot.attitude);
     if !kept {
         return Err(anyhow!("the host run kept no snapshot before the reset"));
     }

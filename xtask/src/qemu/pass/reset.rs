@@ -236,8 +236,10 @@ pub struct Report {
     /// largest relative change of a period among them.
     pub changed: usize,
     pub largest_change: f64,
-    /// The attitude blend was in force, and the reset restarted it.
-    pub blend_restarts: bool,
+    /// The attitude blend was in force: the reset keeps its estimate, not the change of
+    /// the rates it carries (made again from the next GNSS fix), so the first frames
+    /// after it may round a period otherwise.
+    pub blend_in_force: bool,
     pub examples: Vec<String>,
     /// PERIODS and STATUS frames compared with the host's model of the reset.
     pub modelled: (usize, usize),
@@ -307,7 +309,7 @@ impl Report {
         Decoder::new().feed(before, |e| {
             attitude_frames |= matches!(e, Event::Frame(f) if f.kind == kind::ATTITUDE);
         });
-        let blend_restarts = attitude_frames && config.attitude_blend.gain < 1.0;
+        let blend_in_force = attitude_frames && config.attitude_blend.gain < 1.0;
         if let Some(fresh) = fresh_at_us {
             // Mode, ticks and held flags: the drift and yaw request may differ in their
             // last bits on the bus's frames, whose C2T pole (kept up to a minute by
@@ -391,7 +393,7 @@ impl Report {
             fresh_at_us,
             changed,
             largest_change,
-            blend_restarts,
+            blend_in_force,
             examples,
             modelled,
             unlike_model,
@@ -418,9 +420,9 @@ impl Report {
         let fresh = self.fresh_at_us.map_or("never fresh again".into(), |t| {
             format!("held until fresh telemetry at {:.2} s", t as f64 * 1e-6)
         });
-        let blend = if self.blend_restarts {
+        let blend = if self.blend_in_force {
             format!(
-                " (the attitude blend restarts from the first frame after it: largest period change {:.1e})",
+                " (the attitude blend in force: its estimate kept, taken up again by a frame within its largest gap: largest period change {:.1e})",
                 self.largest_change
             )
         } else {
@@ -463,11 +465,12 @@ impl Report {
         if self.fresh_at_us.is_none() {
             p.push("no fresh update after the reset".into());
         }
-        // A reset restarts the attitude blend (its estimate is not kept), and one that
-        // loses frames loses them as a link would: either may change later outputs, and
-        // the host's model of the same reset is the check. Without a blend in force
-        // (NAV, or the blend off) and without a loss, nothing may change.
-        if self.lost.is_empty() && !self.blend_restarts {
+        // A reset keeps the attitude blend's estimate but not its rates' change (until
+        // the next fix), and one that loses frames loses them as a link would: either
+        // may change later outputs, and the host's model of the same reset is the
+        // check. Without a blend in force (NAV, or the blend off) and without a loss,
+        // nothing may change.
+        if self.lost.is_empty() && !self.blend_in_force {
             p.extend(self.examples.iter().cloned());
         }
         p.extend(self.unlike_model.iter().cloned());
