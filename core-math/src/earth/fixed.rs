@@ -133,10 +133,9 @@ struct Terms {
     w0: [i64; 2],
     /// -W1, -W3, Q33.
     nw: [i32; 2],
-    /// -V1 2^30 and -V2 2^30, Q70.
+    /// V1 2^30 + 2^30 and V2 2^30 + 2^30, Q70: the constant terms of V_k + t_k V3, and
+    /// half a unit of Q39.
     v0: [i64; 2],
-    /// -V3, Q40.
-    nv3: i32,
 }
 
 impl Terms {
@@ -148,8 +147,10 @@ impl Terms {
             s0: -(wide(m[2]) << 30) + (1 << 31),
             w0: [wide(w[1]) << 30, -(wide(w[0]) << 30)],
             nw: [-w[0], -w[2]],
-            v0: [-(wide(v[0]) << 30), -(wide(v[1]) << 30)],
-            nv3: -v[2],
+            v0: [
+                (wide(v[0]) << 30) + (1 << 30),
+                (wide(v[1]) << 30) + (1 << 30),
+            ],
         }
     }
 }
@@ -466,11 +467,11 @@ impl EarthFixedUpdate {
         let m3 = i64::from(self.m[2]);
         // (m.u')^2: Q66 -> Q30, < 0.026.
         let alpha = (1u32 << 30) + ((m3 * m3) >> 36) as u32;
-        let inv_s = i64::from(inv_sigma(b31, alpha, self)?);
-        // V_k / sigma: Q40 x Q25 = Q65, |.| < 2^62.2, to Q63.
+        let ninv_s = i64::from(neg_inv_sigma(b31, alpha, self)?);
+        // -V_k / sigma: Q40 x Q24 = Q64, |.| < 2^61.2, to Q63.
         let [w1, w2, _] = self.w;
-        let vf1 = (i64::from(w2) << 30) - ((i64::from(self.v[0]) * inv_s) >> 2);
-        let vf2 = -(i64::from(w1) << 30) - ((i64::from(self.v[1]) * inv_s) >> 2);
+        let vf1 = (i64::from(w2) << 30) + ((i64::from(self.v[0]) * ninv_s) >> 1);
+        let vf2 = -(i64::from(w1) << 30) + ((i64::from(self.v[1]) * ninv_s) >> 1);
         if vf1 == 0 {
             return Err(ModelError::NoAlongTrackMotion);
         }
@@ -608,23 +609,32 @@ impl Backend<Earth> for EarthFixed {
         let s31 = (mac(mac(k.s0, up.m[0], t1), up.m[1], t2) >> 32) as i32;
         // alpha = |u'|^2 + (m.u')^2, Q30 (the square's high word), < 3.08.
         let alpha = px.uu + ((i64::from(s31) * i64::from(s31)) >> 32) as u32;
-        // 1/sigma, Q25 (< 2^31.2).
-        let inv_s = inv_sigma(b31, alpha, up)?;
+        // -1/sigma, Q24 (> -2^30.2).
+        let ninv_s = neg_inv_sigma(b31, alpha, up)?;
+        // V_k + t_k V3, Q70 -> Q39 (rounded), |.| < 2^-8: below 2^31 as V_k < 2^-9.
+        let v3 = up.v[2];
+        let p1 = (mac(k.v0[0], v3, t1) >> 31) as i32;
+        let p2 = (mac(k.v0[1], v3, t2) >> 31) as i32;
         // v/f, Q63: W terms Q33 x Q30, each < 2^60, four of them < 2^62; the V term
-        // -(V_k + t_k V3) in Q70 (< 2^62) times 1/sigma, Q95, its top 64 bits
-        // (< 2^61.2); sum < 2^62.7.
+        // Q39 x Q24, < 2^61.2; sum < 2^62.7.
         let [_, w2, w3] = up.w;
-        let vf1 = mac(mac(mac(k.w0[0], w2, px.t11), w3, t2), k.nw[0], px.t12)
-            + mul_hi(mac(k.v0[0], k.nv3, t1), inv_s);
-        let vf2 = mac(mac(mac(k.w0[1], k.nw[0], px.t22), k.nw[1], t1), w2, px.t12)
-            + mul_hi(mac(k.v0[1], k.nv3, t2), inv_s);
-        let v1 = times_focal(vf1, px);
+        let vf1 = mac(
+            mac(mac(mac(k.w0[0], p1, ninv_s), w2, px.t11), w3, t2),
+            k.nw[0],
+            px.t12,
+        );
+        let vf2 = mac(
+            mac(mac(mac(k.w0[1], p2, ninv_s), k.nw[0], px.t22), k.nw[1], t1),
+            w2,
+            px.t12,
+        );
+        let (v1, v2) = (times_focal(vf1, px), times_focal(vf2, px));
         if v1 == 0 {
             return Err(ModelError::NoAlongTrackMotion);
         }
         Ok(ImageMotion {
             v1_mps: I24F40::from_bits(v1),
-            v2_mps: I24F40::from_bits(times_focal(vf2, px)),
+            v2_mps: I24F40::from_bits(v2),
         })
     }
 }
@@ -641,38 +651,38 @@ fn mulhi(a: u32, b: u32) -> u32 {
     ((u64::from(a) * u64::from(b)) >> 32) as u32
 }
 
-/// floor(x u / 2^32), exactly, for |x u| / 2^32 < 2^63: the top 64 bits of the 96-bit
-/// product, from two 32 x 32 -> 64 products (x = hi 2^32 + lo).
+/// -1/sigma (1/sigma the near root's reciprocal) in Q24 from |beta| (Q31) and alpha
+/// (Q30), with the update's C and |r|^2/C; a ray whose discriminant is negative misses.
+/// Negative, so that its products are plainly signed ones (SMLAL).
 #[inline(always)]
-fn mul_hi(x: i64, u: u32) -> i64 {
-    let (hi, lo) = ((x >> 32) as i32, x as u32);
-    i64::from(hi) * i64::from(u) + i64::from(mulhi(lo, u))
-}
-
-/// 1/sigma, the near root's reciprocal, in Q25 from |beta| (Q31) and alpha (Q30), with
-/// the update's C and |r|^2/C; a ray whose discriminant is negative misses.
-#[inline(always)]
-fn inv_sigma(b31: u32, alpha: u32, up: &EarthFixedUpdate) -> Result<u32, ModelError> {
+fn neg_inv_sigma(b31: u32, alpha: u32, up: &EarthFixedUpdate) -> Result<i32, ModelError> {
     // beta^2 and alpha C, Q62, < 2^63.7 and 2^62.7.
     let bb = u64::from(b31) * u64::from(b31);
     let ac = u64::from(alpha) * u64::from(up.c);
-    let Some(disc) = bb.checked_sub(ac) else {
+    let (disc, miss) = bb.overflowing_sub(ac);
+    if miss {
         return Err(ModelError::LineOfSightMissesEarth);
-    };
+    }
     // sqrt(disc), Q31.
     let root = sqrt_u64(disc);
     // (sqrt(disc) + |beta|) / 2, Q30, the numerator of 1/sigma (< 3.56): the halving
     // add that needs no 33rd bit.
     let num = (root & b31) + ((root ^ b31) >> 1);
-    // 1/sigma = num |r|^2/C: Q57 (< 71.2 = 2^63.2), its high word Q25 (< 2^31.2).
-    Ok(mulhi(num, up.inv_c))
+    // 1/sigma = num |r|^2/C: Q57 (< 71.2 = 2^63.2), its high word Q25 (< 2^31.2),
+    // halved to Q24 (< 2^30.2) for signed products.
+    Ok(-((mulhi(num, up.inv_c) >> 1) as i32))
 }
 
 /// (v/f in Q63) x f as I24F40 bits: x f_mant 2^-e 2^-23 = (x f_mant 2^-32) >> (e - 9),
 /// e - 9 in 13..29. Truncated toward -infinity twice: 2^-40 m/s at most each.
 #[inline(always)]
 fn times_focal(x: i64, px: &EarthFixedPixel) -> i64 {
-    shr(mul_hi(x, px.f_mant), px.shift)
+    // x f_mant 2^-32 exactly, with f_mant = g + 2^32 (g its bits as i32, negative
+    // since f_mant >= 2^31): hi g + hi 2^32 + (lo f_mant) 2^-32, one UMULL and one SMLAL.
+    let (hi, lo) = ((x >> 32) as i32, x as u32);
+    let m = px.f_mant;
+    let top = i64::from(hi) * i64::from(m as i32) + (i64::from(hi) << 32) + i64::from(mulhi(lo, m));
+    shr(top, px.shift)
 }
 
 /// floor(sqrt(x)) within 2 units (`sqrt_u64_within_two_units`; measured 1), integer
