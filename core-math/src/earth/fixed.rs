@@ -139,6 +139,8 @@ struct Terms {
 }
 
 impl Terms {
+    // Out of line: one copy for every constructor of the update (flash).
+    #[inline(never)]
     fn of(m: &[i32; 3], rho: &[i32; 3], w: &[i32; 3], v: &[i32; 3]) -> Terms {
         let wide = |x: i32| i64::from(x);
         Terms {
@@ -278,7 +280,7 @@ impl EarthFixed {
         let sh = if (re - 40) % 2 == 0 { 40 } else { 39 };
         let big_m = (rm as u64) << sh;
         // |r| = s 2^h, s in [2^31, 2^32] (within 2 units), 1/|r| = inv 2^(-63 - h).
-        let s = u64::from(sqrt_u64(big_m));
+        let s = u64::from(sqrt_per_update(big_m));
         let h = (re - sh) / 2;
         let inv = (1u64 << 63).checked_div(s).ok_or(position)? as i64;
         // x / |r| in Q`frac`: its mantissa times inv, exact in i64 (< 2^56).
@@ -324,7 +326,7 @@ impl EarthFixed {
         // sqrt(kappa^2 - 1) = sk 2^((ke - sh) / 2) (within 2 units of 32 bits), sh making
         // the exponent even.
         let sh = if (ke - 40) % 2 == 0 { 40 } else { 39 };
-        let sk = i64::from(sqrt_u64((km as u64) << sh));
+        let sk = i64::from(sqrt_per_update((km as u64) << sh));
         let stretched = |x: f32| -> Option<i64> {
             let (m, e) = parts(x);
             round_shift(sk * m, (ke - sh) / 2 + e + 33)
@@ -685,11 +687,17 @@ fn times_focal(x: i64, px: &EarthFixedPixel) -> i64 {
     shr(top, px.shift)
 }
 
-/// floor(sqrt(x)) within 2 units (`sqrt_u64_within_two_units`; measured 1), integer
-/// only, no division (core's `isqrt` divides, a `__aeabi_uldivmod` call on a 32-bit
+/// [`sqrt_u64`] out of line, for the per-update code (one copy in flash).
+#[inline(never)]
+fn sqrt_per_update(x: u64) -> u32 {
+    sqrt_u64(x)
+}
+
+/// sqrt(x), never above it and at most 2 units below (`sqrt_u64_within_two_units`),
+/// integer only, no division (core's `isqrt` divides, a `__aeabi_uldivmod` call on a 32-bit
 /// core), in 32-bit halves. The round Earth's scheme (`docs/fixed-point.md`): x
 /// normalised by an even shift z to xn in [2^62, 2^64) (x below 2^32 first taken as
-/// x 2^32), f = its high word in [2^30, 2^32); a seed r0 of 2^32/sqrt(f) from f's top
+/// x 2^32), f = its high word in [2^30, 2^32); a seed r0 of 1/sqrt(f 2^-32) from f's top
 /// 10 bits, one Newton step r1 = r0 (3 - f r0^2) / 2 with the product rounded up, so
 /// that r1 <= 1/sqrt(f) (Newton's step for 1/sqrt never overshoots), s = f r1 <=
 /// sqrt(xn), then Heron's correction (xn - s^2) r1 / 2 from xn's 64 bits (xn - s^2 >= 0
