@@ -105,25 +105,30 @@ fn bound(c: &EarthCase, g: &EarthGeometry<f64>, v_ref: &ImageMotion<f64>) -> f64
     let disc = (beta * beta - alpha * cc).max(0.0);
     let num = disc.sqrt() - beta;
     let inv_s = num / cc;
-    let e = v.map(|x| x * inv_s);
 
-    // Inputs of beta and n.u': Q30 roundings of rho, n (per component) and t.
+    // Inputs of beta: Q30 roundings of rho (per component) and t; |beta| to Q31.
     let sum_t = t[0].abs() + t[1].abs() + 1.0;
     let d_beta = sum_t * p2(-31) + (rho[0].abs() + rho[1].abs()) * p2(-31) + p2(-32);
-    let d_nu = sum_t * p2(-31) + (n[0].abs() + n[1].abs()) * p2(-31) + p2(-31);
-    // alpha: |u'|^2 rounded, the two Q30 floors of the stretch term, k's Q36 rounding.
-    let d_alpha = p2(-31) + p2(-30) + k * (p2(-30) + 2.0 * nu.abs() * d_nu) + nu * nu * p2(-37);
+    // m.u' (m = sqrt(k) n): m's Q33 roundings, t's, the rounding to Q31.
+    let m = n.map(|x| libm::sqrt(k) * x);
+    let s = dot(m, t);
+    let d_s = sum_t * p2(-34) + (m[0].abs() + m[1].abs()) * p2(-31) + p2(-32);
+    // alpha: |u'|^2 rounded, the square of m.u' floored to Q30.
+    let d_alpha = p2(-31) + p2(-30) + 2.0 * s.abs() * d_s + d_s * d_s;
     let d_disc = 2.0 * beta.abs() * d_beta + d_beta * d_beta + cc * d_alpha + alpha * p2(-33);
     let d_root = (d_disc / disc.sqrt()).min(d_disc.sqrt()) + 2.0 * p2(-31);
     let d_num = d_root + d_beta + p2(-30);
-    // 1/sigma: num x (|r|^2 / C, Q27), floored to Q25.
+    // 1/sigma: num x (|r|^2 / C, Q27), rounded to Q24.
     let d_inv_s = d_num / cc + num * p2(-28) + p2(-25);
-    // V_k / sigma: V in Q39, rounded to Q33.
-    let d_e = |k: usize| p2(-34) + inv_s * p2(-40) + v[k].abs() * d_inv_s;
+    // V_k + t_k V3 (V in Q40, t in Q30) rounded to Q39, times 1/sigma exactly.
+    let d_v = |k: usize| {
+        let p = v[k] + t[k] * v[2];
+        let d_p = (1.0 + t[k].abs()) * p2(-41) + v[2].abs() * p2(-31) + p2(-40);
+        p.abs() * d_inv_s + inv_s * d_p + d_p * d_inv_s
+    };
     let sum_w = w[0].abs() + w[1].abs() + w[2].abs();
     let d_w_terms = 4.0 * p2(-34) + sum_w * p2(-31);
-    let d_vf = |k: usize, tk: f64| d_w_terms + d_e(k) + tk.abs() * d_e(2) + e[2].abs() * p2(-31);
-    let (d1, d2) = (d_vf(0, t[0]), d_vf(1, t[1]));
+    let (d1, d2) = (d_w_terms + d_v(0), d_w_terms + d_v(1));
     let speed = libm::hypot(v_ref.v1_mps, v_ref.v2_mps);
     // f (d1 + d2), the mantissa of f (2^-32 relative), two floors of 2^-40 m/s each.
     (f * (d1 + d2) + 2.0 * p2(-40) * 2.0) / speed + p2(-32)

@@ -49,11 +49,30 @@ pub mod envelope {
     pub const MAX_ATTITUDE_RATE_RAD_S: f64 = 0.04;
     /// Each component of W (rad/s), the camera's angular velocity relative to the Earth.
     pub const MAX_W_RAD_S: f64 = 0.125;
-    /// Each component of V_B / |r| (rad/s): 2^-9, about 12.7 km/s at 6 500 km.
+    /// Each component of V_B / |r| (rad/s): below 2^-9, about 12.7 km/s at 6 500 km
+    /// (2^-9 itself is refused: the format, Q40 in 32 bits, stops one unit short).
     pub const MAX_V_OVER_R_RAD_S: f64 = 1.0 / 512.0;
     /// Each component of a unit vector (n_B): 1 and the rounding of a rotation's axes
     /// (Part II accepts axes within 1e-5 of orthonormal).
     pub const MAX_UNIT: f64 = 1.001;
+    /// Each component of sqrt(kappa^2 - 1) n_B: sqrt([`MAX_STRETCH2_MINUS_1`])
+    /// [`MAX_UNIT`] = 0.15827, rounded up.
+    pub const MAX_M: f64 = 0.1583;
+}
+
+/// The envelope's bounds in each field's format (`round_update` refuses the same).
+mod limit {
+    use super::envelope;
+    pub const C_LO: i64 = (envelope::C_OVER_R2.0 * 4_294_967_296.0) as i64;
+    pub const C_HI: i64 = (envelope::C_OVER_R2.1 * 4_294_967_296.0) as i64;
+    pub const K2M1: i64 = (envelope::MAX_STRETCH2_MINUS_1 * (1u64 << 36) as f64) as i64;
+    pub const M: i64 = (envelope::MAX_M * (1u64 << 33) as f64) as i64;
+    pub const RHO: i64 =
+        ((envelope::MAX_UNIT + envelope::MAX_STRETCH2_MINUS_1) * (1u64 << 30) as f64) as i64;
+    pub const N: i64 = (envelope::MAX_UNIT * (1u64 << 30) as f64) as i64;
+    pub const W: i64 = (envelope::MAX_W_RAD_S * (1u64 << 33) as f64) as i64;
+    /// Below 2^-9 in Q40: one unit short of 2^31.
+    pub const V: i64 = (1 << 31) - 1;
 }
 
 /// The fixed-point real-Earth backend.
@@ -81,20 +100,76 @@ pub struct EarthFixedPixel {
 /// Constants of one instant (build with [`Backend::update`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct EarthFixedUpdate {
-    /// n_B (the spin axis in B), Q30, |.| <= 1.001.
-    n: [i32; 3],
+    /// sqrt(kappa^2 - 1) n_B (n_B the spin axis in B), Q33, |.| <= 0.159: the stretch
+    /// term of alpha is (m.u')^2.
+    m: [i32; 3],
     /// rho_B / |r|, Q30, |.| <= 1.026.
     rho: [i32; 3],
-    /// kappa^2 - 1, Q36, within [0, 0.025].
-    k2m1: i32,
     /// C / |r|^2, Q32, within [0.05, 0.5].
     c: u32,
     /// |r|^2 / C, Q27, within [2, 20].
     inv_c: u32,
     /// W_B (rad/s), Q33, |.| <= 2^-3.
     w: [i32; 3],
-    /// V_B / |r| (rad/s), Q39, |.| <= 2^-9.
+    /// V_B / |r| (rad/s), Q40, |.| < 2^-9.
     v: [i32; 3],
+    /// What `motion` needs of the fields above, folded once per update ([`Terms`]).
+    k: Terms,
+}
+
+/// The per-update constants of [`Backend::motion`], in the signs and shifts its sums
+/// take, so that each sum is a chain of 32 x 32 -> 64 multiply-accumulates from a
+/// preset accumulator (rounding constants folded in). Derived from the other fields of
+/// [`EarthFixedUpdate`] by [`Terms::of`], never set on their own.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Terms {
+    /// rho3 2^30 + 2^28, Q60: -beta's constant term, and half a unit of Q31.
+    beta0: i64,
+    /// -rho1, -rho2, Q30.
+    nrho: [i32; 2],
+    /// -m3 2^30 + 2^31, Q63: m.u''s constant term, and half a unit of Q31.
+    s0: i64,
+    /// W2 2^30 and -W1 2^30, Q63: the constant terms of v1/f and v2/f.
+    w0: [i64; 2],
+    /// -W1, -W3, Q33.
+    nw: [i32; 2],
+    /// V1 2^30 + 2^30 and V2 2^30 + 2^30, Q70: the constant terms of V_k + t_k V3, and
+    /// half a unit of Q39.
+    v0: [i64; 2],
+}
+
+impl Terms {
+    // Out of line: one copy for every constructor of the update (flash).
+    #[inline(never)]
+    fn of(m: &[i32; 3], rho: &[i32; 3], w: &[i32; 3], v: &[i32; 3]) -> Terms {
+        let wide = |x: i32| i64::from(x);
+        Terms {
+            beta0: (wide(rho[2]) << 30) + (1 << 28),
+            nrho: [-rho[0], -rho[1]],
+            s0: -(wide(m[2]) << 30) + (1 << 31),
+            w0: [wide(w[1]) << 30, -(wide(w[0]) << 30)],
+            nw: [-w[0], -w[2]],
+            v0: [
+                (wide(v[0]) << 30) + (1 << 30),
+                (wide(v[1]) << 30) + (1 << 30),
+            ],
+        }
+    }
+}
+
+impl EarthFixedUpdate {
+    /// The update from its rounded fields (each within its format's bound).
+    fn new(m: [i32; 3], rho: [i32; 3], c: u32, inv_c: u32, w: [i32; 3], v: [i32; 3]) -> Self {
+        EarthFixedUpdate {
+            m,
+            rho,
+            c,
+            inv_c,
+            w,
+            v,
+            k: Terms::of(&m, &rho, &w, &v),
+        }
+    }
 }
 
 /// x 2^frac rounded to nearest, refused as `err` unless |x| <= max. The caller's `max`
@@ -205,7 +280,7 @@ impl EarthFixed {
         let sh = if (re - 40) % 2 == 0 { 40 } else { 39 };
         let big_m = (rm as u64) << sh;
         // |r| = s 2^h, s in [2^31, 2^32] (within 2 units), 1/|r| = inv 2^(-63 - h).
-        let s = sqrt_u64(big_m);
+        let s = u64::from(sqrt_per_update(big_m));
         let h = (re - sh) / 2;
         let inv = (1u64 << 63).checked_div(s).ok_or(position)? as i64;
         // x / |r| in Q`frac`: its mantissa times inv, exact in i64 (< 2^56).
@@ -227,15 +302,7 @@ impl EarthFixed {
         let c_prod = cm * inv2;
         let c_exp = ce - 94 - 2 * h;
         let c = round_shift(c_prod, c_exp + 32).ok_or(position)?;
-        // The envelope's bounds in each format, as `round_update` checks them.
-        const C_LO: i64 = (envelope::C_OVER_R2.0 * 4_294_967_296.0) as i64;
-        const C_HI: i64 = (envelope::C_OVER_R2.1 * 4_294_967_296.0) as i64;
-        const K2M1: i64 = (envelope::MAX_STRETCH2_MINUS_1 * (1u64 << 36) as f64) as i64;
-        const N: i64 = (envelope::MAX_UNIT * (1u64 << 30) as f64) as i64;
-        const RHO: i64 =
-            ((envelope::MAX_UNIT + envelope::MAX_STRETCH2_MINUS_1) * (1u64 << 30) as f64) as i64;
-        const W: i64 = (envelope::MAX_W_RAD_S * (1u64 << 33) as f64) as i64;
-        const V: i64 = (envelope::MAX_V_OVER_R_RAD_S * (1u64 << 39) as f64) as i64;
+        use limit::{C_HI, C_LO, K2M1, M, RHO, V, W};
         if !(C_LO..=C_HI).contains(&c) {
             return Err(position);
         }
@@ -251,20 +318,30 @@ impl EarthFixed {
             let (m, e) = parts(x);
             round_shift(m, e + frac)
         };
-        let k2m1 = direct(up.stretch2_minus_1, 36);
-        if !matches!(k2m1, Some(k) if k <= K2M1) {
-            return Err(ModelError::OutOfDomain(Param::Flattening));
+        let flattening = ModelError::OutOfDomain(Param::Flattening);
+        let (km, ke) = parts(up.stretch2_minus_1);
+        if !(km >= 0 && matches!(direct(up.stretch2_minus_1, 36), Some(k) if k <= K2M1)) {
+            return Err(flattening);
         }
+        // sqrt(kappa^2 - 1) = sk 2^((ke - sh) / 2) (within 2 units of 32 bits), sh making
+        // the exponent even.
+        let sh = if (ke - 40) % 2 == 0 { 40 } else { 39 };
+        let sk = i64::from(sqrt_per_update((km as u64) << sh));
+        let stretched = |x: f32| -> Option<i64> {
+            let (m, e) = parts(x);
+            round_shift(sk * m, (ke - sh) / 2 + e + 33)
+        };
         let within = |q: Option<i64>, max: i64, err: ModelError| match q {
             Some(q) if q.abs() <= max => Ok(q as i32),
             _ => Err(err),
         };
-        let mut n = [0; 3];
+        let mut m = [0; 3];
         let mut rho = [0; 3];
         let mut w = [0; 3];
         let mut v = [0; 3];
         for k in 0..3 {
-            n[k] = within(direct(up.n_b[k], 30), N, position)?;
+            within(direct(up.n_b[k], 30), limit::N, position)?;
+            m[k] = within(stretched(up.n_b[k]), M, position)?;
             rho[k] = within(over_r(up.rho_b_m[k], 30), RHO, position)?;
             w[k] = within(
                 direct(up.w_b_rad_s[k], 33),
@@ -272,20 +349,19 @@ impl EarthFixed {
                 ModelError::OutOfDomain(Param::AngularVelocity),
             )?;
             v[k] = within(
-                over_r(up.v_b_mps[k], 39),
+                over_r(up.v_b_mps[k], 40),
                 V,
                 ModelError::OutOfDomain(Param::Velocity),
             )?;
         }
-        Ok(EarthFixedUpdate {
-            n,
+        Ok(EarthFixedUpdate::new(
+            m,
             rho,
-            k2m1: within(k2m1, K2M1, position)?,
-            c: c as u32,
-            inv_c: u32::try_from(inv_c).map_err(|_| position)?,
+            c as u32,
+            u32::try_from(inv_c).map_err(|_| position)?,
             w,
             v,
-        })
+        ))
     }
 
     /// The f64 update, every length over |r|, rounded to the per-pixel formats.
@@ -299,16 +375,19 @@ impl EarthFixed {
         if !(c >= c_min && c <= c_max) {
             return Err(ModelError::OutOfDomain(Param::Position));
         }
-        if !(up.stretch2_minus_1 <= envelope::MAX_STRETCH2_MINUS_1) {
+        let k = up.stretch2_minus_1;
+        if !(0.0..=envelope::MAX_STRETCH2_MINUS_1).contains(&k) {
             return Err(ModelError::OutOfDomain(Param::Flattening));
         }
+        let sqrt_k = libm::sqrt(k);
         let unit = ModelError::OutOfDomain(Param::Position);
-        let mut n = [0; 3];
+        let mut m = [0; 3];
         let mut rho = [0; 3];
         let mut w = [0; 3];
         let mut v = [0; 3];
         for k in 0..3 {
-            n[k] = to_q(up.n_b[k], 30, envelope::MAX_UNIT, unit)?;
+            to_q(up.n_b[k], 30, envelope::MAX_UNIT, unit)?;
+            m[k] = to_q(sqrt_k * up.n_b[k], 33, envelope::MAX_M, unit)?;
             rho[k] = to_q(
                 up.rho_b_m[k] / r_m,
                 30,
@@ -321,27 +400,22 @@ impl EarthFixed {
                 envelope::MAX_W_RAD_S,
                 ModelError::OutOfDomain(Param::AngularVelocity),
             )?;
+            // One unit short of 2^31 in Q40.
             v[k] = to_q(
                 up.v_b_mps[k] / r_m,
-                39,
-                envelope::MAX_V_OVER_R_RAD_S,
+                40,
+                limit::V as f64 / (1u64 << 40) as f64,
                 ModelError::OutOfDomain(Param::Velocity),
             )?;
         }
-        Ok(EarthFixedUpdate {
-            n,
+        Ok(EarthFixedUpdate::new(
+            m,
             rho,
-            k2m1: to_q(
-                up.stretch2_minus_1,
-                36,
-                envelope::MAX_STRETCH2_MINUS_1,
-                unit,
-            )?,
-            c: to_uq(c, 32),
-            inv_c: to_uq(1.0 / c, 27),
+            to_uq(c, 32),
+            to_uq(1.0 / c, 27),
             w,
             v,
-        })
+        ))
     }
 }
 
@@ -369,19 +443,14 @@ impl EarthFixedUpdate {
             out[2] = x[2];
             Ok(out)
         };
-        // The envelope's bounds in each vector's format, as `round_update` refuses them.
-        const N: i64 = (envelope::MAX_UNIT * (1u64 << 30) as f64) as i64;
-        const RHO: i64 =
-            ((envelope::MAX_UNIT + envelope::MAX_STRETCH2_MINUS_1) * (1u64 << 30) as f64) as i64;
-        const W: i64 = (envelope::MAX_W_RAD_S * (1u64 << 33) as f64) as i64;
-        const V: i64 = (envelope::MAX_V_OVER_R_RAD_S * (1u64 << 39) as f64) as i64;
-        Ok(EarthFixedUpdate {
-            n: turn(self.n, N, Param::Position)?,
-            rho: turn(self.rho, RHO, Param::Position)?,
-            w: turn(self.w, W, Param::AngularVelocity)?,
-            v: turn(self.v, V, Param::Velocity)?,
-            ..*self
-        })
+        Ok(EarthFixedUpdate::new(
+            turn(self.m, limit::M, Param::Position)?,
+            turn(self.rho, limit::RHO, Param::Position)?,
+            self.c,
+            self.inv_c,
+            turn(self.w, limit::W, Param::AngularVelocity)?,
+            turn(self.v, limit::V, Param::Velocity)?,
+        ))
     }
 }
 
@@ -391,20 +460,20 @@ impl EarthFixedUpdate {
     /// pixel constant is left (the yaw request needs only its direction). The same
     /// refusals.
     pub fn boresight_over_focal(&self) -> Result<(i64, i64), ModelError> {
-        // beta = -rho3 (Q30 -> Q31), n.u' = -n3.
-        let beta = -i64::from(self.rho[2]);
-        if beta >= 0 {
+        // beta = -rho3 (Q30 -> Q31), m.u' = -m3.
+        let rho3 = self.rho[2];
+        if rho3 <= 0 {
             return Err(ModelError::LineOfSightMissesEarth);
         }
-        let b31 = (beta.unsigned_abs() << 1) as u32;
-        let n3 = i64::from(self.n[2]);
-        let nn30 = ((n3 * n3) as u64 >> 30) as u32;
-        let alpha = (1u32 << 30) + ((self.k2m1 as u64 * nn30 as u64) >> 36) as u32;
-        let inv_s = inv_sigma(b31, alpha, self)?;
-        let e = |vk: i32| ((vk as i64 * inv_s as i64 + (1 << 30)) >> 31) as i32;
+        let b31 = (rho3 as u32) << 1;
+        let m3 = i64::from(self.m[2]);
+        // (m.u')^2: Q66 -> Q30, < 0.026.
+        let alpha = (1u32 << 30) + ((m3 * m3) >> 36) as u32;
+        let ninv_s = i64::from(neg_inv_sigma(b31, alpha, self)?);
+        // -V_k / sigma: Q40 x Q24 = Q64, |.| < 2^61.2, to Q63.
         let [w1, w2, _] = self.w;
-        let vf1 = (i64::from(w2) << 30) - (i64::from(e(self.v[0])) << 30);
-        let vf2 = -(i64::from(w1) << 30) - (i64::from(e(self.v[1])) << 30);
+        let vf1 = (i64::from(w2) << 30) + ((i64::from(self.v[0]) * ninv_s) >> 1);
+        let vf2 = -(i64::from(w1) << 30) + ((i64::from(self.v[1]) * ninv_s) >> 1);
         if vf1 == 0 {
             return Err(ModelError::NoAlongTrackMotion);
         }
@@ -527,101 +596,130 @@ impl Backend<Earth> for EarthFixed {
         up: &EarthFixedUpdate,
         px: &EarthFixedPixel,
     ) -> Result<ImageMotion<I24F40>, ModelError> {
-        let mul = |a: i32, b: i32| a as i64 * b as i64;
+        let k = &up.k;
         let (t1, t2) = (px.t1, px.t2);
-        // beta = rho.u', Q60, |.| <= 1.026 sqrt(3) < 1.78 (2^60.8).
-        let beta = mul(up.rho[0], t1) + mul(up.rho[1], t2) - ((up.rho[2] as i64) << 30);
-        // Both roots share the sign of -beta (C > 0): a ray with beta >= 0 looks away.
-        if beta >= 0 {
+        // -beta = -rho.u' and half a unit of Q31, Q60, |.| <= 1.026 sqrt(3) < 1.78.
+        let nbeta = mac(mac(k.beta0, k.nrho[0], t1), k.nrho[1], t2);
+        // Both roots share the sign of -beta (C > 0): a ray with beta >= 0 looks away
+        // (one with |beta| below half a unit, b31 = 0, misses on the discriminant).
+        if nbeta < 0 {
             return Err(ModelError::LineOfSightMissesEarth);
         }
-        // |beta|, Q31, < 2^31.9.
-        let b31 = ((beta.unsigned_abs() + (1 << 28)) >> 29) as u32;
-        // n.u', Q60 -> Q30, |.| <= 1.001 sqrt(3) < 1.74.
-        let nu60 = mul(up.n[0], t1) + mul(up.n[1], t2) - ((up.n[2] as i64) << 30);
-        let nu30 = ((nu60 + (1 << 29)) >> 30) as i32;
-        // (n.u')^2, Q30, < 3.03 (2^31.6).
-        let nn30 = ((nu30 as i64 * nu30 as i64) as u64 >> 30) as u32;
-        // alpha = |u'|^2 + (kappa^2 - 1)(n.u')^2, Q30, < 3.08.
-        let alpha = px.uu + ((up.k2m1 as u64 * nn30 as u64) >> 36) as u32;
-        // 1/sigma, Q25 (< 2^31.2).
-        let inv_s = inv_sigma(b31, alpha, up)?;
-        // V_k / sigma, Q39 x Q25 = Q64 (< 2^61.2), rounded to Q33 (< 0.139 = 2^30.2).
-        let e = |vk: i32| ((vk as i64 * inv_s as i64 + (1 << 30)) >> 31) as i32;
-        let (e1, e2, e3) = (e(up.v[0]), e(up.v[1]), e(up.v[2]));
-        let [w1, w2, w3] = up.w;
-        // v/f, Q63: W terms Q33 x Q30, each < 2^60, four of them < 2^62; V terms
-        // < 2 x 0.139 x 2^63 = 2^61.2; sum < 2^62.7.
-        let vf1 = ((w2 as i64) << 30) + mul(w2, px.t11) + mul(w3, t2)
-            - mul(w1, px.t12)
-            - ((e1 as i64) << 30)
-            - mul(t1, e3);
-        let vf2 = -((w1 as i64) << 30) - mul(w1, px.t22) - mul(w3, t1) + mul(w2, px.t12)
-            - ((e2 as i64) << 30)
-            - mul(t2, e3);
-        let v1 = times_focal(vf1, px);
+        // |beta|, Q31 (rounded), < 2^31.9.
+        let b31 = (nbeta >> 29) as u32;
+        // m.u' = sqrt(kappa^2 - 1) n.u', Q63 (< 0.48), its high word Q31 (rounded).
+        let s31 = (mac(mac(k.s0, up.m[0], t1), up.m[1], t2) >> 32) as i32;
+        // alpha = |u'|^2 + (m.u')^2, Q30 (the square's high word), < 3.08.
+        let alpha = px.uu + ((i64::from(s31) * i64::from(s31)) >> 32) as u32;
+        // -1/sigma, Q24 (> -2^30.2).
+        let ninv_s = neg_inv_sigma(b31, alpha, up)?;
+        // V_k + t_k V3, Q70 -> Q39 (rounded), |.| < 2^-8: below 2^31 as V_k < 2^-9.
+        let v3 = up.v[2];
+        let p1 = (mac(k.v0[0], v3, t1) >> 31) as i32;
+        let p2 = (mac(k.v0[1], v3, t2) >> 31) as i32;
+        // v/f, Q63: W terms Q33 x Q30, each < 2^60, four of them < 2^62; the V term
+        // Q39 x Q24, < 2^61.2; sum < 2^62.7.
+        let [_, w2, w3] = up.w;
+        let vf1 = mac(
+            mac(mac(mac(k.w0[0], p1, ninv_s), w2, px.t11), w3, t2),
+            k.nw[0],
+            px.t12,
+        );
+        let vf2 = mac(
+            mac(mac(mac(k.w0[1], p2, ninv_s), k.nw[0], px.t22), k.nw[1], t1),
+            w2,
+            px.t12,
+        );
+        let (v1, v2) = (times_focal(vf1, px), times_focal(vf2, px));
         if v1 == 0 {
             return Err(ModelError::NoAlongTrackMotion);
         }
         Ok(ImageMotion {
             v1_mps: I24F40::from_bits(v1),
-            v2_mps: I24F40::from_bits(times_focal(vf2, px)),
+            v2_mps: I24F40::from_bits(v2),
         })
     }
 }
 
-/// 1/sigma, the near root's reciprocal, in Q25 from |beta| (Q31) and alpha (Q30), with
-/// the update's C and |r|^2/C; a ray whose discriminant is negative misses.
+/// acc + a b: one multiply-accumulate (SMLAL).
 #[inline(always)]
-fn inv_sigma(b31: u32, alpha: u32, up: &EarthFixedUpdate) -> Result<u32, ModelError> {
-    // beta^2 and alpha C, Q62, < 2^63.7 and 2^62.7.
-    let bb = b31 as u64 * b31 as u64;
-    let ac = alpha as u64 * up.c as u64;
-    if ac > bb {
-        return Err(ModelError::LineOfSightMissesEarth);
-    }
-    // sqrt(disc), Q31, <= |beta| + 2 units.
-    let root = sqrt_u64(bb - ac);
-    // (sqrt(disc) + |beta|) / 2 ... as Q30: the numerator of 1/sigma, < 3.56.
-    let num = ((root + b31 as u64) >> 1) as u32;
-    // 1/sigma = num |r|^2/C: Q57 (< 71.2 = 2^63.2), then Q25 (< 2^31.2).
-    Ok(((num as u64 * up.inv_c as u64) >> 32) as u32)
+fn mac(acc: i64, a: i32, b: i32) -> i64 {
+    acc + i64::from(a) * i64::from(b)
 }
 
-/// (v/f in Q63) x f as I24F40 bits: x f_mant 2^-e 2^-23, by two 32x32 -> 64 products
-/// (x = hi 2^32 + lo): (x f_mant) >> 32 = hi f_mant + (lo f_mant) >> 32 (< 2^62.7), then
-/// >> (e - 9), in 13..29. Truncated toward -infinity: 2^-40 m/s at most.
+/// The high word of a 32 x 32 -> 64 product (UMULL).
+#[inline(always)]
+fn mulhi(a: u32, b: u32) -> u32 {
+    ((u64::from(a) * u64::from(b)) >> 32) as u32
+}
+
+/// -1/sigma (1/sigma the near root's reciprocal) in Q24 from |beta| (Q31) and alpha
+/// (Q30), with the update's C and |r|^2/C; a ray whose discriminant is negative misses.
+/// Negative, so that its products are plainly signed ones (SMLAL).
+#[inline(always)]
+fn neg_inv_sigma(b31: u32, alpha: u32, up: &EarthFixedUpdate) -> Result<i32, ModelError> {
+    // beta^2 and alpha C, Q62, < 2^63.7 and 2^62.7.
+    let bb = u64::from(b31) * u64::from(b31);
+    let ac = u64::from(alpha) * u64::from(up.c);
+    let (disc, miss) = bb.overflowing_sub(ac);
+    if miss {
+        return Err(ModelError::LineOfSightMissesEarth);
+    }
+    // sqrt(disc), Q31.
+    let root = sqrt_u64(disc);
+    // (sqrt(disc) + |beta|) / 2, Q30, the numerator of 1/sigma (< 3.56): the halving
+    // add that needs no 33rd bit.
+    let num = (root & b31) + ((root ^ b31) >> 1);
+    // 1/sigma = num |r|^2/C: Q57 (< 71.2 = 2^63.2), rounded to Q24 (< 2^30.2) for
+    // signed products: its high word (Q25) plus one, halved.
+    Ok(-(((mulhi(num, up.inv_c) + 1) >> 1) as i32))
+}
+
+/// (v/f in Q63) x f as I24F40 bits: x f_mant 2^-e 2^-23 = (x f_mant 2^-32) >> (e - 9),
+/// e - 9 in 13..29. Truncated toward -infinity twice: 2^-40 m/s at most each.
 #[inline(always)]
 fn times_focal(x: i64, px: &EarthFixedPixel) -> i64 {
-    let hi = (x >> 32) as i32;
-    let lo = x as u32;
+    // x f_mant 2^-32 exactly, with f_mant = g + 2^32 (g its bits as i32, negative
+    // since f_mant >= 2^31): hi g + hi 2^32 + (lo f_mant) 2^-32, one UMULL and one SMLAL.
+    let (hi, lo) = ((x >> 32) as i32, x as u32);
     let m = px.f_mant;
-    let top = hi as i64 * m as i64 + ((lo as u64 * m as u64) >> 32) as i64;
+    let top = i64::from(hi) * i64::from(m as i32) + (i64::from(hi) << 32) + i64::from(mulhi(lo, m));
     shr(top, px.shift)
 }
 
-/// sqrt(x) to within 2 units, integer only, no division (core's `isqrt` divides, which
-/// is a `__aeabi_uldivmod` call on a 32-bit core). The scheme of the round Earth's
-/// per-pixel root (`docs/fixed-point.md`): normalise x by an even shift z to
-/// xn in [2^62, 2^64), f = hi(xn) in [1/4, 1) (Q32); seed r0 from f's top 10 bits,
-/// one Newton step for 1/sqrt(f) (r1, Q29), s = f r1 (Q31), one Heron correction with
-/// xn's full 64 bits; sqrt(x) = 2 y 2^(-z/2), y = sqrt(xn 2^-64) in Q31.
+/// [`sqrt_u64`] out of line, for the per-update code (one copy in flash).
+#[inline(never)]
+fn sqrt_per_update(x: u64) -> u32 {
+    sqrt_u64(x)
+}
+
+/// sqrt(x), never above it and at most 2 units below (`sqrt_u64_within_two_units`),
+/// integer only, no division (core's `isqrt` divides, a `__aeabi_uldivmod` call on a 32-bit
+/// core), in 32-bit halves. The round Earth's scheme (`docs/fixed-point.md`): x
+/// normalised by an even shift z to xn in [2^62, 2^64) (x below 2^32 first taken as
+/// x 2^32), f = its high word in [2^30, 2^32); a seed r0 of 1/sqrt(f 2^-32) from f's top
+/// 10 bits, one Newton step r1 = r0 (3 - f r0^2) / 2 with the product rounded up, so
+/// that r1 <= 1/sqrt(f) (Newton's step for 1/sqrt never overshoots), s = f r1 <=
+/// sqrt(xn), then Heron's correction (xn - s^2) r1 / 2 from xn's 64 bits (xn - s^2 >= 0
+/// and below 2^47: its high word suffices); sqrt(x) = that 2^(-z/2).
 #[inline(always)]
-pub fn sqrt_u64(x: u64) -> u64 {
-    if x == 0 {
-        return 0;
-    }
-    let z = x.leading_zeros() & !1;
-    let xn = x << z;
-    let f = (xn >> 32) as u32; // [2^30, 2^32)
-    let r0 = RSQRT_SEED[(f >> 22) as usize & 1023] as u32; // Q14
-    let u = (3 << 28) - ((f as u64 * (r0 * r0) as u64) >> 32) as u32; // 3 - f r0^2, Q28
-    let r1 = ((r0 as u64 * u as u64) >> 14) as u32; // Q29, < 2^30.1
-    let s = ((f as u64 * r1 as u64) >> 30) as u32; // Q31
-    let d = (xn >> 2) as i64 - (s as u64 * s as u64) as i64; // f - s^2, Q62
-    let corr = (r1 as i64 * (d >> 16)) >> 45; // r1 d / 2, Q31
-    let y = (s as i64 + corr) as u64; // Q31, <= 2^31 + 1
-    (y << 1) >> (z >> 1)
+pub fn sqrt_u64(x: u64) -> u32 {
+    let (hi, lo) = ((x >> 32) as u32, x as u32);
+    let (hi, lo, extra) = if hi == 0 { (lo, 0, 16) } else { (hi, lo, 0) };
+    // z even, 0..=30 (0 for x = 0, which then gives 0 throughout).
+    let z = hi.leading_zeros() & 30;
+    let f = (hi << z) | ((lo >> 1) >> (31 - z));
+    let xn = (u64::from(f) << 32) | u64::from(lo << z);
+    // r0, Q14, < 2.
+    let r0 = u32::from(RSQRT_SEED[(f >> 22) as usize]);
+    // 3 - f r0^2 rounded down, Q30 (about 2); r1 = r0 u / 2, Q30, < 2.
+    let u = (3 << 30) - 1 - mulhi(f, (r0 * r0) << 2);
+    let r1 = mulhi(r0 << 17, u);
+    // sqrt(xn) from below: sqrt(f 2^-32) in Q30 (< 1), shifted to Q32.
+    let s = mulhi(f, r1) << 2;
+    let d = xn - u64::from(s) * u64::from(s);
+    let y = s.saturating_add(mulhi((d >> 32) as u32, r1 << 1));
+    y >> ((z >> 1) + extra)
 }
 
 #[cfg(test)]
@@ -696,12 +794,11 @@ mod tests {
                         worst = worst.max(excess / (x.unsigned_abs().max(1) as f64));
                     };
                     for k in 0..3 {
-                        d(a.n[k].into(), b.n[k].into());
+                        d(a.m[k].into(), b.m[k].into());
                         d(a.rho[k].into(), b.rho[k].into());
                         d(a.w[k].into(), b.w[k].into());
                         d(a.v[k].into(), b.v[k].into());
                     }
-                    d(a.k2m1.into(), b.k2m1.into());
                     d(a.c.into(), b.c.into());
                     d(a.inv_c.into(), b.inv_c.into());
                     checked += 1;
@@ -716,15 +813,20 @@ mod tests {
         );
     }
 
-    /// Against the exact floor square root (u128 arithmetic, independent of the scheme)
-    /// over every magnitude, the extremes included.
+    /// Against the exact square root (u128 arithmetic, independent of the scheme, in
+    /// units of 2^-30) over every magnitude, the extremes and the top of every
+    /// normalisation band included: never above it by a unit, at most two below it.
     #[test]
     fn sqrt_u64_within_two_units() {
+        extern crate std;
         let mut x: u64 = 0x9E37_79B9_7F4A_7C15;
-        let mut worst = 0u64;
+        let (mut below, mut above) = (0i128, 0i128);
         let mut check = |v: u64| {
-            let exact = (v as u128).isqrt() as u64;
-            worst = worst.max(sqrt_u64(v).abs_diff(exact));
+            // sqrt(v) 2^30, floored: the exact root to 2^-30.
+            let exact = ((v as u128) << 60).isqrt() as i128;
+            let got = i128::from(sqrt_u64(v)) << 30;
+            below = below.max(exact - got);
+            above = above.max(got - exact);
         };
         for i in 0..2_000_000u32 {
             x ^= x << 13;
@@ -732,20 +834,21 @@ mod tests {
             x ^= x << 17;
             check(x >> (i % 64));
         }
-        for v in [
-            0,
-            1,
-            2,
-            3,
-            4,
-            u64::MAX,
-            u64::MAX - 1,
-            1 << 62,
-            (1 << 62) - 1,
-            1 << 63,
-        ] {
+        for v in [0, 1, 2, 3, 4, u64::MAX, u64::MAX - 1, 1 << 63] {
             check(v);
         }
-        assert!(worst <= 2, "{worst}");
+        for j in 1..32 {
+            let top = 1u64 << (2 * j);
+            for v in [top - 1, top - 2, top - (top >> 20).max(1), top, top + 1] {
+                check(v);
+            }
+        }
+        let unit = 1i128 << 30;
+        std::eprintln!(
+            "sqrt_u64: at most {:.3} units below the root, {:.3} above",
+            below as f64 / unit as f64,
+            above as f64 / unit as f64
+        );
+        assert!(below <= 2 * unit && above < unit, "{below} {above}");
     }
 }
