@@ -148,6 +148,13 @@ impl Trigger {
             }
         });
         if self.seen >= self.after_frames {
+            // The last frame can reach the host while the firmware, past sending it,
+            // still writes the snapshot of that update to retained RAM (its transmit
+            // queue drains by interrupt): a reset then would find the snapshot torn and
+            // rightly refuse it, which the host's model of the reset does not do. The
+            // uplink waits at the cut, so the firmware is idle once that write is done:
+            // a quarter second of host time covers it on a loaded host.
+            std::thread::sleep(std::time::Duration::from_millis(250));
             system_reset(&self.qmp)?;
             self.done_after_us = Some(self.last_periods_us.unwrap_or(0));
             if let Some(made) = self.made.take() {
