@@ -38,7 +38,13 @@ impl Footprint {
 
     /// The rows and columns the footprint from p2 `a_m` to `b_m` spans, without its
     /// margins: [row low, row high, column low, column high] (affine in p2: its ends').
-    #[inline(always)]
+    // Out of line on the M3 (soft float): the carried footprint's check and the
+    // extremes' held a copy each (docs/target.md, `m3-flash`).
+    #[cfg_attr(all(target_arch = "arm", not(target_abi = "eabihf")), inline(never))]
+    #[cfg_attr(
+        not(all(target_arch = "arm", not(target_abi = "eabihf"))),
+        inline(always)
+    )]
     fn spans(&self, a_m: f32, b_m: f32) -> [f32; 4] {
         let (da, db) = (a_m - self.a_m, b_m - self.a_m);
         let (ra, rb) = (

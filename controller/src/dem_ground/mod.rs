@@ -315,7 +315,13 @@ impl<'h> SegmentRays<'h> {
     }
 
     /// [`SegmentRays::new`] from r and the [`SegmentRays::directions`].
-    #[inline(always)]
+    // Out of line on the M3, where each product is a software call: the DEM route's
+    // boresight and extremes held a copy each (docs/target.md, `m3-flash`).
+    #[cfg_attr(all(target_arch = "arm", not(target_abi = "eabihf")), inline(never))]
+    #[cfg_attr(
+        not(all(target_arch = "arm", not(target_abi = "eabihf"))),
+        inline(always)
+    )]
     pub(crate) fn from_directions(
         ground: &DemGround,
         heights_m: &'h [i16],
