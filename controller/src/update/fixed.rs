@@ -230,7 +230,7 @@ impl Controller {
         } else {
             worst_drift_rad
         };
-        let residual_drift_rad = match (steer, &update.yawed, seg.fixed.first()) {
+        let residual_drift_rad = match (steer, update.yawed(), seg.fixed.first()) {
             (None, _, _) => drift_rad,
             // The centre on the turned fixed-point update, in integers.
             (Some(_), Some(up), Some(px)) => {

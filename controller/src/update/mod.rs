@@ -144,8 +144,9 @@ impl Controller {
         // place in memory, which the out-of-line `segment` and `extremes` read.
         // The DEM's route needs a tile in force and the ITRF of the instant.
         let dem_frame = if self.dem_ground.active() { itrf } else { None };
+        let mut update = empty_ground(&self.plan);
         let (steer, mut ground_h_m, mut ground) =
-            self.steer_and_ground(&instant, dem_frame.as_ref());
+            self.steer_and_ground(&instant, dem_frame.as_ref(), &mut update);
         self.yaw_request_rad = steer.map(|(_, _, rad)| rad);
         // Output slots by `get` (`index` < MAX_SEGMENTS by construction of the plan): no
         // panic path (docs/no-panic.md).
@@ -160,19 +161,19 @@ impl Controller {
             // height's bits, and -0 against 0 only makes the same ground again.
             let bits = ground_h_m.to_bits();
             if height_m.to_bits() != bits || bits & 0x7fff_ffff > 0x7f80_0000 {
-                ground = self.make_ground(&instant, height_m, steer);
+                ground = self.make_ground(&mut update, &instant, height_m, steer);
                 ground_h_m = height_m;
             }
-            let result = match (&ground, &dem_frame) {
-                (Err(f), _) => Err(*f),
+            let result = match (ground, &dem_frame) {
+                (Err(f), _) => Err(f),
                 // With a DEM tile in force, each sample's own ground on it.
-                (Ok(update), Some(frame)) => self
-                    .dem_segment(k, frame, update, &instant, height_m)
+                (Ok(()), Some(frame)) => self
+                    .dem_segment(k, frame, &update, &instant, height_m)
                     .and_then(|e| match self.plan.segments.get(k) {
-                        Some(seg) => self.segment(update, seg, steer, Some(&e)),
+                        Some(seg) => self.segment(&update, seg, steer, Some(&e)),
                         None => Err(Fault::InvalidScene),
                     }),
-                (Ok(update), _) => self.segment(update, seg, steer, None),
+                (Ok(()), _) => self.segment(&update, seg, steer, None),
             };
             let slot = usize::from(index);
             match result {

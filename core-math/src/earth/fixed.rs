@@ -120,7 +120,7 @@ pub struct EarthFixedUpdate {
 /// The per-update constants of [`Backend::motion`], in the signs and shifts its sums
 /// take, so that each sum is a chain of 32 x 32 -> 64 multiply-accumulates from a
 /// preset accumulator (rounding constants folded in). Derived from the other fields of
-/// [`EarthFixedUpdate`] by [`Terms::of`], never set on their own.
+/// [`EarthFixedUpdate`] by `EarthFixedUpdate::set`, never set on their own.
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Terms {
     /// rho3 2^30 + 2^28, Q60: -beta's constant term, and half a unit of Q31.
@@ -139,36 +139,57 @@ struct Terms {
 }
 
 impl Terms {
-    // Out of line: one copy for every constructor of the update (flash).
-    #[inline(never)]
-    fn of(m: &[i32; 3], rho: &[i32; 3], w: &[i32; 3], v: &[i32; 3]) -> Terms {
-        let wide = |x: i32| i64::from(x);
-        Terms {
-            beta0: (wide(rho[2]) << 30) + (1 << 28),
-            nrho: [-rho[0], -rho[1]],
-            s0: -(wide(m[2]) << 30) + (1 << 31),
-            w0: [wide(w[1]) << 30, -(wide(w[0]) << 30)],
-            nw: [-w[0], -w[2]],
-            v0: [
-                (wide(v[0]) << 30) + (1 << 30),
-                (wide(v[1]) << 30) + (1 << 30),
-            ],
-        }
-    }
+    const ZERO: Terms = Terms {
+        beta0: 0,
+        nrho: [0; 2],
+        s0: 0,
+        w0: [0; 2],
+        nw: [0; 2],
+        v0: [0; 2],
+    };
 }
 
 impl EarthFixedUpdate {
+    /// All zeros: a place to build an update into ([`EarthFixed::from_general_f32_into`],
+    /// [`EarthFixedUpdate::yawed_into`]) without copying one, never one to evaluate
+    /// (`motion` on it refuses every pixel as [`ModelError::NoAlongTrackMotion`]).
+    pub const ZERO: EarthFixedUpdate = EarthFixedUpdate {
+        m: [0; 3],
+        rho: [0; 3],
+        c: 0,
+        inv_c: 0,
+        w: [0; 3],
+        v: [0; 3],
+        k: Terms::ZERO,
+    };
+
     /// The update from its rounded fields (each within its format's bound).
     fn new(m: [i32; 3], rho: [i32; 3], c: u32, inv_c: u32, w: [i32; 3], v: [i32; 3]) -> Self {
-        EarthFixedUpdate {
-            m,
-            rho,
-            c,
-            inv_c,
-            w,
-            v,
-            k: Terms::of(&m, &rho, &w, &v),
-        }
+        let mut up = EarthFixedUpdate::ZERO;
+        up.set(m, rho, c, inv_c, w, v);
+        up
+    }
+
+    /// Overwrites every field, [`Terms`] derived from the others, in place.
+    // Out of line: one copy for every constructor of the update (flash).
+    #[inline(never)]
+    fn set(&mut self, m: [i32; 3], rho: [i32; 3], c: u32, inv_c: u32, w: [i32; 3], v: [i32; 3]) {
+        let wide = |x: i32| i64::from(x);
+        self.k.beta0 = (wide(rho[2]) << 30) + (1 << 28);
+        self.k.nrho = [-rho[0], -rho[1]];
+        self.k.s0 = -(wide(m[2]) << 30) + (1 << 31);
+        self.k.w0 = [wide(w[1]) << 30, -(wide(w[0]) << 30)];
+        self.k.nw = [-w[0], -w[2]];
+        self.k.v0 = [
+            (wide(v[0]) << 30) + (1 << 30),
+            (wide(v[1]) << 30) + (1 << 30),
+        ];
+        self.m = m;
+        self.rho = rho;
+        self.c = c;
+        self.inv_c = inv_c;
+        self.w = w;
+        self.v = v;
     }
 }
 
@@ -271,6 +292,19 @@ impl EarthFixed {
         up: &crate::earth::GeneralUpdate<f32>,
         r2_m2: f32,
     ) -> Result<EarthFixedUpdate, ModelError> {
+        let mut out = EarthFixedUpdate::ZERO;
+        self.from_general_f32_into(up, r2_m2, &mut out)?;
+        Ok(out)
+    }
+
+    /// [`EarthFixed::from_general_f32`] written into `out` (left as it was on a refusal):
+    /// for a caller that keeps the update in place, where returning one copied it.
+    pub fn from_general_f32_into(
+        &self,
+        up: &crate::earth::GeneralUpdate<f32>,
+        r2_m2: f32,
+        out: &mut EarthFixedUpdate,
+    ) -> Result<(), ModelError> {
         let position = ModelError::OutOfDomain(Param::Position);
         if !(r2_m2 > 0.0 && r2_m2.is_finite()) {
             return Err(position);
@@ -282,7 +316,7 @@ impl EarthFixed {
         // |r| = s 2^h, s in [2^31, 2^32] (within 2 units), 1/|r| = inv 2^(-63 - h).
         let s = u64::from(sqrt_per_update(big_m));
         let h = (re - sh) / 2;
-        let inv = (1u64 << 63).checked_div(s).ok_or(position)? as i64;
+        let inv = recip_63(s).ok_or(position)?;
         // x / |r| in Q`frac`: its mantissa times inv, exact in i64 (< 2^56).
         let over_r = |x: f32, frac: i32| -> Option<i64> {
             let (m, e) = parts(x);
@@ -312,7 +346,7 @@ impl EarthFixed {
         // included).
         let t = 32 - (c_prod as u64).leading_zeros() as i32;
         let d = (c_prod as u64).checked_shr(t.max(0) as u32).unwrap_or(0);
-        let quotient = (1u64 << 63).checked_div(d).ok_or(position)? as i64;
+        let quotient = recip_63(d).ok_or(position)?;
         let inv_c = round_shift(quotient, -36 - c_exp - t).ok_or(position)?;
         let direct = |x: f32, frac: i32| -> Option<i64> {
             let (m, e) = parts(x);
@@ -354,14 +388,9 @@ impl EarthFixed {
                 ModelError::OutOfDomain(Param::Velocity),
             )?;
         }
-        Ok(EarthFixedUpdate::new(
-            m,
-            rho,
-            c as u32,
-            u32::try_from(inv_c).map_err(|_| position)?,
-            w,
-            v,
-        ))
+        let inv_c = u32::try_from(inv_c).map_err(|_| position)?;
+        out.set(m, rho, c as u32, inv_c, w, v);
+        Ok(())
     }
 
     /// The f64 update, every length over |r|, rounded to the per-pixel formats.
@@ -429,6 +458,19 @@ impl EarthFixedUpdate {
     /// [`ModelError::OutOfDomain`]. Integers only: the per-segment steered centre of a
     /// core without an FPU is then one [`Backend::motion`].
     pub fn yawed(&self, sin_q30: i32, cos_q30: i32) -> Result<EarthFixedUpdate, ModelError> {
+        let mut out = EarthFixedUpdate::ZERO;
+        self.yawed_into(sin_q30, cos_q30, &mut out)?;
+        Ok(out)
+    }
+
+    /// [`EarthFixedUpdate::yawed`] written into `out` (left as it was on a refusal), for
+    /// a caller that keeps the update in place.
+    pub fn yawed_into(
+        &self,
+        sin_q30: i32,
+        cos_q30: i32,
+        out: &mut EarthFixedUpdate,
+    ) -> Result<(), ModelError> {
         let turn = |x: [i32; 3], max: i64, p: Param| -> Result<[i32; 3], ModelError> {
             let (c, s) = (i64::from(cos_q30), i64::from(sin_q30));
             let (x0, x1) = (i64::from(x[0]), i64::from(x[1]));
@@ -443,14 +485,12 @@ impl EarthFixedUpdate {
             out[2] = x[2];
             Ok(out)
         };
-        Ok(EarthFixedUpdate::new(
-            turn(self.m, limit::M, Param::Position)?,
-            turn(self.rho, limit::RHO, Param::Position)?,
-            self.c,
-            self.inv_c,
-            turn(self.w, limit::W, Param::AngularVelocity)?,
-            turn(self.v, limit::V, Param::Velocity)?,
-        ))
+        let m = turn(self.m, limit::M, Param::Position)?;
+        let rho = turn(self.rho, limit::RHO, Param::Position)?;
+        let w = turn(self.w, limit::W, Param::AngularVelocity)?;
+        let v = turn(self.v, limit::V, Param::Velocity)?;
+        out.set(m, rho, self.c, self.inv_c, w, v);
+        Ok(())
     }
 }
 
@@ -478,6 +518,19 @@ impl EarthFixedUpdate {
             return Err(ModelError::NoAlongTrackMotion);
         }
         Ok((vf1, vf2))
+    }
+}
+
+/// 2^63 / `d` truncated, for `d` in [2^31 - 2, 2^32]: the core's 32-bit divide twice
+/// (`wide::div_64_32`), where a u64 division is a software call; 2^32 at and below 2^31
+/// (within 1e-9 relative of the quotient there), None for 0.
+#[inline(always)]
+fn recip_63(d: u64) -> Option<i64> {
+    match u32::try_from(d) {
+        Ok(n) if n > 1 << 31 => Some(i64::from(crate::wide::div_64_32(1 << 31, 0, n))),
+        Ok(0) => None,
+        Ok(n) if n >= (1 << 31) - 2 => Some(1 << 32),
+        _ => (1u64 << 63).checked_div(d).map(|q| q as i64),
     }
 }
 
@@ -811,6 +864,41 @@ mod tests {
         std::eprintln!(
             "from_general_f32: beyond one unit, worst {worst:.2e} relative over {checked} updates"
         );
+    }
+
+    /// `recip_63` against the u64 division over its domain's every edge and 10^6
+    /// random divisors: exact (the truncated quotient) above 2^31, 2^32 at 2^31 and the
+    /// two below it (within 1e-9 of the quotient there), None for 0.
+    #[test]
+    fn recip_63_is_the_truncated_quotient() {
+        let mut x: u64 = 0x2545_F491_4F6C_DD1D;
+        let check = |d: u64| {
+            let want = (1u64 << 63) / d;
+            let got = recip_63(d).unwrap() as u64;
+            if d > 1 << 31 {
+                assert_eq!(got, want, "{d}");
+            } else {
+                assert_eq!(got, 1 << 32, "{d}");
+                assert!((want - got) as f64 <= 1e-9 * want as f64, "{d}");
+            }
+        };
+        for d in [
+            (1 << 31) - 2,
+            (1 << 31) - 1,
+            1 << 31,
+            (1 << 31) + 1,
+            u32::MAX as u64,
+            1 << 32,
+        ] {
+            check(d);
+        }
+        for _ in 0..1_000_000 {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            check((1 << 31) + x % ((1 << 31) + 1));
+        }
+        assert_eq!(recip_63(0), None);
     }
 
     /// Against the exact square root (u128 arithmetic, independent of the scheme, in
