@@ -217,6 +217,11 @@ impl Controller {
         };
         if let (Ok(()), Some((sin_q30, cos_q30, _))) = (ground, turn) {
             g.turn(sin_q30, cos_q30);
+            // A turn past the fixed formats: its steered centres take the f32 ground.
+            if !g.yawed_ok && !g.float_ok {
+                let ground = self.float_ground(g, instant, boresight_h);
+                return (turn.map(|t| t.2), boresight_h, ground);
+            }
         }
         (turn.map(|t| t.2), boresight_h, ground)
     }
@@ -339,7 +344,10 @@ pub(super) type Ground = GeneralUpdate<f32>;
 /// twentieth of the M3's update.
 #[cfg(feature = "earth-fixed")]
 pub(super) struct Ground {
+    /// The f32 update: valid when `float_ok`; with fixed-point pixels made only where
+    /// read (the DEM's route, a steered centre past the fixed formats).
     pub(super) float: GeneralUpdate<f32>,
+    pub(super) float_ok: bool,
     /// Valid when `fixed_ok` (never unless [`Controller::fixed_pixels`]).
     fixed: core_math::earth::fixed::EarthFixedUpdate,
     fixed_ok: bool,
@@ -360,6 +368,7 @@ impl Ground {
         use core_math::earth::fixed::EarthFixedUpdate;
         Ground {
             float: ZERO_UPDATE,
+            float_ok: false,
             fixed: EarthFixedUpdate::ZERO,
             fixed_ok: false,
             yawed: EarthFixedUpdate::ZERO,
@@ -391,6 +400,11 @@ impl Ground {
                 .is_ok();
     }
 }
+
+/// The Earth's constants of `EarthFixed::ground_f32_into`, made at compile time.
+#[cfg(feature = "earth-fixed")]
+const GROUND: core_math::earth::fixed::GroundConsts =
+    core_math::earth::fixed::GroundConsts::new(&EARTH);
 
 /// A placeholder f32 update, overwritten before any use.
 const ZERO_UPDATE: GeneralUpdate<f32> = GeneralUpdate {
@@ -445,17 +459,44 @@ impl Controller {
     ) -> Result<(), Fault> {
         g.fixed_ok = false;
         g.yawed_ok = false;
-        g.float = GENERAL_F32.ground(instant, &EARTH, height_m)?;
+        g.float_ok = false;
         if self.fixed_pixels() {
-            // `EarthFixed::from_general_f32`: within a unit and 1.7e-9 relative of the
-            // same update widened to f64 and rounded there, which cost soft f64 on the
-            // M3.
-            core_math::EARTH_FIXED.from_general_f32_into(&g.float, instant.r2_m2, &mut g.fixed)?;
+            // Straight from the instant in integers (`EarthFixed::ground_f32_into`,
+            // within two units and 1.4e-9 relative of the f64 ground's rounding), without
+            // the f32 ground in soft float.
+            // Where the integers hand over (`EarthFixed::ground_int_into`: a height of
+            // 2^16 m or more, which no scene or TERRAIN frame passes, -500..9 000 m; a
+            // non-finite instant; |r|^2 - A^2 <= 0, C / |r|^2 below the formats' 0.05),
+            // the f32 ground and its rounding refuse too, each as `Fault::OutOfRange`:
+            // so here, without linking that route.
+            match core_math::EARTH_FIXED.ground_int_into(instant, &GROUND, height_m, &mut g.fixed) {
+                Some(r) => r?,
+                None => return Err(Fault::OutOfRange),
+            }
             g.fixed_ok = true;
+            if let Some((sin, cos, _)) = steer {
+                g.turn(q30(sin), q30(cos));
+            }
+            // The f32 ground only where it is read: the DEM's route, or a steered centre
+            // whose turn left the fixed formats.
+            if g.float_ok || !self.dem_ground.active() && (steer.is_none() || g.yawed_ok) {
+                return Ok(());
+            }
         }
-        if let Some((sin, cos, _)) = steer {
-            g.turn(q30(sin), q30(cos));
-        }
+        self.float_ground(g, instant, height_m)
+    }
+
+    /// The f32 ground into `g.float`.
+    #[cfg(feature = "earth-fixed")]
+    #[inline(never)]
+    pub(super) fn float_ground(
+        &self,
+        g: &mut Ground,
+        instant: &GeneralInstant<f32>,
+        height_m: f32,
+    ) -> Result<(), Fault> {
+        g.float = GENERAL_F32.ground(instant, &EARTH, height_m)?;
+        g.float_ok = true;
         Ok(())
     }
 }

@@ -237,7 +237,11 @@ impl Controller {
                 let m = core_math::EARTH_FIXED.motion(up, px)?;
                 signed(m.v2_mps.to_bits(), m.v1_mps.to_bits())
             }
-            (Some((sin, cos, _)), _, _) => steered_drift_cold(&update.float, seg, sin, cos)?,
+            // The f32 ground is made wherever the turn left the fixed formats.
+            (Some((sin, cos, _)), _, _) if update.float_ok => {
+                steered_drift_cold(&update.float, seg, sin, cos)?
+            }
+            (Some(_), _, _) => return Err(Fault::InvalidScene),
         };
         Ok(SegmentOutput {
             index: seg.index,
