@@ -156,11 +156,10 @@ impl Controller {
         &mut self,
         instant: &GeneralInstant<f32>,
         dem: Option<&ItrfFrame>,
-        g: &mut Ground,
-    ) -> (Steer, f32, Result<(), Fault>) {
+    ) -> (Steer, f32, Result<Ground, Fault>) {
         let boresight_h = self.height(self.plan.boresight_segment);
-        let ground = self.make_ground(g, instant, boresight_h, None);
-        let steer = ground.ok().and_then(|()| {
+        let ground = self.make_ground(instant, boresight_h, None);
+        let steer = ground.as_ref().ok().and_then(|g| {
             let on_dem = match dem {
                 Some(_) => self.dem_boresight(dem, g, instant.r2_minus_a2_m2, boresight_h),
                 None => None,
@@ -407,6 +406,7 @@ const GROUND: core_math::earth::fixed::GroundConsts =
     core_math::earth::fixed::GroundConsts::new(&EARTH);
 
 /// A placeholder f32 update, overwritten before any use.
+#[cfg(feature = "earth-fixed")]
 const ZERO_UPDATE: GeneralUpdate<f32> = GeneralUpdate {
     n_b: [0.0; 3],
     rho_b_m: [0.0; 3],
@@ -416,13 +416,6 @@ const ZERO_UPDATE: GeneralUpdate<f32> = GeneralUpdate {
     w_b_rad_s: [0.0; 3],
     v_b_mps: [0.0; 3],
 };
-
-/// No ground yet: the f32 route's placeholder, overwritten before any use.
-#[cfg(not(feature = "earth-fixed"))]
-#[inline(always)]
-pub(super) fn empty_ground(_plan: &crate::plan::Plan) -> Ground {
-    ZERO_UPDATE
-}
 
 /// No ground yet: nothing valid.
 #[cfg(feature = "earth-fixed")]
@@ -436,13 +429,13 @@ impl Controller {
     #[inline(never)]
     pub(super) fn make_ground(
         &self,
-        g: &mut Ground,
         instant: &GeneralInstant<f32>,
         height_m: f32,
         _steer: Option<(f32, f32, f32)>,
-    ) -> Result<(), Fault> {
-        *g = GENERAL_F32.ground(instant, &EARTH, height_m)?;
-        Ok(())
+    ) -> Result<Ground, Fault> {
+        GENERAL_F32
+            .ground(instant, &EARTH, height_m)
+            .map_err(Fault::from)
     }
 
     /// The f32 update of the ground and, for fixed-point pixels, the same rounded once
