@@ -132,7 +132,7 @@ impl Controller {
         sin: f32,
         cos: f32,
     ) -> Result<(f32, f32), Fault> {
-        match (&update.yawed, seg.fixed.first()) {
+        match (update.yawed(), seg.fixed.first()) {
             // The pair in I24F40 units: only its ratio is used.
             (Some(up), Some(px)) => {
                 let m = core_math::EARTH_FIXED.motion(up, px)?;
@@ -183,39 +183,44 @@ impl Controller {
         &mut self,
         instant: &GeneralInstant<f32>,
         dem: Option<&ItrfFrame>,
-    ) -> (Steer, f32, Result<Ground, Fault>) {
+        g: &mut Ground,
+    ) -> (Steer, f32, Result<(), Fault>) {
         let boresight_h = self.height(self.plan.boresight_segment);
-        let mut ground = self.make_ground(instant, boresight_h, None);
+        let ground = self.make_ground(g, instant, boresight_h, None);
         // Over a DEM tile, the boresight's ground on it (the f32 route's, soft float on
         // a core without an FPU, as the DEM's samples are).
-        let on_dem = match (&ground, dem) {
-            (Ok(g), Some(_)) => {
+        let on_dem = match (ground, dem) {
+            (Ok(()), Some(_)) => {
                 self.dem_boresight(dem, &g.float, instant.r2_minus_a2_m2, boresight_h)
             }
             _ => None,
         };
         if !self.fixed_pixels() {
-            let steer = ground.as_ref().ok().and_then(|g| match on_dem {
+            let steer = ground.ok().and_then(|()| match on_dem {
                 Some(m) => steer_from(m.v1_mps, m.v2_mps, atan_reduced(m.v2_mps / m.v1_mps)),
                 None => self.steer_f32(&g.float),
             });
             return (steer, boresight_h, ground);
         }
-        let turn = match (&ground, on_dem) {
+        let turn = match (ground, on_dem, g.fixed()) {
             // Over the DEM, the request from the boresight's f32 motion there.
-            (Ok(_), Some(m)) => steer_from(m.v1_mps, m.v2_mps, atan_pair_rad(m.v2_mps, m.v1_mps))
-                .map(|(sin, cos, rad)| (q30(sin), q30(cos), (sin, cos, rad))),
-            (Ok(Ground { fixed: Some(f), .. }), None) => f
+            (Ok(()), Some(m), _) => {
+                steer_from(m.v1_mps, m.v2_mps, atan_pair_rad(m.v2_mps, m.v1_mps))
+                    .map(|(sin, cos, rad)| (q30(sin), q30(cos), (sin, cos, rad)))
+            }
+            (Ok(()), None, Some(f)) => f
                 .boresight_over_focal()
                 .ok()
                 .and_then(|(vf1, vf2)| steer_fixed(vf1, vf2)),
             _ => None,
         };
-        if let (Ok(g), Some((sin_q30, cos_q30, _))) = (&mut ground, turn) {
-            g.yawed = g
-                .fixed
-                .as_ref()
-                .and_then(|f| f.yawed(sin_q30, cos_q30).ok());
+        if let (Ok(()), Some((sin_q30, cos_q30, _))) = (ground, turn) {
+            g.turn(sin_q30, cos_q30);
+            // A turn past the fixed formats: its steered centres take the f32 ground.
+            if !g.yawed_ok && !g.float_ok {
+                let ground = self.float_ground(g, instant, boresight_h);
+                return (turn.map(|t| t.2), boresight_h, ground);
+            }
         }
         (turn.map(|t| t.2), boresight_h, ground)
     }
@@ -333,18 +338,90 @@ pub(super) type Ground = GeneralUpdate<f32>;
 
 /// What the segments over one ground height are evaluated from: the f32 update, which
 /// the steered centre uses, and the same rounded to the fixed-point backend's formats,
-/// which every sample pixel uses (docs/controller.md, "Backends").
+/// which every sample pixel uses (docs/controller.md, "Backends"). Made in place, once
+/// per update, and overwritten per ground height: returned by value, its copies were a
+/// twentieth of the M3's update.
 #[cfg(feature = "earth-fixed")]
 pub(super) struct Ground {
+    /// The f32 update: valid when `float_ok`; with fixed-point pixels made only where
+    /// read (the DEM's route, a steered centre past the fixed formats).
     pub(super) float: GeneralUpdate<f32>,
-    /// None unless [`Controller::fixed_pixels`].
-    pub(super) fixed: Option<core_math::earth::fixed::EarthFixedUpdate>,
-    /// `fixed` turned by the yaw request, for the steered centres; None without a
-    /// request, or where the turn leaves the fixed formats' envelope.
-    pub(super) yawed: Option<core_math::earth::fixed::EarthFixedUpdate>,
+    pub(super) float_ok: bool,
+    /// Valid when `fixed_ok` (never unless [`Controller::fixed_pixels`]).
+    fixed: core_math::earth::fixed::EarthFixedUpdate,
+    fixed_ok: bool,
+    /// `fixed` turned by the yaw request, for the steered centres; valid when
+    /// `yawed_ok`: not without a request, or where the turn leaves the fixed formats'
+    /// envelope.
+    yawed: core_math::earth::fixed::EarthFixedUpdate,
+    yawed_ok: bool,
     /// The plan's line speed (pixel x clock, m/s) and period bounds in ticks, for
-    /// [`Controller::segment_fixed`]: once per ground, not per segment.
+    /// [`Controller::segment_fixed`]: once per update, not per segment.
     pub(super) period: PeriodConsts,
+}
+
+#[cfg(feature = "earth-fixed")]
+impl Ground {
+    /// No ground yet: nothing valid.
+    pub(super) fn empty(plan: &crate::plan::Plan) -> Ground {
+        use core_math::earth::fixed::EarthFixedUpdate;
+        Ground {
+            float: ZERO_UPDATE,
+            float_ok: false,
+            fixed: EarthFixedUpdate::ZERO,
+            fixed_ok: false,
+            yawed: EarthFixedUpdate::ZERO,
+            yawed_ok: false,
+            period: PeriodConsts::of(plan),
+        }
+    }
+
+    /// The fixed-point update, where made.
+    #[inline(always)]
+    pub(super) fn fixed(&self) -> Option<&core_math::earth::fixed::EarthFixedUpdate> {
+        self.fixed_ok.then_some(&self.fixed)
+    }
+
+    /// The fixed-point update turned by the yaw request, where made.
+    #[inline(always)]
+    pub(super) fn yawed(&self) -> Option<&core_math::earth::fixed::EarthFixedUpdate> {
+        self.yawed_ok.then_some(&self.yawed)
+    }
+
+    /// Turns the fixed-point update by the yaw request (sine and cosine in Q30) into
+    /// `yawed`; not valid where it is not made or the turn leaves the envelope.
+    #[inline(always)]
+    fn turn(&mut self, sin_q30: i32, cos_q30: i32) {
+        self.yawed_ok = self.fixed_ok
+            && self
+                .fixed
+                .yawed_into(sin_q30, cos_q30, &mut self.yawed)
+                .is_ok();
+    }
+}
+
+/// The Earth's constants of `EarthFixed::ground_f32_into`, made at compile time.
+#[cfg(feature = "earth-fixed")]
+const GROUND: core_math::earth::fixed::GroundConsts =
+    core_math::earth::fixed::GroundConsts::new(&EARTH);
+
+/// A placeholder f32 update, overwritten before any use.
+#[cfg(feature = "earth-fixed")]
+const ZERO_UPDATE: GeneralUpdate<f32> = GeneralUpdate {
+    n_b: [0.0; 3],
+    rho_b_m: [0.0; 3],
+    stretch2_minus_1: 0.0,
+    c_m2: 0.0,
+    inv_c_per_m2: 0.0,
+    w_b_rad_s: [0.0; 3],
+    v_b_mps: [0.0; 3],
+};
+
+/// No ground yet: nothing valid.
+#[cfg(feature = "earth-fixed")]
+#[inline(always)]
+pub(super) fn empty_ground(plan: &crate::plan::Plan) -> Ground {
+    Ground::empty(plan)
 }
 
 impl Controller {
@@ -361,43 +438,60 @@ impl Controller {
             .map_err(Fault::from)
     }
 
-    /// The f32 update of the ground and, for fixed-point pixels, the same widened to
-    /// f64 and rounded once to the fixed-point formats: per ground height, not per pixel.
+    /// The f32 update of the ground and, for fixed-point pixels, the same rounded once
+    /// to the fixed-point formats in integers, turned by the yaw request `steer` where
+    /// one is given: per ground height, not per pixel, into `g` in place. A refusal
+    /// leaves nothing of `g` valid.
     #[cfg(feature = "earth-fixed")]
     pub(super) fn make_ground(
         &self,
+        g: &mut Ground,
         instant: &GeneralInstant<f32>,
         height_m: f32,
         steer: Option<(f32, f32, f32)>,
-    ) -> Result<Ground, Fault> {
-        let float = GENERAL_F32.ground(instant, &EARTH, height_m)?;
-        let fixed = if self.fixed_pixels() {
-            Some(fixed_update(&float, instant.r2_m2)?)
-        } else {
-            None
-        };
-        let yawed = match (&fixed, steer) {
-            (Some(f), Some((sin, cos, _))) => f.yawed(q30(sin), q30(cos)).ok(),
-            _ => None,
-        };
-        Ok(Ground {
-            float,
-            fixed,
-            yawed,
-            period: PeriodConsts::of(&self.plan),
-        })
+    ) -> Result<(), Fault> {
+        g.fixed_ok = false;
+        g.yawed_ok = false;
+        g.float_ok = false;
+        if self.fixed_pixels() {
+            // Straight from the instant in integers (`EarthFixed::ground_f32_into`,
+            // within two units and 1.4e-9 relative of the f64 ground's rounding), without
+            // the f32 ground in soft float.
+            // Where the integers hand over (`EarthFixed::ground_int_into`: a height of
+            // 2^16 m or more, which no scene or TERRAIN frame passes, -500..9 000 m; a
+            // non-finite instant; |r|^2 - A^2 <= 0, C / |r|^2 below the formats' 0.05),
+            // the f32 ground and its rounding refuse too, each as `Fault::OutOfRange`:
+            // so here, without linking that route.
+            match core_math::EARTH_FIXED.ground_int_into(instant, &GROUND, height_m, &mut g.fixed) {
+                Some(r) => r?,
+                None => return Err(Fault::OutOfRange),
+            }
+            g.fixed_ok = true;
+            if let Some((sin, cos, _)) = steer {
+                g.turn(q30(sin), q30(cos));
+            }
+            // The f32 ground only where it is read: the DEM's route, or a steered centre
+            // whose turn left the fixed formats.
+            if g.float_ok || !self.dem_ground.active() && (steer.is_none() || g.yawed_ok) {
+                return Ok(());
+            }
+        }
+        self.float_ground(g, instant, height_m)
     }
-}
 
-/// `float` rounded to the fixed-point backend's formats, in integers
-/// (`EarthFixed::from_general_f32`: within a unit and 1.7e-9 relative of the same
-/// update widened to f64 and rounded there, which cost soft f64 on the M3).
-#[cfg(feature = "earth-fixed")]
-pub(super) fn fixed_update(
-    float: &GeneralUpdate<f32>,
-    r2_m2: f32,
-) -> Result<core_math::earth::fixed::EarthFixedUpdate, Fault> {
-    Ok(core_math::EARTH_FIXED.from_general_f32(float, r2_m2)?)
+    /// The f32 ground into `g.float`.
+    #[cfg(feature = "earth-fixed")]
+    #[inline(never)]
+    pub(super) fn float_ground(
+        &self,
+        g: &mut Ground,
+        instant: &GeneralInstant<f32>,
+        height_m: f32,
+    ) -> Result<(), Fault> {
+        g.float = GENERAL_F32.ground(instant, &EARTH, height_m)?;
+        g.float_ok = true;
+        Ok(())
+    }
 }
 
 #[cfg(not(feature = "earth-fixed"))]

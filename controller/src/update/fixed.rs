@@ -230,14 +230,18 @@ impl Controller {
         } else {
             worst_drift_rad
         };
-        let residual_drift_rad = match (steer, &update.yawed, seg.fixed.first()) {
+        let residual_drift_rad = match (steer, update.yawed(), seg.fixed.first()) {
             (None, _, _) => drift_rad,
             // The centre on the turned fixed-point update, in integers.
             (Some(_), Some(up), Some(px)) => {
                 let m = core_math::EARTH_FIXED.motion(up, px)?;
                 signed(m.v2_mps.to_bits(), m.v1_mps.to_bits())
             }
-            (Some((sin, cos, _)), _, _) => steered_drift_cold(&update.float, seg, sin, cos)?,
+            // The f32 ground is made wherever the turn left the fixed formats.
+            (Some((sin, cos, _)), _, _) if update.float_ok => {
+                steered_drift_cold(&update.float, seg, sin, cos)?
+            }
+            (Some(_), _, _) => return Err(Fault::InvalidScene),
         };
         Ok(SegmentOutput {
             index: seg.index,

@@ -144,6 +144,15 @@ impl Controller {
         // place in memory, which the out-of-line `segment` and `extremes` read.
         // The DEM's route needs a tile in force and the ITRF of the instant.
         let dem_frame = if self.dem_ground.active() { itrf } else { None };
+        // With fixed-point pixels the ground is one place per update that each height's
+        // update is written into (returned by value, its copies were a twentieth of the
+        // M3's update); the f32 route returns its smaller update as before.
+        #[cfg(feature = "earth-fixed")]
+        let mut update = empty_ground(&self.plan);
+        #[cfg(feature = "earth-fixed")]
+        let (steer, mut ground_h_m, mut ground) =
+            self.steer_and_ground(&instant, dem_frame.as_ref(), &mut update);
+        #[cfg(not(feature = "earth-fixed"))]
         let (steer, mut ground_h_m, mut ground) =
             self.steer_and_ground(&instant, dem_frame.as_ref());
         self.yaw_request_rad = steer.map(|(_, _, rad)| rad);
@@ -160,11 +169,22 @@ impl Controller {
             // height's bits, and -0 against 0 only makes the same ground again.
             let bits = ground_h_m.to_bits();
             if height_m.to_bits() != bits || bits & 0x7fff_ffff > 0x7f80_0000 {
-                ground = self.make_ground(&instant, height_m, steer);
+                #[cfg(feature = "earth-fixed")]
+                {
+                    ground = self.make_ground(&mut update, &instant, height_m, steer);
+                }
+                #[cfg(not(feature = "earth-fixed"))]
+                {
+                    ground = self.make_ground(&instant, height_m, steer);
+                }
                 ground_h_m = height_m;
             }
-            let result = match (&ground, &dem_frame) {
-                (Err(f), _) => Err(*f),
+            #[cfg(feature = "earth-fixed")]
+            let made = ground.map(|()| &update);
+            #[cfg(not(feature = "earth-fixed"))]
+            let made = ground.as_ref().map_err(|f| *f);
+            let result = match (made, &dem_frame) {
+                (Err(f), _) => Err(f),
                 // With a DEM tile in force, each sample's own ground on it.
                 (Ok(update), Some(frame)) => self
                     .dem_segment(k, frame, update, &instant, height_m)

@@ -94,7 +94,7 @@ pub(super) fn sweep(
 #[inline(never)]
 pub(super) fn extremes_fixed(g: &Ground, seg: &SegmentPlan) -> Result<ExtremesBits, Fault> {
     use core_math::EARTH_FIXED;
-    let Some(up) = &g.fixed else {
+    let Some(up) = g.fixed() else {
         return Err(Fault::InvalidScene);
     };
     let Some((first, pixels)) = seg.fixed.split_first() else {

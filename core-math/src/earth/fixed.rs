@@ -120,7 +120,7 @@ pub struct EarthFixedUpdate {
 /// The per-update constants of [`Backend::motion`], in the signs and shifts its sums
 /// take, so that each sum is a chain of 32 x 32 -> 64 multiply-accumulates from a
 /// preset accumulator (rounding constants folded in). Derived from the other fields of
-/// [`EarthFixedUpdate`] by [`Terms::of`], never set on their own.
+/// [`EarthFixedUpdate`] by `EarthFixedUpdate::set`, never set on their own.
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Terms {
     /// rho3 2^30 + 2^28, Q60: -beta's constant term, and half a unit of Q31.
@@ -139,36 +139,57 @@ struct Terms {
 }
 
 impl Terms {
-    // Out of line: one copy for every constructor of the update (flash).
-    #[inline(never)]
-    fn of(m: &[i32; 3], rho: &[i32; 3], w: &[i32; 3], v: &[i32; 3]) -> Terms {
-        let wide = |x: i32| i64::from(x);
-        Terms {
-            beta0: (wide(rho[2]) << 30) + (1 << 28),
-            nrho: [-rho[0], -rho[1]],
-            s0: -(wide(m[2]) << 30) + (1 << 31),
-            w0: [wide(w[1]) << 30, -(wide(w[0]) << 30)],
-            nw: [-w[0], -w[2]],
-            v0: [
-                (wide(v[0]) << 30) + (1 << 30),
-                (wide(v[1]) << 30) + (1 << 30),
-            ],
-        }
-    }
+    const ZERO: Terms = Terms {
+        beta0: 0,
+        nrho: [0; 2],
+        s0: 0,
+        w0: [0; 2],
+        nw: [0; 2],
+        v0: [0; 2],
+    };
 }
 
 impl EarthFixedUpdate {
+    /// All zeros: a place to build an update into ([`EarthFixed::from_general_f32_into`],
+    /// [`EarthFixedUpdate::yawed_into`]) without copying one, never one to evaluate
+    /// (`motion` on it refuses every pixel as [`ModelError::NoAlongTrackMotion`]).
+    pub const ZERO: EarthFixedUpdate = EarthFixedUpdate {
+        m: [0; 3],
+        rho: [0; 3],
+        c: 0,
+        inv_c: 0,
+        w: [0; 3],
+        v: [0; 3],
+        k: Terms::ZERO,
+    };
+
     /// The update from its rounded fields (each within its format's bound).
     fn new(m: [i32; 3], rho: [i32; 3], c: u32, inv_c: u32, w: [i32; 3], v: [i32; 3]) -> Self {
-        EarthFixedUpdate {
-            m,
-            rho,
-            c,
-            inv_c,
-            w,
-            v,
-            k: Terms::of(&m, &rho, &w, &v),
-        }
+        let mut up = EarthFixedUpdate::ZERO;
+        up.set(m, rho, c, inv_c, w, v);
+        up
+    }
+
+    /// Overwrites every field, [`Terms`] derived from the others, in place.
+    // Out of line: one copy for every constructor of the update (flash).
+    #[inline(never)]
+    fn set(&mut self, m: [i32; 3], rho: [i32; 3], c: u32, inv_c: u32, w: [i32; 3], v: [i32; 3]) {
+        let wide = |x: i32| i64::from(x);
+        self.k.beta0 = (wide(rho[2]) << 30) + (1 << 28);
+        self.k.nrho = [-rho[0], -rho[1]];
+        self.k.s0 = -(wide(m[2]) << 30) + (1 << 31);
+        self.k.w0 = [wide(w[1]) << 30, -(wide(w[0]) << 30)];
+        self.k.nw = [-w[0], -w[2]];
+        self.k.v0 = [
+            (wide(v[0]) << 30) + (1 << 30),
+            (wide(v[1]) << 30) + (1 << 30),
+        ];
+        self.m = m;
+        self.rho = rho;
+        self.c = c;
+        self.inv_c = inv_c;
+        self.w = w;
+        self.v = v;
     }
 }
 
@@ -271,6 +292,19 @@ impl EarthFixed {
         up: &crate::earth::GeneralUpdate<f32>,
         r2_m2: f32,
     ) -> Result<EarthFixedUpdate, ModelError> {
+        let mut out = EarthFixedUpdate::ZERO;
+        self.from_general_f32_into(up, r2_m2, &mut out)?;
+        Ok(out)
+    }
+
+    /// [`EarthFixed::from_general_f32`] written into `out` (left as it was on a refusal):
+    /// for a caller that keeps the update in place, where returning one copied it.
+    pub fn from_general_f32_into(
+        &self,
+        up: &crate::earth::GeneralUpdate<f32>,
+        r2_m2: f32,
+        out: &mut EarthFixedUpdate,
+    ) -> Result<(), ModelError> {
         let position = ModelError::OutOfDomain(Param::Position);
         if !(r2_m2 > 0.0 && r2_m2.is_finite()) {
             return Err(position);
@@ -282,7 +316,7 @@ impl EarthFixed {
         // |r| = s 2^h, s in [2^31, 2^32] (within 2 units), 1/|r| = inv 2^(-63 - h).
         let s = u64::from(sqrt_per_update(big_m));
         let h = (re - sh) / 2;
-        let inv = (1u64 << 63).checked_div(s).ok_or(position)? as i64;
+        let inv = recip_63(s).ok_or(position)?;
         // x / |r| in Q`frac`: its mantissa times inv, exact in i64 (< 2^56).
         let over_r = |x: f32, frac: i32| -> Option<i64> {
             let (m, e) = parts(x);
@@ -312,7 +346,7 @@ impl EarthFixed {
         // included).
         let t = 32 - (c_prod as u64).leading_zeros() as i32;
         let d = (c_prod as u64).checked_shr(t.max(0) as u32).unwrap_or(0);
-        let quotient = (1u64 << 63).checked_div(d).ok_or(position)? as i64;
+        let quotient = recip_63(d).ok_or(position)?;
         let inv_c = round_shift(quotient, -36 - c_exp - t).ok_or(position)?;
         let direct = |x: f32, frac: i32| -> Option<i64> {
             let (m, e) = parts(x);
@@ -354,14 +388,46 @@ impl EarthFixed {
                 ModelError::OutOfDomain(Param::Velocity),
             )?;
         }
-        Ok(EarthFixedUpdate::new(
-            m,
-            rho,
-            c as u32,
-            u32::try_from(inv_c).map_err(|_| position)?,
-            w,
-            v,
-        ))
+        let inv_c = u32::try_from(inv_c).map_err(|_| position)?;
+        out.set(m, rho, c as u32, inv_c, w, v);
+        Ok(())
+    }
+
+    /// [`EarthFixed::from_general_f32_into`] of `General::<f32>::ground(inst, e,
+    /// ground_h_m)` (`e` the ellipsoid of `consts`), without that f32 update: straight
+    /// from the f32 instant in integers. kappa^2 - 1 = (A - B)(A + B) / B^2 (A - B = a f)
+    /// by one `div_64_32` in Q38; C / |r|^2 = (|r|^2 - a^2 - (2a + h) h) / |r|^2 +
+    /// (kappa^2 - 1)(r_z / |r|)^2 in Q60; rho / |r| = rho0 / |r| + (kappa^2 - 1)(r_z /
+    /// |r|) n in Q40; each rounded once to its format. The same checks and refusals in
+    /// the same order; a height of 2^16 m or more, or |r|^2 - A^2 <= 0, takes the f32
+    /// ground and [`EarthFixed::from_general_f32_into`], which refuse as before. Within
+    /// a unit or two of each format of [`EarthFixed::from_general`] on the f64 ground of
+    /// the same instant (`ground_f32_matches_the_f64_ground`).
+    pub fn ground_f32_into(
+        &self,
+        inst: &crate::earth::GeneralInstant<f32>,
+        consts: &GroundConsts,
+        ground_h_m: f32,
+        out: &mut EarthFixedUpdate,
+    ) -> Result<(), ModelError> {
+        match self.ground_int_into(inst, consts, ground_h_m, out) {
+            Some(r) => r,
+            None => ground_cold(inst, consts, ground_h_m, out),
+        }
+    }
+
+    /// [`EarthFixed::ground_f32_into`] where the integers reach, None elsewhere: for a
+    /// caller that makes the f32 ground itself there (one copy of it in flash) and
+    /// rounds it by [`EarthFixed::from_general_f32_into`].
+    #[inline(always)]
+    pub fn ground_int_into(
+        &self,
+        inst: &crate::earth::GeneralInstant<f32>,
+        consts: &GroundConsts,
+        ground_h_m: f32,
+        out: &mut EarthFixedUpdate,
+    ) -> Option<Result<(), ModelError>> {
+        ground_q(inst, consts, ground_h_m, out)
     }
 
     /// The f64 update, every length over |r|, rounded to the per-pixel formats.
@@ -429,6 +495,19 @@ impl EarthFixedUpdate {
     /// [`ModelError::OutOfDomain`]. Integers only: the per-segment steered centre of a
     /// core without an FPU is then one [`Backend::motion`].
     pub fn yawed(&self, sin_q30: i32, cos_q30: i32) -> Result<EarthFixedUpdate, ModelError> {
+        let mut out = EarthFixedUpdate::ZERO;
+        self.yawed_into(sin_q30, cos_q30, &mut out)?;
+        Ok(out)
+    }
+
+    /// [`EarthFixedUpdate::yawed`] written into `out` (left as it was on a refusal), for
+    /// a caller that keeps the update in place.
+    pub fn yawed_into(
+        &self,
+        sin_q30: i32,
+        cos_q30: i32,
+        out: &mut EarthFixedUpdate,
+    ) -> Result<(), ModelError> {
         let turn = |x: [i32; 3], max: i64, p: Param| -> Result<[i32; 3], ModelError> {
             let (c, s) = (i64::from(cos_q30), i64::from(sin_q30));
             let (x0, x1) = (i64::from(x[0]), i64::from(x[1]));
@@ -443,14 +522,12 @@ impl EarthFixedUpdate {
             out[2] = x[2];
             Ok(out)
         };
-        Ok(EarthFixedUpdate::new(
-            turn(self.m, limit::M, Param::Position)?,
-            turn(self.rho, limit::RHO, Param::Position)?,
-            self.c,
-            self.inv_c,
-            turn(self.w, limit::W, Param::AngularVelocity)?,
-            turn(self.v, limit::V, Param::Velocity)?,
-        ))
+        let m = turn(self.m, limit::M, Param::Position)?;
+        let rho = turn(self.rho, limit::RHO, Param::Position)?;
+        let w = turn(self.w, limit::W, Param::AngularVelocity)?;
+        let v = turn(self.v, limit::V, Param::Velocity)?;
+        out.set(m, rho, self.c, self.inv_c, w, v);
+        Ok(())
     }
 }
 
@@ -478,6 +555,230 @@ impl EarthFixedUpdate {
             return Err(ModelError::NoAlongTrackMotion);
         }
         Ok((vf1, vf2))
+    }
+}
+
+/// An ellipsoid's constants for [`EarthFixed::ground_f32_into`], in integers (made in
+/// a const context: no soft f64 at run time).
+#[derive(Clone, Copy, Debug)]
+pub struct GroundConsts {
+    /// The ellipsoid itself, for the f32 route where the integers do not reach.
+    ellipsoid: crate::earth::Ellipsoid,
+    /// A - B = a f, Q16.
+    a_minus_b_q16: i64,
+    /// a + b, Q8.
+    a_plus_b_q8: i64,
+    /// b, Q8.
+    b_q8: i64,
+    /// 2a, Q4.
+    two_a_q4: i64,
+}
+
+impl GroundConsts {
+    /// The constants of `e` (a and b below 2^22.9 m: the Earth's, rounded to nearest).
+    pub const fn new(e: &crate::earth::Ellipsoid) -> GroundConsts {
+        let b = e.a_m * (1.0 - e.flattening);
+        GroundConsts {
+            ellipsoid: *e,
+            a_minus_b_q16: (e.a_m * e.flattening * 65_536.0 + 0.5) as i64,
+            a_plus_b_q8: ((e.a_m + b) * 256.0 + 0.5) as i64,
+            b_q8: (b * 256.0 + 0.5) as i64,
+            two_a_q4: (2.0 * e.a_m * 16.0 + 0.5) as i64,
+        }
+    }
+}
+
+/// [`EarthFixed::ground_f32_into`] where the integers reach: the f32 ground and its
+/// rounding.
+#[cold]
+#[inline(never)]
+fn ground_cold(
+    inst: &crate::earth::GeneralInstant<f32>,
+    consts: &GroundConsts,
+    ground_h_m: f32,
+    out: &mut EarthFixedUpdate,
+) -> Result<(), ModelError> {
+    let up = General::<f32>::new().ground(inst, &consts.ellipsoid, ground_h_m)?;
+    EarthFixed.from_general_f32_into(&up, inst.r2_m2, out)
+}
+
+/// The integer body of [`EarthFixed::ground_f32_into`]; None where it hands over to
+/// the f32 route.
+#[inline(never)]
+fn ground_q(
+    inst: &crate::earth::GeneralInstant<f32>,
+    k: &GroundConsts,
+    ground_h_m: f32,
+    out: &mut EarthFixedUpdate,
+) -> Option<Result<(), ModelError>> {
+    let position = ModelError::OutOfDomain(Param::Position);
+    let r2_m2 = inst.r2_m2;
+    if !(r2_m2 > 0.0 && r2_m2.is_finite()) {
+        return None;
+    }
+    // h in Q8 (|h| < 2^16 m), its mantissa for (2a + h) h.
+    let (hm, he) = parts(ground_h_m);
+    let h8 = round_shift_call(hm, he + 8)?;
+    if h8.abs() >= 1 << 24 {
+        return None;
+    }
+    // 1/|r| and its square as in `from_general_f32_into`.
+    let (rm, re) = parts(r2_m2);
+    let sh = if (re - 40) % 2 == 0 { 40 } else { 39 };
+    let s = u64::from(sqrt_per_update((rm as u64) << sh));
+    let hr = (re - sh) / 2;
+    let inv = recip_63(s)?;
+    let over_r = |x: f32, frac: i32| -> Option<i64> {
+        let (m, e) = parts(x);
+        round_shift_call(m * inv, e - 63 - hr + frac)
+    };
+    let inv2 = if inv >= 1 << 32 {
+        1 << 32
+    } else {
+        ((inv as u64 * inv as u64) >> 32) as i64
+    };
+    // kappa^2 - 1 = (A - B)(A + B) / B^2, Q38: B in Q8 (about 2^30.6), B^2 in Q16 below
+    // 2^62, its top 32 bits d (>= 2^31); (A - B)(A + B) in Q24, below d 2^31.
+    let b8 = k.b_q8 + h8;
+    let num = k.a_minus_b_q16 * (k.a_plus_b_q8 + 2 * h8);
+    let b2 = (b8 * b8) as u64;
+    let d = (b2 >> 30) as u32;
+    if b8 <= 0 || d < 1 << 31 || num < 0 || (num as u64) >> 31 >= u64::from(d) {
+        return None;
+    }
+    // num / (d 2^30) 2^-8 = q 2^-38.
+    let q = i64::from(crate::wide::div_64_32((num >> 32) as u32, num as u32, d));
+    // z / |r|, Q30, and its square.
+    let zr = over_r(inst.r_z_m, 30)?;
+    let zr2 = (zr * zr + (1 << 29)) >> 30;
+    // |r|^2 - A^2 = (|r|^2 - a^2) - (2a + h) h, Q4: (2a + h) in Q4 times h's mantissa.
+    let (nm, ne) = parts(inst.r2_minus_a2_m2);
+    let lead = round_shift_call(nm, ne + 4)?;
+    let tail = round_shift_call((k.two_a_q4 + (h8 >> 4)) * hm, he)?;
+    let n4 = lead - tail;
+    if n4 <= 0 {
+        return None;
+    }
+    // n4 = n 2^t with n < 2^31 (truncated), then over |r|^2: Q60.
+    let t = (33 - n4.leading_zeros() as i32).max(0);
+    let term1 = round_shift_call((n4 >> t) * inv2, t - 4 - 94 - 2 * hr + 60)?;
+    // (kappa^2 - 1)(z/|r|)^2: Q38 x Q30 = Q68, to Q60.
+    let c60 = term1 + ((q * zr2 + (1 << 7)) >> 8);
+    let c = (c60 + (1 << 27)) >> 28;
+    use limit::{C_HI, C_LO, K2M1};
+    if !(C_LO..=C_HI).contains(&c) {
+        return Some(Err(position));
+    }
+    // r^2 / C, Q27 = 2^87 / c60: c60 = dc 2^tc + (less), dc in [2^31, 2^32).
+    let tc = 32 - c60.leading_zeros() as i32;
+    let dc = (c60 as u64).checked_shr(tc.max(0) as u32).unwrap_or(0);
+    let inv_c = round_shift_call(recip_63(dc)?, 24 - tc)?;
+    let Ok(inv_c) = u32::try_from(inv_c) else {
+        return Some(Err(position));
+    };
+    if (q + 2) >> 2 > K2M1 {
+        return Some(Err(ModelError::OutOfDomain(Param::Flattening)));
+    }
+    // sqrt(kappa^2 - 1): q 2^z in [2^62, 2^64), z even; its root in Q(19 + z/2).
+    let z = (q as u64).leading_zeros() & !1;
+    let sk = i64::from(sqrt_per_update((q as u64) << z));
+    let sk_frac = 19 + (z / 2) as i32;
+    // (kappa^2 - 1) z / |r|, Q40 (Q38 x Q30 = Q68).
+    let kz40 = (q * zr + (1 << 27)) >> 28;
+    let mut m = [0; 3];
+    let mut rho = [0; 3];
+    let mut w = [0; 3];
+    let mut v = [0; 3];
+    let scales = Scales {
+        inv,
+        hr,
+        sk,
+        sk_frac,
+        kz40,
+    };
+    for kk in 0..3 {
+        let f = ground_fields(inst, &scales, kk);
+        match f {
+            Ok(f) => (m[kk], rho[kk], w[kk], v[kk]) = f,
+            Err(e) => return Some(Err(e)),
+        }
+    }
+    out.set(m, rho, c as u32, inv_c, w, v);
+    Some(Ok(()))
+}
+
+/// The per-instant scales of [`ground_fields`]: 1/|r| = inv 2^(-63 - hr), sqrt(kappa^2
+/// - 1) = sk 2^-sk_frac, (kappa^2 - 1) z / |r| in Q40.
+struct Scales {
+    inv: i64,
+    hr: i32,
+    sk: i64,
+    sk_frac: i32,
+    kz40: i64,
+}
+
+/// One axis `kk` of [`ground_q`]'s fields (m, rho, W, V) in their formats, with their
+/// checks. Out of line, one copy for the three axes (flash).
+#[inline(never)]
+fn ground_fields(
+    inst: &crate::earth::GeneralInstant<f32>,
+    sc: &Scales,
+    kk: usize,
+) -> Result<(i32, i32, i32, i32), ModelError> {
+    let position = ModelError::OutOfDomain(Param::Position);
+    let within = |q: Option<i64>, max: i64, err: ModelError| match q {
+        Some(q) if q.abs() <= max => Ok(q as i32),
+        _ => Err(err),
+    };
+    let at = |x: [f32; 3]| x.get(kk).copied().unwrap_or(f32::NAN);
+    let over_r = |x: f32, frac: i32| -> Option<i64> {
+        let (m, e) = parts(x);
+        round_shift_call(m * sc.inv, e - 63 - sc.hr + frac)
+    };
+    let n = at(inst.n_b);
+    let (nm, ne) = parts(n);
+    within(round_shift_call(nm, ne + 30), limit::N, position)?;
+    let m = within(
+        round_shift_call(sc.sk * nm, ne - sc.sk_frac + 33),
+        limit::M,
+        position,
+    )?;
+    // rho0 / |r| + (kappa^2 - 1)(z / |r|) n, both in Q40, rounded once to Q30.
+    let rho40 = over_r(at(inst.rho0_b_m), 40)
+        .zip(round_shift_call(sc.kz40 * nm, ne))
+        .and_then(|(a, b)| round_shift_call(a + b, -10));
+    let rho = within(rho40, limit::RHO, position)?;
+    let (wm, we) = parts(at(inst.w_b_rad_s));
+    let w = within(
+        round_shift_call(wm, we + 33),
+        limit::W,
+        ModelError::OutOfDomain(Param::AngularVelocity),
+    )?;
+    let v = within(
+        over_r(at(inst.v_b_mps), 40),
+        limit::V,
+        ModelError::OutOfDomain(Param::Velocity),
+    )?;
+    Ok((m, rho, w, v))
+}
+
+/// [`round_shift`] out of line (a 64-bit shift by a variable is long on a 32-bit core:
+/// one copy for [`ground_q`]).
+#[inline(never)]
+fn round_shift_call(m: i64, sh: i32) -> Option<i64> {
+    round_shift(m, sh)
+}
+
+/// 2^63 / `d` truncated, for `d` in [2^31 - 2, 2^32]: the core's 32-bit divide twice
+/// (`wide::div_64_32`), where a u64 division is a software call; 2^32 at and below 2^31
+/// (within 1e-9 relative of the quotient there), None for 0.
+#[inline(always)]
+fn recip_63(d: u64) -> Option<i64> {
+    match u32::try_from(d) {
+        Ok(n) if n > 1 << 31 => Some(i64::from(crate::wide::div_64_32(1 << 31, 0, n))),
+        Ok(0) => None,
+        Ok(n) if n >= (1 << 31) - 2 => Some(1 << 32),
+        _ => (1u64 << 63).checked_div(d).map(|q| q as i64),
     }
 }
 
@@ -811,6 +1112,135 @@ mod tests {
         std::eprintln!(
             "from_general_f32: beyond one unit, worst {worst:.2e} relative over {checked} updates"
         );
+    }
+
+    /// `ground_f32_into` (integers, from the f32 instant) against `from_general` on the
+    /// general form's f64 ground of the same instant widened to f64: every field within
+    /// two units of its format plus 3e-9 of its value, the same refusals, over
+    /// altitudes 150-2 700 km, attitudes, rates and ground heights from -500 to 9 000 m;
+    /// heights past the integers' 2^16 m take the f32 route and agree with it.
+    #[test]
+    fn ground_f32_matches_the_f64_ground() {
+        extern crate std;
+        use crate::earth::{circular_state, Ellipsoid, GeneralInstant};
+        let mut rng = crate::sample::SplitMix64(0x6_0D1D_2026_1127);
+        let general = General::<f32>::new();
+        let consts = GroundConsts::new(&Ellipsoid::WGS84);
+        let (mut worst, mut worst_units, mut checked, mut refused) = (0f64, 0u64, 0, 0);
+        for i in 0..20_000 {
+            let radius = Ellipsoid::WGS84.a_m + rng.uniform(150e3, 2_700e3);
+            let state = circular_state(radius, rng.uniform(0.0, 3.1), rng.uniform(-3.2, 3.2));
+            let attitude = Attitude {
+                roll_rad: rng.uniform(-0.6, 0.6) as f32,
+                pitch_rad: rng.uniform(-0.5, 0.5) as f32,
+                yaw_rad: rng.uniform(-3.2, 3.2) as f32,
+                roll_rate_rad_s: rng.uniform(-0.05, 0.05) as f32,
+                pitch_rate_rad_s: rng.uniform(-0.05, 0.05) as f32,
+                yaw_rate_rad_s: rng.uniform(-0.05, 0.05) as f32,
+            };
+            let Ok(inst) = general.instant(
+                &state,
+                &attitude,
+                &Ellipsoid::WGS84,
+                crate::EARTH_RATE_RAD_S,
+            ) else {
+                continue;
+            };
+            let h = if i % 100 == 0 {
+                rng.uniform(70e3, 400e3) as f32
+            } else {
+                rng.uniform(-500.0, 9_000.0) as f32
+            };
+            let w = |x: [f32; 3]| x.map(f64::from);
+            let wide = GeneralInstant {
+                n_b: w(inst.n_b),
+                rho0_b_m: w(inst.rho0_b_m),
+                r_z_m: f64::from(inst.r_z_m),
+                r2_m2: f64::from(inst.r2_m2),
+                r2_minus_a2_m2: f64::from(inst.r2_minus_a2_m2),
+                w_b_rad_s: w(inst.w_b_rad_s),
+                v_b_mps: w(inst.v_b_mps),
+            };
+            let want = General::<f64>::new()
+                .ground(&wide, &Ellipsoid::WGS84, f64::from(h))
+                .and_then(|up| EarthFixed.from_general(&up, f64::from(inst.r2_m2)));
+            let mut got = EarthFixedUpdate::ZERO;
+            let got = EarthFixed
+                .ground_f32_into(&inst, &consts, h, &mut got)
+                .map(|()| got);
+            if h >= 65_536.0 {
+                // The f32 route: the f32 ground rounded, as before.
+                let float = general
+                    .ground(&inst, &Ellipsoid::WGS84, h)
+                    .and_then(|up| EarthFixed.from_general_f32(&up, inst.r2_m2));
+                assert_eq!(got, float);
+                continue;
+            }
+            match (want, got) {
+                (Ok(a), Ok(b)) => {
+                    let mut d = |x: i64, y: i64| {
+                        let units = x.abs_diff(y);
+                        worst_units = worst_units.max(units);
+                        let excess = units.saturating_sub(2) as f64;
+                        worst = worst.max(excess / (x.unsigned_abs().max(1) as f64));
+                    };
+                    for k in 0..3 {
+                        d(a.m[k].into(), b.m[k].into());
+                        d(a.rho[k].into(), b.rho[k].into());
+                        d(a.w[k].into(), b.w[k].into());
+                        d(a.v[k].into(), b.v[k].into());
+                    }
+                    d(a.c.into(), b.c.into());
+                    d(a.inv_c.into(), b.inv_c.into());
+                    checked += 1;
+                }
+                (a, b) => {
+                    assert_eq!(a.err(), b.err());
+                    refused += 1;
+                }
+            }
+        }
+        assert!(checked > 15_000, "{checked}");
+        assert!(worst <= 3e-9, "{worst:e}");
+        std::eprintln!(
+            "ground_f32_into: at most {worst_units} units, beyond two {worst:.2e} relative, \
+             over {checked} updates ({refused} refused alike)"
+        );
+    }
+
+    /// `recip_63` against the u64 division over its domain's every edge and 10^6
+    /// random divisors: exact (the truncated quotient) above 2^31, 2^32 at 2^31 and the
+    /// two below it (within 1e-9 of the quotient there), None for 0.
+    #[test]
+    fn recip_63_is_the_truncated_quotient() {
+        let mut x: u64 = 0x2545_F491_4F6C_DD1D;
+        let check = |d: u64| {
+            let want = (1u64 << 63) / d;
+            let got = recip_63(d).unwrap() as u64;
+            if d > 1 << 31 {
+                assert_eq!(got, want, "{d}");
+            } else {
+                assert_eq!(got, 1 << 32, "{d}");
+                assert!((want - got) as f64 <= 1e-9 * want as f64, "{d}");
+            }
+        };
+        for d in [
+            (1 << 31) - 2,
+            (1 << 31) - 1,
+            1 << 31,
+            (1 << 31) + 1,
+            u32::MAX as u64,
+            1 << 32,
+        ] {
+            check(d);
+        }
+        for _ in 0..1_000_000 {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            check((1 << 31) + x % ((1 << 31) + 1));
+        }
+        assert_eq!(recip_63(0), None);
     }
 
     /// Against the exact square root (u128 arithmetic, independent of the scheme, in
