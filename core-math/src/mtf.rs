@@ -553,6 +553,30 @@ pub mod int {
         acc
     }
 
+    /// y = 1/4 in Q30: up to it [`sinc_pi_short_q30`] is within 1e-8 of [`sinc_pi_q30`].
+    const SHORT_Y_MAX_Q30: u32 = 1 << 28;
+    /// 2^-20 in Q60: the band about the floor where the short sincs do not decide.
+    const SHORT_BAND_Q60: i64 = 1 << 40;
+
+    /// [`sinc_pi_q30`]'s first five coefficients by the same Horner's rule, for y at
+    /// most 1/4: it differs from that by the last five coefficients' Horner sum (below
+    /// 2.6e-3) times y^10 (2.5e-9 at most) and nine roundings of 2^-31 (4.2e-9): by
+    /// less than 1e-8.
+    // Out of line on the M3, as [`sinc_pi_q30`]: one copy in flash.
+    #[cfg_attr(all(target_arch = "arm", not(target_abi = "eabihf")), inline(never))]
+    #[cfg_attr(
+        not(all(target_arch = "arm", not(target_abi = "eabihf"))),
+        inline(always)
+    )]
+    fn sinc_pi_short_q30(y_q30: u32) -> i32 {
+        let y2 = ((u64::from(y_q30) * u64::from(y_q30)) >> 30) as i32;
+        let mut acc = SINC_PI_Q30[4];
+        for &c in SINC_PI_Q30[..4].iter().rev() {
+            acc = ((i64::from(acc) * i64::from(y2) + (1 << 29)) >> 30) as i32 + c;
+        }
+        acc
+    }
+
     /// A value in [0, 1] as Q30, truncated (at most one unit, 9.3e-10, below it).
     fn unit_q30(x: f32) -> u32 {
         let bits = x.to_bits();
@@ -568,14 +592,8 @@ pub mod int {
         ((u64::from(mant) << 7) >> (127 - e)) as u32
     }
 
-    /// sinc(pi/2 M x) in Q30 on the main lobe, `None` past it.
-    #[inline(always)]
-    fn factor_q30(x: Smear, m: u32) -> Option<i32> {
-        x.y_q30(m).map(sinc_pi_q30)
-    }
-
     /// |sinc(pi/2 M x)| in Q30 for M x / 2 below 2^32: on the main lobe as
-    /// [`factor_q30`]; past it, with y = k + f (f in [0, 1)), |sin(pi y)| = sin(pi f),
+    /// [`sinc_pi_q30`] of `y_q30`; past it, with y = k + f (f in [0, 1)), |sin(pi y)| = sin(pi f),
     /// so |sinc(pi y)| = f sinc(pi f) / y, one integer division.
     #[inline(always)]
     fn smear_q30(x: Smear, m: u32) -> Option<i32> {
@@ -670,6 +688,71 @@ pub mod int {
         }
     }
 
+    /// The short sincs' bound against the full polynomial at every y up to 1/4 (step 7),
+    /// and `meets_q30` against the full sincs' decision at each count around the
+    /// answer, with floors 0.5 to 0.99 and arguments that put the product within a
+    /// few 2^-20 of the floor as well as across it.
+    #[test]
+    fn short_sincs_decide_as_the_full_ones() {
+        extern crate std;
+        let mut worst = 0i64;
+        for y in (0..=SHORT_Y_MAX_Q30).step_by(7) {
+            worst = worst.max((i64::from(sinc_pi_short_q30(y)) - i64::from(sinc_pi_q30(y))).abs());
+        }
+        // 1e-8 in Q30 is 10.7 units.
+        assert!(worst <= 10, "{worst}");
+        let full = |xe: Smear, xt: Smear, floor: i64, m: u32| match (
+            xe.y_q30(m).map(sinc_pi_q30),
+            xt.y_q30(m).map(sinc_pi_q30),
+        ) {
+            (Some(a), Some(b)) => i64::from(a) * i64::from(b) >= floor,
+            _ => false,
+        };
+        let mut rng = crate::sample::SplitMix64(0x5EED_2026_1127_0024);
+        let (mut checked, mut in_band) = (0u32, 0u32);
+        for floor in [0.5f32, 0.8, 0.9, 0.95, 0.99] {
+            let floor_q60 = (u64::from(unit_q30(floor)) << 30) as i64;
+            for _ in 0..20_000 {
+                let m = 1 + (rng.next_u64() % 4096) as u32;
+                // y_e = m e / 2 where the product of sinc(pi y_e) and sinc(pi r y_e) is
+                // the floor plus d, d within 3e-8, 4 x 2^-20 or 0.05 of 0 (by bisection
+                // in f64), t = r e.
+                let r = rng.uniform(0.0, 1.0);
+                let d = [4.0 / f64::from(1u32 << 20), 0.05, 3e-8][(rng.next_u64() % 3) as usize]
+                    * rng.uniform(-1.0, 1.0);
+                let sinc = |x: f64| if x == 0.0 { 1.0 } else { libm::sin(x) / x };
+                let pi = core::f64::consts::PI;
+                let (mut lo, mut hi) = (0.0, 1.0);
+                for _ in 0..60 {
+                    let y = 0.5 * (lo + hi);
+                    if sinc(pi * y) * sinc(pi * r * y) > f64::from(floor) + d {
+                        lo = y;
+                    } else {
+                        hi = y;
+                    }
+                }
+                let e = (2.0 * lo / f64::from(m)) as f32;
+                let t = (f64::from(e) * r) as f32;
+                let (xe, xt) = (Smear::new(e).unwrap(), Smear::new(t).unwrap());
+                for k in m.saturating_sub(2)..=m + 2 {
+                    let want = full(xe, xt, floor_q60, k);
+                    assert_eq!(meets_q30(xe, xt, floor_q60, k), want, "{e} {t} {k}");
+                    if let (Some(a), Some(b)) = (xe.y_q30(k), xt.y_q30(k)) {
+                        let p = i64::from(sinc_pi_q30(a)) * i64::from(sinc_pi_q30(b));
+                        if (p - floor_q60).abs() < 1 << 42 {
+                            in_band += 1;
+                        }
+                    }
+                    checked += 1;
+                }
+            }
+        }
+        assert!(in_band > 10_000, "{in_band} of {checked} near the floor");
+        std::println!(
+            "short sincs within {worst} units of the full; {in_band} of {checked} counts within 2^-18 of the floor"
+        );
+    }
+
     /// Against the exact root (u128's `isqrt`) at random magnitudes and around squares.
     #[test]
     fn isqrt_u64_is_the_floor_root() {
@@ -697,11 +780,24 @@ pub mod int {
         inline(always)
     )]
     fn meets_q30(xe: Smear, xt: Smear, floor: i64, m: u32) -> bool {
-        match (factor_q30(xe, m), factor_q30(xt, m)) {
-            (Some(a), Some(b)) => i64::from(a) * i64::from(b) >= floor,
-            // Past either factor's first zero the product is under every floor.
-            _ => false,
+        // Past either factor's first zero the product is under every floor.
+        let (Some(ye), Some(yt)) = (xe.y_q30(m), xt.y_q30(m)) else {
+            return false;
+        };
+        // Both arguments at most 1/4 (the usual case near the floors in use): the series'
+        // first five terms first. Their product is within 2e-8 of the full polynomials'
+        // (each factor within 1e-8, [`sinc_pi_short_q30`]), so outside a band of 2^-20
+        // about the floor it decides as those would; inside the band, the full sincs.
+        if ye.max(yt) <= SHORT_Y_MAX_Q30 {
+            let p = i64::from(sinc_pi_short_q30(ye)) * i64::from(sinc_pi_short_q30(yt));
+            if p >= floor + SHORT_BAND_Q60 {
+                return true;
+            }
+            if p < floor - SHORT_BAND_Q60 {
+                return false;
+            }
         }
+        i64::from(sinc_pi_q30(ye)) * i64::from(sinc_pi_q30(yt)) >= floor
     }
 
     #[cold]
