@@ -287,50 +287,6 @@ pub(super) fn steer_from(v1: f32, v2: f32, rad: f32) -> Option<(f32, f32, f32)> 
     (sin.is_finite() && cos.is_finite()).then_some((sin, cos, rad))
 }
 
-/// The yaw request from the boresight's (v1/f, v2/f) in Q63 (`vf1` not 0), in integers:
-/// the angle atan(v2/v1) in Q30 ([`atan_ratio_q30`]), its sine and cosine in Q30
-/// (`trig::sin_cos_q30`: sin = sign(v1) v2 / |v|, cos = |v1| / |v|, as [`steer_from`]
-/// forms them), and the f32 (sin, cos, angle) of [`Steer`], each rounded once from Q30.
-#[cfg(feature = "earth-fixed")]
-#[inline(always)]
-pub(super) fn steer_fixed(vf1: i64, vf2: i64) -> Option<(i32, i32, (f32, f32, f32))> {
-    let negative = (vf1 < 0) != (vf2 < 0);
-    let q = atan_ratio_q30(vf2.unsigned_abs(), vf1.unsigned_abs())?;
-    let (s, c) = core_math::trig::sin_cos_q30(q);
-    let s = if negative { -s } else { s };
-    let f32_of = |x: i32| signed_q30_to_f32(x.saturating_abs(), x < 0);
-    Some((s, c, (f32_of(s), f32_of(c), signed_q30_to_f32(q, negative))))
-}
-
-/// A sine or cosine in Q30, truncated toward zero: `(x * 2^30) as i32` from the f32's
-/// bits, without the software product and conversion (the same value for every |x| < 2,
-/// and 0 for NaN; `controller/src/update/fixed_tests.rs`).
-#[cfg(feature = "earth-fixed")]
-#[inline(always)]
-pub(super) fn q30(x: f32) -> i32 {
-    let bits = x.to_bits();
-    let biased = ((bits >> 23) & 0xff) as i32;
-    // |x| 2^30 = m 2^(biased - 120), m the 24-bit mantissa.
-    let m = (bits & 0x7f_ffff) | 0x80_0000;
-    let mag = match biased - 120 {
-        _ if biased == 0 => 0,
-        _ if biased == 0xff => {
-            if bits & 0x7f_ffff != 0 {
-                return 0;
-            }
-            u32::MAX
-        }
-        sh if sh >= 8 => u32::MAX,
-        sh if sh >= 0 => m << sh,
-        sh => m.checked_shr(sh.unsigned_abs()).unwrap_or(0),
-    };
-    if bits >> 31 != 0 {
-        (mag.min(1 << 31) as i32).wrapping_neg()
-    } else {
-        mag.min(i32::MAX as u32) as i32
-    }
-}
-
 /// What the segments over one ground height are evaluated from: the f32 general form's
 /// update (docs/controller.md, "Backends").
 #[cfg(not(feature = "earth-fixed"))]

@@ -206,7 +206,7 @@ fn integer_pair_drift_angle_matches_atan() {
 /// every sign, magnitude and special value drawn.
 #[test]
 fn q30_from_bits_is_the_conversion() {
-    use super::backend::q30;
+    use super::fixed::q30;
     let mut rng = SplitMix64(0x5EED_2026_1127_0011);
     let scale = (1u32 << 30) as f32;
     let check = |x: f32| assert_eq!(q30(x), (x * scale) as i32, "{x:e} ({:#x})", x.to_bits());
@@ -240,7 +240,7 @@ fn q30_from_bits_is_the_conversion() {
 /// the same plus half an f32 ulp, over pairs of every magnitude, sign and ratio.
 #[test]
 fn integer_yaw_request_matches_f64() {
-    use super::backend::steer_fixed;
+    use super::fixed::steer_fixed;
     let mut rng = SplitMix64(0x5EED_2026_1127_0012);
     let mut worst = 0f64;
     let q30 = (1u64 << 30) as f64;
