@@ -1090,18 +1090,10 @@ mod tests {
                 (Ok(a), Ok(b)) => {
                     // Units off beyond the last one, over the value: the relative error
                     // of 1/|r| (and of its square for C and 1/C).
-                    let mut d = |x: i64, y: i64| {
+                    for_each_field(&a, &b, |x, y| {
                         let excess = x.abs_diff(y).saturating_sub(1) as f64;
                         worst = worst.max(excess / (x.unsigned_abs().max(1) as f64));
-                    };
-                    for k in 0..3 {
-                        d(a.m[k].into(), b.m[k].into());
-                        d(a.rho[k].into(), b.rho[k].into());
-                        d(a.w[k].into(), b.w[k].into());
-                        d(a.v[k].into(), b.v[k].into());
-                    }
-                    d(a.c.into(), b.c.into());
-                    d(a.inv_c.into(), b.inv_c.into());
+                    });
                     checked += 1;
                 }
                 (a, b) => assert_eq!(a.is_ok(), b.is_ok(), "{a:?} vs {b:?}"),
@@ -1178,20 +1170,12 @@ mod tests {
             }
             match (want, got) {
                 (Ok(a), Ok(b)) => {
-                    let mut d = |x: i64, y: i64| {
+                    for_each_field(&a, &b, |x, y| {
                         let units = x.abs_diff(y);
                         worst_units = worst_units.max(units);
                         let excess = units.saturating_sub(2) as f64;
                         worst = worst.max(excess / (x.unsigned_abs().max(1) as f64));
-                    };
-                    for k in 0..3 {
-                        d(a.m[k].into(), b.m[k].into());
-                        d(a.rho[k].into(), b.rho[k].into());
-                        d(a.w[k].into(), b.w[k].into());
-                        d(a.v[k].into(), b.v[k].into());
-                    }
-                    d(a.c.into(), b.c.into());
-                    d(a.inv_c.into(), b.inv_c.into());
+                    });
                     checked += 1;
                 }
                 (a, b) => {
@@ -1206,6 +1190,18 @@ mod tests {
             "ground_f32_into: at most {worst_units} units, beyond two {worst:.2e} relative, \
              over {checked} updates ({refused} refused alike)"
         );
+    }
+
+    /// `d(x, y)` for each pair of like fields of two updates, as i64.
+    fn for_each_field(a: &EarthFixedUpdate, b: &EarthFixedUpdate, mut d: impl FnMut(i64, i64)) {
+        for k in 0..3 {
+            d(a.m[k].into(), b.m[k].into());
+            d(a.rho[k].into(), b.rho[k].into());
+            d(a.w[k].into(), b.w[k].into());
+            d(a.v[k].into(), b.v[k].into());
+        }
+        d(a.c.into(), b.c.into());
+        d(a.inv_c.into(), b.inv_c.into());
     }
 
     /// `recip_63` against the u64 division over its domain's every edge and 10^6
