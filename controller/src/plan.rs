@@ -337,8 +337,8 @@ impl Plan {
                         .get_or_insert((self.segments.len() as u8, samples.len() as u8));
                 }
                 // Checked like any pixel: the row form then needs no check of its own.
-                // (`focal_plane_m` alone checks the same but, inlined, costs 280 bytes of
-                // flash more: `cargo xtask size`.)
+                // (`focal_plane_m` alone checks the same but, inlined, costs more flash:
+                // docs/target.md, flash.)
                 GENERAL_F32
                     .pixel(&camera, n)
                     .map_err(|_| Fault::InvalidScene)?;

@@ -31,6 +31,7 @@ use core_math::earth::frames::{
     mat_mul, row_times as row_times_f64, CelestialPole, TimeScales, POLE_MAX_AGE_S,
 };
 use core_math::earth::{GeneralInstant, InertialAttitude};
+use core_math::vector::dot;
 use core_math::{ModelError, Param, StateVector, GENERAL_F32};
 
 use crate::bus::{gps_s, Gnss, StarAttitude};
@@ -254,18 +255,7 @@ fn q_exp(v: [f32; 3]) -> [f32; 4] {
 // frame's acceleration and blend held a copy at each use (docs/target.md, flash).
 #[cfg_attr(all(target_arch = "arm", not(target_abi = "eabihf")), inline(never))]
 fn cross(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-// Out of line on the M3, where each product is a software call: inlined, the
-// frame's acceleration and blend held a copy at each use (docs/target.md, flash).
-#[cfg_attr(all(target_arch = "arm", not(target_abi = "eabihf")), inline(never))]
-fn dot(a: [f32; 3], b: [f32; 3]) -> f32 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+    core_math::vector::cross(a, b)
 }
 
 /// dOmega/dt (rad/s^2, camera axes) of a camera whose roll, pitch and yaw relative to

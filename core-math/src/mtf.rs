@@ -538,7 +538,7 @@ pub mod int {
     /// ten roundings of 2^-31, the constants' 2^-31 each; measured:
     /// `core-math/tests/mtf_period.rs`).
     // Out of line on the M3, whose update it is for: two copies inlined there, against
-    // a call per sinc in an update of ~95 000 instructions (docs/target.md, flash).
+    // a call per sinc, small beside the update (docs/target.md, flash).
     #[cfg_attr(all(target_arch = "arm", not(target_abi = "eabihf")), inline(never))]
     #[cfg_attr(
         not(all(target_arch = "arm", not(target_abi = "eabihf"))),

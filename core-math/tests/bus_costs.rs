@@ -23,6 +23,7 @@ use core_math::earth::kepler::Kepler;
 use core_math::earth::reference::EarthRefPixel;
 use core_math::earth::{limb_margin_rad, Attitude, InertialGeometry};
 use core_math::sample::{eccentric_state, SplitMix64};
+use core_math::vector::{cross, dot, norm};
 use core_math::{
     EarthCamera, EarthGeometry, EarthReference, Ellipsoid, ImageMotion, StateVector,
     EARTH_RATE_RAD_S, GM_M3_S2,
@@ -152,22 +153,6 @@ fn mat_vec(a: &Mat3, x: [f64; 3]) -> [f64; 3] {
 
 fn transpose(a: &Mat3) -> Mat3 {
     core::array::from_fn(|i| core::array::from_fn(|j| a[j][i]))
-}
-
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-fn norm(a: [f64; 3]) -> f64 {
-    libm::sqrt(dot(a, a))
-}
-
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
 }
 
 /// exp(\[w\]x t): the rotation by |w| t about w (Rodrigues).

@@ -21,8 +21,8 @@ pub const EXIT_UNEXPECTED_INTERRUPT: i32 = 103;
 
 /// Ends the program with `code` as the debugger's (QEMU's) exit status.
 // Out of line in the flight binary: `main`, the start-up and the default handler each
-// inlined a copy. Not in the bench binary, whose single-pixel regions it moved by 2 to
-// 4 instructions (the harness's registers around `black_box`, docs/target.md).
+// inlined a copy. Not in the bench binary, whose single-pixel regions it moved (the
+// harness's registers around `black_box`, docs/target.md).
 #[cfg_attr(not(feature = "bench"), inline(never))]
 pub fn exit(code: i32) -> ! {
     semihosting::process::exit(code)
