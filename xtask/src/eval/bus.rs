@@ -467,8 +467,6 @@ mod tests {
         let c2t: Vec<String> = (0..9).map(|k| format!("c2t_{}{}", k / 3, k % 3)).collect();
         outputs.extend(c2t.iter().map(String::as_str));
         let text = input(&golden, &outputs);
-        let col = |t: &Table, name: &str| t.columns(&[name]).unwrap()[0];
-        let num = |t: &Table, r: &[String], n: &str| -> f64 { r[col(t, n)].parse().unwrap() };
         for (backend, tol) in [
             ("reference", 1e-9),
             ("f64", 1e-9),
@@ -479,12 +477,12 @@ mod tests {
                 .unwrap();
             assert_eq!(out.rows.len(), golden.rows.len());
             assert!(golden.rows.len() >= 300);
-            for (o, g) in out.rows.iter().zip(&golden.rows) {
-                let case = &g[col(&golden, "case")];
-                assert_eq!(o[col(&out, "error")], "", "{backend} case {case}");
-                let dv = (num(&out, o, "v1_mps") - num(&golden, g, "v1_mps"))
-                    .hypot(num(&out, o, "v2_mps") - num(&golden, g, "v2_mps"));
-                let v = num(&golden, g, "v1_mps").hypot(num(&golden, g, "v2_mps"));
+            for i in 0..out.rows.len() {
+                let case = golden.field(i, "case");
+                assert_eq!(out.field(i, "error"), "", "{backend} case {case}");
+                let dv = (out.num(i, "v1_mps") - golden.num(i, "v1_mps"))
+                    .hypot(out.num(i, "v2_mps") - golden.num(i, "v2_mps"));
+                let v = golden.num(i, "v1_mps").hypot(golden.num(i, "v2_mps"));
                 assert!(
                     dv <= (tol + 2.9e-8) * v,
                     "{backend} case {case}: {:e}",
@@ -493,7 +491,7 @@ mod tests {
                 // The ground point, the reference's for every backend, is on the row's
                 // ellipsoid (a + h, a + h, b + h): its geodetic height is h to a few mm at
                 // these heights (up to 3 km).
-                let dh = num(&out, o, "ground_height_m") - num(&golden, g, "ground_h_m");
+                let dh = out.num(i, "ground_height_m") - golden.num(i, "ground_h_m");
                 assert!(dh.abs() < 0.01, "{backend} case {case}: {dh:e} m");
             }
         }
@@ -509,27 +507,20 @@ mod tests {
         let (grid, heights) = parse_dem(TILE).unwrap();
         let tile = DemTile::new(grid, &heights).unwrap();
         let text = input(&golden, &GOLDEN_OUTPUTS);
-        let col = |t: &Table, name: &str| t.columns(&[name]).unwrap()[0];
         for (backend, tol) in [("reference", 1e-9), ("f64", 1e-9), ("f32", 5e-6)] {
             let out = Table::parse(&crate::eval::eval_csv_on_dem(backend, &text, &tile).unwrap())
                 .unwrap();
             assert_eq!(out.rows.len(), golden.rows.len());
             let mut hits = 0;
-            for (o, g) in out.rows.iter().zip(&golden.rows) {
-                let case = &g[col(&golden, "case")];
-                assert_eq!(
-                    o[col(&out, "error")],
-                    g[col(&golden, "error")],
-                    "{backend} case {case}"
-                );
-                if !g[col(&golden, "error")].is_empty() {
+            for i in 0..out.rows.len() {
+                let (case, error) = (golden.field(i, "case"), golden.field(i, "error"));
+                assert_eq!(out.field(i, "error"), error, "{backend} case {case}");
+                if !error.is_empty() {
                     continue;
                 }
-                let num =
-                    |t: &Table, r: &[String], n: &str| -> f64 { r[col(t, n)].parse().unwrap() };
-                let dv = (num(&out, o, "v1_mps") - num(&golden, g, "v1_mps"))
-                    .hypot(num(&out, o, "v2_mps") - num(&golden, g, "v2_mps"));
-                let v = num(&golden, g, "v1_mps").hypot(num(&golden, g, "v2_mps"));
+                let dv = (out.num(i, "v1_mps") - golden.num(i, "v1_mps"))
+                    .hypot(out.num(i, "v2_mps") - golden.num(i, "v2_mps"));
+                let v = golden.num(i, "v1_mps").hypot(golden.num(i, "v2_mps"));
                 assert!(dv <= tol * v, "{backend} case {case}: {:e}", dv / v);
                 // The ground columns are the reference's for every backend.
                 for (name, gtol) in [
@@ -537,7 +528,7 @@ mod tests {
                     ("ground_lon_deg", 1e-9),
                     ("ground_height_m", 0.01),
                 ] {
-                    let d = (num(&out, o, name) - num(&golden, g, name)).abs();
+                    let d = (out.num(i, name) - golden.num(i, name)).abs();
                     assert!(d <= gtol, "{backend} case {case} {name}: {d:e}");
                 }
                 hits += 1;
