@@ -153,13 +153,7 @@ fn figures(maps: &[Map], secs: f64) -> BTreeMap<String, String> {
         let letter = m.spec.letter;
         let a = m.aggregate(|_, _| true);
         let mut put = |what: &str, s: String| put(&format!("{letter}.{what}"), s);
-        put(
-            "grid",
-            format!(
-                "{} x {} cells, {} sub-samples each, {} cases",
-                m.nx, m.ny, m.sub, a.n
-            ),
-        );
+        put("grid", m.grid_text(a.n.into()));
         put("others", m.spec.others.into());
         for (what, w) in [("worst_f32", &a.ratio_f32), ("max_kappa", &a.kappa)] {
             if let Some((p, o)) = &w.at {

@@ -594,13 +594,7 @@ pub fn figures(maps: &[GMap], secs: f64) -> std::collections::BTreeMap<String, S
         let a = m.aggregate(|_, _| true);
         let l = m.spec.letter.replace('\'', "y");
         let mut put = |what: &str, s: String| put(&format!("{l}.{what}"), s);
-        put(
-            "grid",
-            format!(
-                "{} x {} cells, {} sub-samples each, {} cases",
-                m.nx, m.ny, m.sub, a.n
-            ),
-        );
+        put("grid", m.grid_text(a.n));
         put("others", m.spec.others.into());
         put("ratio", f2(a.ratio.max));
         put("kappa_max", sig(a.kappa.max));
