@@ -46,6 +46,19 @@ impl Table {
     }
 }
 
+/// What the tests read of a table: a field by row and column name.
+#[cfg(test)]
+impl Table {
+    /// Field `name` of row `row` (0: the first after the header).
+    pub fn field(&self, row: usize, name: &str) -> &str {
+        &self.rows[row][self.columns(&[name]).unwrap()[0]]
+    }
+
+    pub fn num(&self, row: usize, name: &str) -> f64 {
+        self.field(row, name).parse().unwrap()
+    }
+}
+
 /// A CSV document being written: `preamble` (whole `#` lines), the header, the rows.
 pub struct Writer(::csv::Writer<Vec<u8>>);
 

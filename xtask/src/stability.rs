@@ -153,13 +153,7 @@ fn figures(maps: &[Map], secs: f64) -> BTreeMap<String, String> {
         let letter = m.spec.letter;
         let a = m.aggregate(|_, _| true);
         let mut put = |what: &str, s: String| put(&format!("{letter}.{what}"), s);
-        put(
-            "grid",
-            format!(
-                "{} x {} cells, {} sub-samples each, {} cases",
-                m.nx, m.ny, m.sub, a.n
-            ),
-        );
+        put("grid", m.grid_text(a.n.into()));
         put("others", m.spec.others.into());
         for (what, w) in [("worst_f32", &a.ratio_f32), ("max_kappa", &a.kappa)] {
             if let Some((p, o)) = &w.at {
@@ -170,7 +164,6 @@ fn figures(maps: &[Map], secs: f64) -> BTreeMap<String, String> {
         }
         put("ratio_f32", f2(a.ratio_f32.max));
         put("ratio_f32_in", f2(a.ratio_f32_in.max));
-        put("ratio_fixed", f2(a.ratio_fixed.max));
         put("kappa_min", sig(a.kappa_min));
         put("kappa_max", sig(a.kappa.max));
         put("e_f32", e2(a.err.f32));
@@ -184,8 +177,6 @@ fn figures(maps: &[Map], secs: f64) -> BTreeMap<String, String> {
     put("ratio_f32", f2(whole.ratio_f32.max));
     put("ratio_f32_in", f2(whole.ratio_f32_in.max));
     put("ratio_fixed", f2(whole.ratio_fixed.max));
-    put("e_f32", e2(whole.err.f32));
-    put("e_fixed", e2(whole.err.fixed_worst()));
     for (what, w) in [("f32", &whole.ratio_f32), ("fixed", &whole.ratio_fixed)] {
         if let Some((p, o)) = &w.at {
             for (k, s) in sample_figures(&format!("worst.{what}"), p, o) {
@@ -336,20 +327,18 @@ fn figures(maps: &[Map], secs: f64) -> BTreeMap<String, String> {
 }
 
 /// The values the document may quote about one sample (a map's worst or largest-kappa
-/// case), as (`{prefix}.<what>`, text): where it is, kappa and its parts, q, and the
+/// case), as (`{prefix}.<what>`, text): where it is, kappa and its parts, and the
 /// errors. Every such sample gets the same set, so the template can quote any of them the
 /// same way; the keys it does not use are ignored by [`doc::fill`].
-fn sample_figures(prefix: &str, p: &Point, o: &Outcome) -> [(String, String); 8] {
+fn sample_figures(prefix: &str, p: &Point, o: &Outcome) -> [(String, String); 6] {
     let key = |what: &str| format!("{prefix}.{what}");
     [
         (key("at"), describe(p, o)),
         (key("kappa"), sig(o.kappa)),
         (key("parts"), parts(o)),
-        (key("q"), sig(o.q)),
         (key("e_f32"), e2(o.err.f32)),
         // In units of u, for the whole's worst f32 case.
         (key("e_f32_u"), format!("{:.1}", o.err.f32 / U_F32)),
-        (key("e_f32_in"), e2(o.err.f32_in)),
         (key("e_fixed"), e2(o.err.fixed_worst())),
     ]
 }

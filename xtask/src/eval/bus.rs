@@ -420,6 +420,7 @@ mod tests {
 
     const TILE: &str = include_str!("../../../core-math/tests/data/dem_tile.csv");
     const GOLDEN: &str = include_str!("../../../core-math/tests/data/dem_cases.csv");
+    const PART2: &str = include_str!("../../../core-math/tests/data/part2_motion.csv");
     /// The golden file's own outputs, left out of the eval's input.
     const GOLDEN_OUTPUTS: [&str; 11] = [
         "error",
@@ -435,11 +436,11 @@ mod tests {
         "ground_h_m",
     ];
 
-    /// The golden rows without their outputs (and without `ground_h_m`, which a DEM makes
-    /// optional), as an eval input.
-    fn input(golden: &Table) -> String {
+    /// The golden rows without the columns `outputs` names (its own results, and for the
+    /// DEM goldens `ground_h_m`, which a DEM makes optional), as an eval input.
+    fn input(golden: &Table, outputs: &[&str]) -> String {
         let keep: Vec<usize> = (0..golden.header.len())
-            .filter(|&c| !GOLDEN_OUTPUTS.contains(&golden.header[c].as_str()))
+            .filter(|&c| !outputs.contains(&golden.header[c].as_str()))
             .collect();
         let head: Vec<&str> = keep.iter().map(|&c| golden.header[c].as_str()).collect();
         let mut w = Writer::new("", &head).unwrap();
@@ -448,6 +449,52 @@ mod tests {
             w.row(&fields).unwrap();
         }
         w.into_string().unwrap()
+    }
+
+    /// `eval --model earth` without a DEM on the independent goldens of
+    /// `tools/goldens/part2_motion.py` (the three state frames, quaternions relative to
+    /// the GCRF and the ITRF, body rates, camera mountings), every backend, C2T the
+    /// crate's own: the motion within core-math's golden tolerances (1e-9 for the
+    /// reference and f64, 2e-6 for f32 and the fixed backend's far-from-limb target) plus
+    /// 2.9e-8, the largest effect of C2T's documented error on these rows
+    /// (`docs/earth-model.md`, "Part II: bus inputs"). This is the bus columns' parsing
+    /// (frames, time, quaternions, rates, mounting) checked end to end; core-math's
+    /// `tests/part2.rs` holds the same goldens against its own API.
+    #[test]
+    fn bus_eval_matches_the_independent_goldens() {
+        let golden = Table::parse(PART2).unwrap();
+        let mut outputs = vec!["v1_mps", "v2_mps"];
+        let c2t: Vec<String> = (0..9).map(|k| format!("c2t_{}{}", k / 3, k % 3)).collect();
+        outputs.extend(c2t.iter().map(String::as_str));
+        let text = input(&golden, &outputs);
+        for (backend, tol) in [
+            ("reference", 1e-9),
+            ("f64", 1e-9),
+            ("f32", 2e-6),
+            ("fixed", 2e-6),
+        ] {
+            let out = Table::parse(&crate::eval::eval_csv(Model::Earth, backend, &text).unwrap())
+                .unwrap();
+            assert_eq!(out.rows.len(), golden.rows.len());
+            assert!(golden.rows.len() >= 300);
+            for i in 0..out.rows.len() {
+                let case = golden.field(i, "case");
+                assert_eq!(out.field(i, "error"), "", "{backend} case {case}");
+                let dv = (out.num(i, "v1_mps") - golden.num(i, "v1_mps"))
+                    .hypot(out.num(i, "v2_mps") - golden.num(i, "v2_mps"));
+                let v = golden.num(i, "v1_mps").hypot(golden.num(i, "v2_mps"));
+                assert!(
+                    dv <= (tol + 2.9e-8) * v,
+                    "{backend} case {case}: {:e}",
+                    dv / v
+                );
+                // The ground point, the reference's for every backend, is on the row's
+                // ellipsoid (a + h, a + h, b + h): its geodetic height is h to a few mm at
+                // these heights (up to 3 km).
+                let dh = out.num(i, "ground_height_m") - golden.num(i, "ground_h_m");
+                assert!(dh.abs() < 0.01, "{backend} case {case}: {dh:e} m");
+            }
+        }
     }
 
     /// `eval --model earth --dem` on the independent goldens of
@@ -459,28 +506,21 @@ mod tests {
         let golden = Table::parse(GOLDEN).unwrap();
         let (grid, heights) = parse_dem(TILE).unwrap();
         let tile = DemTile::new(grid, &heights).unwrap();
-        let text = input(&golden);
-        let col = |t: &Table, name: &str| t.columns(&[name]).unwrap()[0];
+        let text = input(&golden, &GOLDEN_OUTPUTS);
         for (backend, tol) in [("reference", 1e-9), ("f64", 1e-9), ("f32", 5e-6)] {
             let out = Table::parse(&crate::eval::eval_csv_on_dem(backend, &text, &tile).unwrap())
                 .unwrap();
             assert_eq!(out.rows.len(), golden.rows.len());
             let mut hits = 0;
-            for (o, g) in out.rows.iter().zip(&golden.rows) {
-                let case = &g[col(&golden, "case")];
-                assert_eq!(
-                    o[col(&out, "error")],
-                    g[col(&golden, "error")],
-                    "{backend} case {case}"
-                );
-                if !g[col(&golden, "error")].is_empty() {
+            for i in 0..out.rows.len() {
+                let (case, error) = (golden.field(i, "case"), golden.field(i, "error"));
+                assert_eq!(out.field(i, "error"), error, "{backend} case {case}");
+                if !error.is_empty() {
                     continue;
                 }
-                let num =
-                    |t: &Table, r: &[String], n: &str| -> f64 { r[col(t, n)].parse().unwrap() };
-                let dv = (num(&out, o, "v1_mps") - num(&golden, g, "v1_mps"))
-                    .hypot(num(&out, o, "v2_mps") - num(&golden, g, "v2_mps"));
-                let v = num(&golden, g, "v1_mps").hypot(num(&golden, g, "v2_mps"));
+                let dv = (out.num(i, "v1_mps") - golden.num(i, "v1_mps"))
+                    .hypot(out.num(i, "v2_mps") - golden.num(i, "v2_mps"));
+                let v = golden.num(i, "v1_mps").hypot(golden.num(i, "v2_mps"));
                 assert!(dv <= tol * v, "{backend} case {case}: {:e}", dv / v);
                 // The ground columns are the reference's for every backend.
                 for (name, gtol) in [
@@ -488,7 +528,7 @@ mod tests {
                     ("ground_lon_deg", 1e-9),
                     ("ground_height_m", 0.01),
                 ] {
-                    let d = (num(&out, o, name) - num(&golden, g, name)).abs();
+                    let d = (out.num(i, name) - golden.num(i, name)).abs();
                     assert!(d <= gtol, "{backend} case {case} {name}: {d:e}");
                 }
                 hits += 1;
@@ -504,7 +544,7 @@ mod tests {
         let golden = Table::parse(GOLDEN).unwrap();
         let (grid, heights) = parse_dem(TILE).unwrap();
         let tile = DemTile::new(grid, &heights).unwrap();
-        let text = input(&golden).replace("1500000000.0", "");
+        let text = input(&golden, &GOLDEN_OUTPUTS).replace("1500000000.0", "");
         let out =
             Table::parse(&crate::eval::eval_csv_on_dem("f64", &text, &tile).unwrap()).unwrap();
         let e = out.columns(&["error"]).unwrap()[0];

@@ -355,9 +355,8 @@ pub struct GCell<B = F32> {
     /// The largest error at least 1 deg inside the limb, and from 0.01 to 1 deg.
     pub far: Worst<GSample>,
     pub near: Worst<GSample>,
-    /// err / [`GOutcome::target`]: the largest over all cases, and over the checked ones
-    /// (every case from 0.01 to 1 deg, those with kappa <= 30 from 1 deg outward).
-    pub of_target: Worst<GSample>,
+    /// The largest err / [`GOutcome::target`] over the checked cases (every case from
+    /// 0.01 to 1 deg, those with kappa <= 30 from 1 deg outward).
     pub of_target_checked: Worst<GSample>,
     /// Cases over their band's target, and the smallest kappa among them.
     pub over: u64,
@@ -419,7 +418,6 @@ impl<B: Tested> grid::Cell for GCell<B> {
             (&mut self.kappa, &o.kappa),
             (&mut self.err, &o.err),
             (&mut self.err_v1, &o.err_v1),
-            (&mut self.of_target, &o.of_target),
         ] {
             s.merge(o);
         }
@@ -467,7 +465,6 @@ impl<B: Tested> GCell<B> {
         self.kappa.offer(o.kappa, w);
         self.err.offer(o.err, w);
         self.err_v1.offer(o.err_v1, w);
-        self.of_target.offer(of_target, w);
     }
 }
 
@@ -597,19 +594,11 @@ pub fn figures(maps: &[GMap], secs: f64) -> std::collections::BTreeMap<String, S
         let a = m.aggregate(|_, _| true);
         let l = m.spec.letter.replace('\'', "y");
         let mut put = |what: &str, s: String| put(&format!("{l}.{what}"), s);
-        put(
-            "grid",
-            format!(
-                "{} x {} cells, {} sub-samples each, {} cases",
-                m.nx, m.ny, m.sub, a.n
-            ),
-        );
+        put("grid", m.grid_text(a.n));
         put("others", m.spec.others.into());
         put("ratio", f2(a.ratio.max));
         put("kappa_max", sig(a.kappa.max));
         put("err", e2(a.err.max));
-        put("err_v1", e2(a.err_v1.max));
-        put("err_tame", format!("{:.3e}", a.tame.max));
         put("over_tol", a.over_tol.to_string());
         put("over_tol_kappa", sig(a.over_tol_kappa_min));
         for (what, w) in [
@@ -617,7 +606,6 @@ pub fn figures(maps: &[GMap], secs: f64) -> std::collections::BTreeMap<String, S
             ("max_kappa", &a.kappa),
             ("max_err", &a.err),
             ("tame", &a.tame),
-            ("max_err_v1", &a.err_v1),
         ] {
             case_figures::<F32>(&mut put, what, w);
         }
@@ -627,7 +615,6 @@ pub fn figures(maps: &[GMap], secs: f64) -> std::collections::BTreeMap<String, S
     rows.push(row("all general maps", &all));
     put("G.samples", all.n.to_string());
     put("G.ratio", f2(all.ratio.max));
-    put("G.kappa_max", sig(all.kappa.max));
     put("G.err", e2(all.err.max));
     put("G.err_v1", e2(all.err_v1.max));
     put("G.err_v1_steady", e2(all.steady.max));
@@ -636,7 +623,6 @@ pub fn figures(maps: &[GMap], secs: f64) -> std::collections::BTreeMap<String, S
         f2(100.0 * all.steady.max / SEGMENT_BUDGET),
     );
     put("G.err_tame", format!("{:.3e}", all.tame.max));
-    put("G.over_tol_kappa", sig(all.over_tol_kappa_min));
     for (what, w) in [
         ("worst", &all.ratio),
         ("max_err_v1", &all.err_v1),
@@ -760,9 +746,6 @@ pub fn case_figures<B: Tested>(
     put(&format!("{prefix}.at"), describe::<B>(c, o));
     put(&format!("{prefix}.kappa"), sig(o.kappa));
     put(&format!("{prefix}.err"), e2(o.err));
-    put(&format!("{prefix}.ratio"), f2(o.ratio()));
-    put(&format!("{prefix}.err_v1"), e2(o.err_v1));
-    put(&format!("{prefix}.v"), e2(o.v));
     put(&format!("{prefix}.v1"), e2(o.v1));
     let period_ms = 1e3 * CAMERA.pixel_m / o.v1.abs();
     put(&format!("{prefix}.period_ms"), sig(period_ms));

@@ -154,20 +154,13 @@ pub fn figures(maps: &[FMap], secs: f64) -> std::collections::BTreeMap<String, S
     let mut all = FCell::empty();
     for m in maps {
         let a = m.aggregate(|_, _| true);
-        let l = m.spec.letter.replace('\'', "y");
-        let mut put = |what: &str, s: String| put(&format!("X{l}.{what}"), s);
-        put("err", e2(a.err.max));
-        put("refused", a.refused.to_string());
-        case_figures::<Fixed>(&mut put, "max_err", &a.err);
         rows.push(row(&format!("{}: {}", m.spec.letter, m.spec.title), &a));
         all.merge(&a);
     }
     rows.push(row("all general maps", &all));
     put("X.samples", all.n.to_string());
-    put("X.refused", all.refused.to_string());
     put("X.err", e2(all.err.max));
     put("X.err_v1", e2(all.err_v1.max));
-    put("X.far", e2(all.far.max));
     put("X.far_tame", e2(all.tame.max));
     put("X.near", e2(all.near.max));
     put("X.over", all.over.to_string());
@@ -178,10 +171,8 @@ pub fn figures(maps: &[FMap], secs: f64) -> std::collections::BTreeMap<String, S
     );
     for (what, w) in [
         ("max_err", &all.err),
-        ("far", &all.far),
         ("far_tame", &all.tame),
         ("near", &all.near),
-        ("of_target", &all.of_target),
     ] {
         case_figures::<Fixed>(&mut put, &format!("X.{what}"), w);
     }

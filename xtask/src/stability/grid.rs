@@ -132,6 +132,12 @@ pub struct Map<C: Cell> {
 }
 
 impl<C: Cell> Map<C> {
+    /// The grid as the document describes it, with the cases `n` of its sweep.
+    pub fn grid_text(&self, n: u64) -> String {
+        let (nx, ny, sub) = (self.nx, self.ny, self.sub);
+        format!("{nx} x {ny} cells, {sub} sub-samples each, {n} cases")
+    }
+
     /// Sweeps `spec` with `nx` x `ny` cells and `sub` sub-samples per cell, on every core.
     pub fn sweep(spec: &'static Spec<C::Point>, nx: usize, ny: usize, sub: usize) -> Self {
         let (x0, x1) = spec.x_range;

@@ -8,6 +8,7 @@ use anyhow::{anyhow, bail, Context, Result};
 use core_math::earth::dem::{DemGrid, DemTile};
 use core_math::earth::frames::{self, TimeScales};
 use core_math::earth::{Attitude, EarthGeometry};
+use core_math::vector::dot;
 use core_math::EARTH_RATE_RAD_S;
 use std::path::Path;
 use tiff::decoder::{Decoder, DecodingResult};
@@ -225,8 +226,4 @@ fn look_centre() -> Result<(f64, f64)> {
         lat.0, lat.1, lon.0, lon.1
     );
     Ok(((lat.0 + lat.1) / 2.0, (lon.0 + lon.1) / 2.0))
-}
-
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }

@@ -13,6 +13,7 @@ use controller::golden::{self, NavInput};
 use controller::Controller;
 use core_math::earth::{Attitude, EarthGeometry};
 use core_math::sphere::Reference;
+use core_math::vector::norm;
 use core_math::{Backend, EarthCamera, EarthReference, StateVector, EARTH_RATE_RAD_S};
 
 use super::bus::{mat_mul, mat_vec, transpose, SCALES};
@@ -318,7 +319,7 @@ fn c2t_error_rad(truth: &AgileTruth, firmware: &Downlink) -> Result<f64> {
         let fw = fw.context("no pole")?.map_err(|e| anyhow!(e.name()))?;
         let d = mat_mul(&fw, &transpose(&truth.earth.c2t(gps_s)));
         let v = [d[2][1] - d[1][2], d[0][2] - d[2][0], d[1][0] - d[0][1]];
-        worst = worst.max(0.5 * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt());
+        worst = worst.max(0.5 * norm(v));
     }
     Ok(worst)
 }
