@@ -1,11 +1,11 @@
 //! Golden values for the on-target tests, computed here on the host at build time.
 //!
-//! Every expected number but the MTF's comes from `core-math` itself (a build-dependency): the f64
-//! `Reference` chain, `line_period_*::<f64>`, and, for the
-//! bit-identity tests, the same `CLOSED_F32` path run on the host. Inputs are rounded
-//! to f32 first and the references are evaluated at exactly those values widened back
-//! to f64, so a comparison measures the algorithm, not the input rounding. Tolerances
-//! come from `core_math::accuracy`. Nothing here is typed by hand but the case list.
+//! Every expected number but the MTF's comes from `core-math` itself (a build-dependency),
+//! for its round-Earth model (`core_math::sphere`): the f64 `Reference` chain,
+//! `line_period_*::<f64>`, and, for the bit-identity tests, the same `CLOSED_F32` path
+//! run on the host. Inputs are rounded to f32 first and the references are evaluated at
+//! exactly those values widened back to f64, so a comparison measures the algorithm,
+//! not the input rounding. Tolerances come from `core_math::sphere::accuracy`. Nothing here is typed by hand but the case list.
 //! The MTF's expectation is its definition, |sin(x)/x| with libm's sine, not
 //! core-math's `mtf_mismatch` (issue 25: a definition both sides shared went unseen).
 //!

@@ -7,6 +7,12 @@
 //! [`config`]) -> state to periods (the bus's data carried to the instant: [`track`]; [`update`]: core-math's general real-Earth form) ->
 //! line periods out ([`sink`], [`report`]; whole frames into the transmit queue:
 //! [`downlink`]).
+//!
+//! Start reading at [`session`], the loop around a byte link that the firmware and the
+//! host tools share. Around the steps: [`fault`] (every refusal typed and counted),
+//! [`restart`] (what a reset must not lose), the DEM tile ([`dem`]) and each sample's
+//! ground on it ([`dem_ground`]), and the f64 reference of an update (`golden`, feature
+//! `reference`). Layout and module graph: `docs/controller.md`.
 #![no_std]
 #![forbid(unsafe_code)]
 #![allow(clippy::neg_cmp_op_on_partial_ord)]

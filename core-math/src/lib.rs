@@ -17,6 +17,8 @@
 //!
 //! Around it: [`line_period`] (seconds and clock ticks), [`mtf`] (mismatch, drift smear,
 //! stage limit), [`accuracy`] (the measured error bounds), [`trig`] and [`vector`].
+//! Start reading at [`earth`] and its [`earth::general`]; [`model`] holds the interface
+//! every backend implements.
 //!
 //! The paper this started from (LI Guang-ze, KONG De-zhu, LIU Jin-guo, "Computation of
 //! scroll image motion velocity of wide coverage optical remote camera", Chinese Optics

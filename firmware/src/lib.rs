@@ -7,15 +7,19 @@
 //!   `controller` crate's `Session`, frames back out); the UART's interrupts serve the
 //!   receive queue ([`rx`]) and the transmit queue ([`tx`]);
 //! - scene and math: the `controller` crate (the scene in force, its plan, the updates,
-//!   on core-math's real-Earth general form in f32, `GENERAL_F32`); no hardware in it;
+//!   on core-math's real-Earth general form in f32, `GENERAL_F32`; on the Cortex-M3,
+//!   feature `mps2-an385`, the pixels in fixed point, `EARTH_FIXED`, and most of the
+//!   update in integers); no hardware in it;
 //! - line periods out: [`line_clock`] (the `controller::LinePeriodSink`: segment 0's
 //!   period into a timer's reload register, the others into a table) and the PERIODS
 //!   frames the session sends;
 //! - the hardware behind those traits: [`board`], one module per board, chosen by cargo
-//!   feature (`mps2-an386`, the default; `stm32f405`); no hardware address outside it;
-//! - [`retained`]: what survives a reset (its cause and count); [`heartbeat`]: the
-//!   periodic wake-up that lets the loop feed the board's watchdog while the link is
-//!   quiet;
+//!   feature (`mps2-an386`, the default; `mps2-an385`; `stm32f405`); no hardware
+//!   address outside it;
+//! - [`retained`]: what survives a reset (its cause and count, the controller's
+//!   snapshot, the DEM tile memory); [`irq`]: the state an interrupt handler owns;
+//!   [`heartbeat`]: the periodic wake-up that lets the loop feed the board's watchdog
+//!   while the link is quiet;
 //! - [`platform`]: panic/fault handlers, exit by semihosting; `logger`: the global
 //!   defmt logger (semihosting, never panics; `defmt-rtt` replaces it on a real board);
 //!   [`stack`]: the stack's high-water mark (the firmware's RAM use).

@@ -8,7 +8,7 @@ at t = 0 (Eq. 13) and proves, exactly:
   (a) v1, v2 of the chain equal the (g2, g3) closed forms;
   (b) the paper's Eq. 14 differs from the chain by exactly -f w g2 sin(i0) sin(g0)/D
       (its Earth-rotation cross term is doubled);
-  (c) the stable forms in (eta, k, q, den) that core-math/src/closed_form.rs evaluates
+  (c) the stable forms in (eta, k, q, den) that core-math/src/sphere/closed_form.rs evaluates
       equal the (g2, g3) forms once g2, g3 come from Eqs. 1-6;
   (d) dP2/dt vanishes for i0 = 0, 180 deg and g0 = 90, 270 deg;
   (e) what survives of the garbled Eq. 15;

@@ -3,6 +3,13 @@
 //! Each command is one module. A command with options declares them as a clap `Args`
 //! struct next to its `run` (one field per option, its doc comment the `--help` text);
 //! `main` only parses and dispatches. A new option is a new field there.
+//!
+//! The firmware flies core-math's real-Earth general form (`GENERAL_F32`; on the
+//! Cortex-M3, `EARTH_FIXED`'s fixed-point pixels). `eval` and `accuracy` take it with
+//! `--model earth` (their default, `sphere`, is the paper's round Earth); `stability`
+//! maps both; `ellipsoid` measures the round Earth against it. Start reading at the
+//! command you run: `cargo xtask run` is `qemu::run` (`qemu/pass.rs`), `cargo xtask
+//! test` is `test_cmd::run`.
 
 mod accuracy;
 mod csv;

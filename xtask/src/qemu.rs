@@ -2,12 +2,14 @@
 //! on-target tests, the instruction counts. See docs/target.md and docs/bench.md.
 //!
 //! - `cargo xtask run [--board NAME]`: build the firmware (release) for a board
-//!   ([`board`]: `mps2-an386`, the default, or `stm32f405` on QEMU's netduinoplus2) and
+//!   ([`board`]: `mps2-an386`, the default, `mps2-an385`, or `stm32f405` on QEMU's
+//!   netduinoplus2) and
 //!   play a pass through it under QEMU (`pass`: telemetry on the board's UART through a
 //!   unix socket, the decoded defmt log on stdout, table, plot, reference and fault
 //!   checks); `--demo` runs the default-scene demo instead.
-//! - `cargo xtask qemu ELF`: the cargo runner for thumbv7em-none-eabihf (QEMU + defmt
-//!   decoding); `.cargo/config.toml` reaches it through `tools/qemu-runner`.
+//! - `cargo xtask qemu ELF`: the cargo runner for thumbv7em-none-eabihf and
+//!   thumbv7m-none-eabi (QEMU + defmt decoding); `.cargo/config.toml` reaches it through
+//!   `tools/qemu-runner`.
 //! - `cargo xtask bench`: guest instruction counts from a QEMU TCG plugin.
 //! - `cargo xtask size`, `cargo xtask flash`: each board's flash and RAM ([`board`]);
 //!   the flight binary on a real board through probe-rs ([`flash`]).

@@ -1,9 +1,11 @@
-//! QEMU as the cargo runner for thumbv7em-none-eabihf, with the defmt stream decoded on
-//! the host (the `defmt-decoder` crate, pinned to 1.2.x in xtask/Cargo.toml).
+//! QEMU as the cargo runner for thumbv7em-none-eabihf and thumbv7m-none-eabi, with the
+//! defmt stream decoded on the host (the `defmt-decoder` crate, pinned to 1.2.x in
+//! xtask/Cargo.toml).
 //!
 //! The machine is the one of the board the ELF was linked for (its memory layout names
-//! it: [`Board::of_elf`]): `mps2-an386`, or `netduinoplus2` for the STM32F405, so
-//! `cargo run`/`cargo test` with either board's features need no other setting.
+//! it: [`Board::of_elf`]): `mps2-an386`, `mps2-an385`, or `netduinoplus2` for the
+//! STM32F405, so `cargo run`/`cargo test` with any board's features need no other
+//! setting.
 //!
 //! The firmware logs defmt frames to semihosting stdout (`defmt-semihosting`); QEMU
 //! writes them to its stdout (`-semihosting-config target=native`), the UART goes
