@@ -14,15 +14,16 @@
 //! refused computation leaves that segment's last good period in force, and nothing
 //! outside the physically possible period range is ever written.
 
+use core_math::earth::dem::DemTile;
 use core_math::earth::frames::{CelestialPole, TimeScales};
 use core_math::earth::Attitude;
 
 use crate::config::Config;
-use crate::dem::Dem;
+use crate::dem::{Dem, DemStatus, DemStore};
+use crate::fault::ResetCause;
 use crate::fault::{Counters, Fault};
 use crate::nav::Propagator;
 use crate::plan::Plan;
-use crate::restart::ResetCause;
 use crate::scene::{Scene, MAX_SEGMENTS};
 use crate::track::{pole_for, AttitudeState, GnssState};
 
@@ -171,7 +172,7 @@ pub struct Controller {
     pub(crate) dem_ground: crate::dem_ground::DemGround,
     /// A tile given by [`Controller::set_dem_tile`] (tests, the bench): it wins over
     /// the uploaded one.
-    pub(crate) dem_given: Option<core_math::earth::dem::DemTile<'static, i16>>,
+    pub(crate) dem_given: Option<DemTile<'static, i16>>,
 }
 
 impl Controller {
@@ -421,6 +422,45 @@ impl Controller {
                 self.hold(index);
             }
         }
+    }
+}
+
+impl Controller {
+    /// Lends the controller its tile memory. Nothing in it is trusted: no tile is in
+    /// force until an upload commits or [`Controller::restore_dem`] checks the recorded
+    /// one. Returns the store it had, if any.
+    pub fn attach_dem(&mut self, store: &'static mut DemStore) -> Option<&'static mut DemStore> {
+        let old = self.dem.attach(store);
+        self.refresh_dem_ground();
+        old
+    }
+
+    /// Takes the tile memory back (the controller then refuses DEM frames and has no
+    /// tile in force).
+    pub fn detach_dem(&mut self) -> Option<&'static mut DemStore> {
+        let store = self.dem.detach();
+        self.refresh_dem_ground();
+        store
+    }
+
+    /// Puts the tile recorded in the store before a reset back in force, if its record
+    /// and its CRC-32 check out (a pass over the whole tile: call it after the kept
+    /// periods are written). Returns its upload id; on a refusal nothing changes.
+    pub fn restore_dem(&mut self) -> Result<u32, Fault> {
+        let restored = self.dem.restore();
+        self.refresh_dem_ground();
+        restored
+    }
+
+    /// The DEM tile in force, for the per-sample ground of the update; `None` when no
+    /// tile is in force (the scene's per-segment heights then apply).
+    pub fn dem_tile(&self) -> Option<DemTile<'_, i16>> {
+        self.dem.tile()
+    }
+
+    /// The upload's state (STATUS).
+    pub fn dem_status(&self) -> DemStatus {
+        self.dem.status()
     }
 }
 

@@ -308,3 +308,26 @@ fn inside_envelope(a: &Attitude<f32>, env: &AttitudeEnvelope, back_s: f32, ahead
         && angle_ok(a.roll_rad, a.roll_rate_rad_s, env.max_roll_rad)
         && angle_ok(a.pitch_rad, a.pitch_rate_rad_s, env.max_pitch_rad)
 }
+
+impl Controller {
+    pub(crate) fn check_dem_begin(&self, payload: &[u8]) -> Result<(), Fault> {
+        self.dem.validate_begin(payload)
+    }
+
+    pub(crate) fn check_dem_chunk(&self, payload: &[u8]) -> Result<(), Fault> {
+        self.dem.validate_chunk(payload)
+    }
+
+    /// DEM_BEGIN: a new upload; one in progress is given up.
+    pub(crate) fn accept_dem_begin(&mut self, payload: &[u8]) -> Result<(), Fault> {
+        self.dem.begin(payload)
+    }
+
+    /// DEM_CHUNK: staged; the last one puts the tile in force.
+    pub(crate) fn accept_dem_chunk(&mut self, payload: &[u8]) -> Result<(), Fault> {
+        if self.dem.chunk(payload)? {
+            self.refresh_dem_ground();
+        }
+        Ok(())
+    }
+}

@@ -19,52 +19,6 @@ use crate::report::{encode_periods, Periods};
 use crate::scene::{Scene, Terrain, MAX_SEGMENTS};
 use crate::sink::LinePeriodSink;
 
-/// Why the core last started, as STATUS reports it (its byte 2; 0: not reported).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[repr(u8)]
-pub enum ResetCause {
-    /// Power-on, or a retained record that did not check out.
-    PowerOn = 1,
-    /// The watchdog: the main loop stopped making progress.
-    Watchdog = 2,
-    /// The firmware asked for it without noting why.
-    Software = 3,
-    /// A reset the firmware did not see coming and the board cannot name (the reset
-    /// pin, a debugger).
-    Unknown = 4,
-    /// The stack ran into its guard.
-    StackOverflow = 5,
-    /// Any other HardFault.
-    Fault = 6,
-}
-
-impl ResetCause {
-    pub const ALL: [ResetCause; 6] = [
-        ResetCause::PowerOn,
-        ResetCause::Watchdog,
-        ResetCause::Software,
-        ResetCause::Unknown,
-        ResetCause::StackOverflow,
-        ResetCause::Fault,
-    ];
-
-    pub fn name(self) -> &'static str {
-        match self {
-            ResetCause::PowerOn => "power-on",
-            ResetCause::Watchdog => "watchdog",
-            ResetCause::Software => "software",
-            ResetCause::Unknown => "unknown",
-            ResetCause::StackOverflow => "stack overflow",
-            ResetCause::Fault => "hard fault",
-        }
-    }
-
-    /// The cause of wire value `code` (None for 0, "not reported", and unknown values).
-    pub fn from_u8(code: u8) -> Option<ResetCause> {
-        ResetCause::ALL.into_iter().find(|c| *c as u8 == code)
-    }
-}
-
 /// One payload and its length. `repr(C)` with only integers, so that RAM kept across a
 /// reset can hold one: any contents are a valid value, checked before use.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

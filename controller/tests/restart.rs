@@ -7,9 +7,10 @@
 mod common;
 
 use common::{feed, frame, nav_frame, periods, roll, state, Registers, H, I0};
+use controller::fault::ResetCause;
 use controller::frame::kind;
 use controller::report::{encode_status, Status, STATUS_LEN};
-use controller::restart::{ResetCause, Snapshot};
+use controller::restart::Snapshot;
 use controller::{Config, Controller, Fault, Scene};
 
 /// A controller that has flown a while: a scene of its own (staggered heights), a

@@ -231,3 +231,30 @@ pub fn div_64_32(hi: u32, lo: u32, d: u32) -> u32 {
     let (q0, _) = digit(rem, lo & 0xffff);
     (q1 << 16) | q0
 }
+
+/// `x` 2^`exp2` as f32, rounded to nearest even: `x as f32` times the power of two,
+/// exactly, without the software conversion and product. For |x| 2^`exp2` inside f32's
+/// normal range (the controller's callers: I24F40 bits, the Cortex-M3's integer instant and
+/// propagation).
+#[inline(always)]
+pub fn i64_to_f32(x: i64, exp2: i32) -> f32 {
+    let sign = if x < 0 { 1 << 31 } else { 0 };
+    f32::from_bits(u64_to_f32(x.unsigned_abs(), exp2).to_bits() | sign)
+}
+
+/// [`i64_to_f32`] of a magnitude.
+#[inline(always)]
+pub fn u64_to_f32(x: u64, exp2: i32) -> f32 {
+    if x == 0 {
+        return 0.0;
+    }
+    let lz = x.leading_zeros();
+    let top = x << lz;
+    let (mant, rest) = ((top >> 40) as u32, top & ((1 << 40) - 1));
+    let half = 1u64 << 39;
+    let up = rest > half || (rest == half && mant & 1 == 1);
+    // x 2^exp2 = (mant 2^40 + rest) 2^(exp2 - lz): about mant 2^(exp2 + 40 - lz), a
+    // biased exponent of exp2 + 190 - lz; a carry to 2^24 moves into it by itself.
+    let biased = (exp2 + 190 - lz as i32) as u32;
+    f32::from_bits(((biased - 1) << 23) + mant + u32::from(up))
+}

@@ -17,7 +17,7 @@
 
 use controller::crc;
 use controller::dem::DemStore;
-pub use controller::restart::ResetCause;
+pub use controller::fault::ResetCause;
 use controller::restart::{Payload, Snapshot};
 use controller::Controller;
 

@@ -17,7 +17,6 @@ use core_math::earth::dem::{DemBounds, DemGrid, DemTile};
 use core_math::earth::dem::{MAX_DEM_HEIGHT_M, MIN_DEM_HEIGHT_M};
 
 use crate::bytes::Reader;
-use crate::control::Controller;
 use crate::crc;
 use crate::fault::Fault;
 
@@ -358,7 +357,7 @@ impl Dem {
     /// heights' range and its CRC-32 check out; otherwise nothing changes and the
     /// fault says why (`dem_grid`: no record or a bad one; `dem_height`; `dem_crc`).
     /// One pass over the tile: for a boot, after the periods are written.
-    fn restore(&mut self) -> Result<u32, Fault> {
+    pub(crate) fn restore(&mut self) -> Result<u32, Fault> {
         let store = self.store.as_deref().ok_or(Fault::UnknownKind)?;
         let rec = store.record;
         let g = rec.grid();
@@ -395,69 +394,44 @@ impl Dem {
     }
 }
 
-impl Controller {
-    /// Lends the controller its tile memory. Nothing in it is trusted: no tile is in
-    /// force until an upload commits or [`Controller::restore_dem`] checks the recorded
-    /// one. Returns the store it had, if any.
-    pub fn attach_dem(&mut self, store: &'static mut DemStore) -> Option<&'static mut DemStore> {
-        let old = self.dem.store.replace(store);
-        self.dem.in_force = None;
-        self.dem.upload = None;
-        self.refresh_dem_ground();
+impl Dem {
+    /// Takes `store` as the tile memory (nothing in it trusted: no tile in force, no
+    /// upload); returns the one it had.
+    pub(crate) fn attach(&mut self, store: &'static mut DemStore) -> Option<&'static mut DemStore> {
+        let old = self.store.replace(store);
+        self.in_force = None;
+        self.upload = None;
         old
     }
 
-    /// Takes the tile memory back (the controller then refuses DEM frames and has no
-    /// tile in force).
-    pub fn detach_dem(&mut self) -> Option<&'static mut DemStore> {
-        self.dem.in_force = None;
-        self.dem.upload = None;
-        self.refresh_dem_ground();
-        self.dem.store.take()
+    /// Gives the tile memory back: no tile in force, no upload.
+    pub(crate) fn detach(&mut self) -> Option<&'static mut DemStore> {
+        self.in_force = None;
+        self.upload = None;
+        self.store.take()
     }
 
-    /// Puts the tile recorded in the store before a reset back in force, if its record
-    /// and its CRC-32 check out (a pass over the whole tile: call it after the kept
-    /// periods are written). Returns its upload id; on a refusal nothing changes.
-    pub fn restore_dem(&mut self) -> Result<u32, Fault> {
-        let restored = self.dem.restore();
-        self.refresh_dem_ground();
-        restored
+    /// DEM_BEGIN's checks alone.
+    pub(crate) fn validate_begin(&self, payload: &[u8]) -> Result<(), Fault> {
+        self.check_begin(payload).map(|_| ())
     }
 
-    /// The DEM tile in force, for the per-sample ground of the update; `None` when no
-    /// tile is in force (the scene's per-segment heights then apply).
-    pub fn dem_tile(&self) -> Option<DemTile<'_, i16>> {
-        self.dem.tile()
-    }
-
-    /// The upload's state (STATUS).
-    pub fn dem_status(&self) -> DemStatus {
-        self.dem.status()
-    }
-
-    pub(crate) fn check_dem_begin(&self, payload: &[u8]) -> Result<(), Fault> {
-        self.dem.check_begin(payload).map(|_| ())
-    }
-
-    pub(crate) fn check_dem_chunk(&self, payload: &[u8]) -> Result<(), Fault> {
-        self.dem.check_chunk(payload).map(|_| ())
+    /// DEM_CHUNK's checks alone.
+    pub(crate) fn validate_chunk(&self, payload: &[u8]) -> Result<(), Fault> {
+        self.check_chunk(payload).map(|_| ())
     }
 
     /// DEM_BEGIN: a new upload; one in progress is given up.
-    pub(crate) fn accept_dem_begin(&mut self, payload: &[u8]) -> Result<(), Fault> {
-        self.dem.upload = Some(self.dem.check_begin(payload)?);
+    pub(crate) fn begin(&mut self, payload: &[u8]) -> Result<(), Fault> {
+        self.upload = Some(self.check_begin(payload)?);
         Ok(())
     }
 
-    /// DEM_CHUNK: staged; the last one puts the tile in force.
-    pub(crate) fn accept_dem_chunk(&mut self, payload: &[u8]) -> Result<(), Fault> {
-        let ok = self.dem.check_chunk(payload)?;
+    /// DEM_CHUNK: staged; the last one puts the tile in force (then true).
+    pub(crate) fn chunk(&mut self, payload: &[u8]) -> Result<bool, Fault> {
+        let ok = self.check_chunk(payload)?;
         let commit = ok.commit;
-        self.dem.apply_chunk(payload, ok)?;
-        if commit {
-            self.refresh_dem_ground();
-        }
-        Ok(())
+        self.apply_chunk(payload, ok)?;
+        Ok(commit)
     }
 }

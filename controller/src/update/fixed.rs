@@ -7,31 +7,7 @@ use super::*;
 use core_math::wide::Wide;
 use core_math::ModelError;
 
-/// `x` 2^`exp2` as f32, rounded to nearest even: `x as f32` times the power of two,
-/// exactly, without the software conversion and product. For |x| 2^`exp2` inside f32's
-/// normal range (the callers': `exp2` 0 or -40, I24F40 bits).
-#[inline(always)]
-pub(crate) fn i64_to_f32(x: i64, exp2: i32) -> f32 {
-    let sign = if x < 0 { 1 << 31 } else { 0 };
-    f32::from_bits(u64_to_f32(x.unsigned_abs(), exp2).to_bits() | sign)
-}
-
-/// [`i64_to_f32`] of a magnitude.
-#[inline(always)]
-pub(crate) fn u64_to_f32(x: u64, exp2: i32) -> f32 {
-    if x == 0 {
-        return 0.0;
-    }
-    let lz = x.leading_zeros();
-    let top = x << lz;
-    let (mant, rest) = ((top >> 40) as u32, top & ((1 << 40) - 1));
-    let half = 1u64 << 39;
-    let up = rest > half || (rest == half && mant & 1 == 1);
-    // x 2^exp2 = (mant 2^40 + rest) 2^(exp2 - lz): about mant 2^(exp2 + 40 - lz), a
-    // biased exponent of exp2 + 190 - lz; a carry to 2^24 moves into it by itself.
-    let biased = (exp2 + 190 - lz as i32) as u32;
-    f32::from_bits(((biased - 1) << 23) + mant + u32::from(up))
-}
+pub(crate) use core_math::wide::{i64_to_f32, u64_to_f32};
 
 /// A finite f32 >= 0 in I24F40 bits, truncated, saturating; 0 for any other.
 #[inline(always)]

@@ -352,8 +352,6 @@ mod sweep;
 
 use backend::*;
 #[cfg(feature = "earth-fixed")]
-pub(crate) use fixed::i64_to_f32 as i64_to_f32_scaled;
-#[cfg(feature = "earth-fixed")]
 use fixed::*;
 pub use sweep::drift_angle_rad;
 use sweep::*;

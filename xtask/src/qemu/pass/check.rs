@@ -90,7 +90,7 @@ impl LinePeriodSink for Accept {
 pub fn new_controller(config: Config) -> Result<Controller> {
     let mut c = Controller::new(config, Scene::paper_default())
         .map_err(|f| anyhow!("the default scene was refused: {}", f.name()))?;
-    c.note_boot(controller::restart::ResetCause::PowerOn, 0);
+    c.note_boot(controller::fault::ResetCause::PowerOn, 0);
     // The firmware's tile memory (retained RAM there); a host run's is never given back.
     c.attach_dem(Box::leak(Box::new(controller::dem::DemStore::new())));
     Ok(c)
@@ -180,7 +180,7 @@ pub fn reset_inputs(
 ) -> Result<BTreeMap<u64, InForce>> {
     let mut inputs = twin(prefix, config)?.1;
     let (before, _) = host_run(prefix, config)?;
-    let cause = controller::restart::ResetCause::ALL[0];
+    let cause = controller::fault::ResetCause::ALL[0];
     let after = restarted(before, cause, 1, config)?;
     inputs.extend(twin_of(Session::new(after), suffix).1);
     Ok(inputs)
@@ -204,7 +204,7 @@ pub const EARTH_FIXED_REL_TOLERANCE: f64 = 2e-6;
 pub fn reset_twin(
     prefix: &[u8],
     suffix: &[u8],
-    cause: controller::restart::ResetCause,
+    cause: controller::fault::ResetCause,
     resets: u32,
     config: Config,
 ) -> Result<(Vec<u8>, Vec<u8>)> {
@@ -219,7 +219,7 @@ pub fn reset_twin(
 /// tile memory kept.
 fn restarted(
     mut before: Session,
-    cause: controller::restart::ResetCause,
+    cause: controller::fault::ResetCause,
     resets: u32,
     config: Config,
 ) -> Result<Controller> {
