@@ -36,6 +36,7 @@ pub fn run() -> Result<()> {
     derivation_check()?;
     crate::qemu::test_target()?;
     crate::no_panic::check()?;
+    no_fpu_elf_check()?;
     eprintln!(
         "\nxtask test: all checks passed in {:.0} s",
         t0.elapsed().as_secs_f64()
@@ -49,6 +50,19 @@ pub fn run() -> Result<()> {
 fn no_float_check() -> Result<()> {
     crate::qemu::ensure_rust_target(crate::qemu::NO_FPU_TARGET)?;
     run_step("sh", &["tools/check-no-float.sh"])
+}
+
+/// The Cortex-M3's release flight binary holds no instruction of the FPU it lacks; the
+/// same scan must find them in the mps2-an386's (tools/check-no-fpu-elf.sh, issue 24).
+fn no_fpu_elf_check() -> Result<()> {
+    use crate::qemu::{board::Board, build_firmware};
+    let m3 = build_firmware(Board::Mps2An385, "firmware", true, &[], &[])?;
+    let m4f = build_firmware(Board::Mps2An386, "firmware", true, &[], &[])?;
+    let path = |p: &std::path::Path| p.to_string_lossy().into_owned();
+    run_step(
+        "sh",
+        &["tools/check-no-fpu-elf.sh", &path(&m3), &path(&m4f)],
+    )
 }
 
 /// The computer-algebra proof of the derivation (tools/derivation/derive.py).
