@@ -163,7 +163,7 @@ fn instant_q(
         return None;
     }
     let z = r2q.leading_zeros() & !1;
-    let s = core_math::earth::fixed::sqrt_u64(r2q << z);
+    let s = core_math::earth::fixed::sqrt_per_update(r2q << z);
     let h = -7 - (z / 2) as i32;
     let inv = i64::from(div_64_32(1 << 30, 0, s));
     // x / |r| in Q`frac` (x's mantissa times inv: below 2^55).
@@ -194,7 +194,7 @@ fn instant_q(
         .iter()
         .map(|&x| x.unsigned_abs() * x.unsigned_abs())
         .fold(0u64, u64::wrapping_add);
-    let nu = i64::from(core_math::earth::fixed::sqrt_u64(nu2));
+    let nu = i64::from(core_math::earth::fixed::sqrt_per_update(nu2));
     if !(1 << 20..1 << 32).contains(&nu) {
         return None;
     }
