@@ -352,7 +352,7 @@ mod sweep;
 
 use backend::*;
 #[cfg(feature = "earth-fixed")]
-pub(crate) use fixed::i64_to_f32 as i64_to_f32_scaled;
+pub(crate) use fixed::i64_to_f32_call as i64_to_f32_scaled;
 #[cfg(feature = "earth-fixed")]
 use fixed::*;
 pub use sweep::drift_angle_rad;
