@@ -427,7 +427,12 @@ struct Ray {
     jc: f32,
 }
 
-#[inline(always)]
+// Out of line on the M3 (three copies inlined there).
+#[cfg_attr(all(target_arch = "arm", not(target_abi = "eabihf")), inline(never))]
+#[cfg_attr(
+    not(all(target_arch = "arm", not(target_abi = "eabihf"))),
+    inline(always)
+)]
 fn clamp(x: f32, lo: f32, hi: f32) -> f32 {
     if x > lo {
         if x < hi {

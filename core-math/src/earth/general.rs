@@ -421,7 +421,12 @@ impl<T: Real> General<T> {
 }
 
 /// g = c'/s = -W x u - V / s at the pixel u and 1/s.
-#[inline(always)]
+// Out of line on the Cortex-M3: only its cold and DEM routes take it there.
+#[cfg_attr(all(target_arch = "arm", not(target_abi = "eabihf")), inline(never))]
+#[cfg_attr(
+    not(all(target_arch = "arm", not(target_abi = "eabihf"))),
+    inline(always)
+)]
 fn g_of<T: Real>(up: &GeneralUpdate<T>, u: [T; 3], inv_s: T) -> [T; 3] {
     let (w, v) = (up.w_b_rad_s, up.v_b_mps);
     [
