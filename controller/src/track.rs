@@ -282,9 +282,9 @@ fn dot(a: [f32; 3], b: [f32; 3]) -> f32 {
 /// dOmega/dt = -(w2 + w3) x w1 - w3 x w2 - Omega x W_c + b^T dW/dt. Zero where the
 /// pitch is within 0.6 deg of +-90 deg (the axes are then degenerate).
 pub fn euler_accel(b: &[[f32; 3]; 3], omega: [f32; 3], r: [f32; 3], v: [f32; 3]) -> [f32; 3] {
-    let to_camera = |x: [f32; 3]| -> [f32; 3] {
-        core::array::from_fn(|j| b[0][j] * x[0] + b[1][j] * x[1] + b[2][j] * x[2])
-    };
+    // b^T x: x^T b, the same products (each commutes exactly) summed in the same order;
+    // on the M3 one out-of-line copy for both uses.
+    let to_camera = |x: [f32; 3]| -> [f32; 3] { row_times(&x, b) };
     let h = cross(r, v);
     let (r2, h2) = (dot(r, r), dot(h, h));
     if !(r2 > 0.0 && h2 > 0.0) {
