@@ -162,8 +162,8 @@ impl SeriesInt {
         // dr (Q16, below 2^32) times 2 r0 + dr to the metre (below 2^25).
         let grow = dr * ((r0 + r + (1 << 15)) >> 16);
         (
-            core_math::wide::i64_to_f32(r, -16),
-            core_math::wide::i64_to_f32(v0 + dv, -20),
+            core_math::wide::i64_to_f32_call(r, -16),
+            core_math::wide::i64_to_f32_call(v0 + dv, -20),
             grow,
         )
     }
@@ -338,7 +338,7 @@ impl Propagator {
         Some(StateParts {
             position_m: r,
             velocity_mps: v,
-            r2_minus_a2_m2: core_math::wide::i64_to_f32(
+            r2_minus_a2_m2: core_math::wide::i64_to_f32_call(
                 p.r2_minus_a2_m2 + ((grow + (1 << 15)) >> 16),
                 0,
             ),

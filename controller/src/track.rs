@@ -152,9 +152,9 @@ impl AttitudeState {
             );
             let r2 = dot(r, r);
             let k = -(core_math::GM_M3_S2 as f32) / (r2 * core_math::sqrt_f32(r2));
-            let r_t: [f32; 3] =
-                core::array::from_fn(|i| r[i] + v[i] * dt_s + 0.5 * k * r[i] * dt_s * dt_s);
-            let v_t: [f32; 3] = core::array::from_fn(|i| v[i] + k * r[i] * dt_s);
+            let carried: [(f32, f32); 3] = core::array::from_fn(|i| carry(r[i], v[i], k, dt_s));
+            let r_t = carried.map(|c| c.0);
+            let v_t = carried.map(|c| c.1);
             let s = EARTH_RATE_RAD_S as f32 * dt_s;
             let turn = |x: [f32; 3]| [x[0] + s * x[1], x[1] - s * x[0], x[2]];
             euler_accel(&b, omega, turn(r_t), turn(v_t))
@@ -221,6 +221,14 @@ fn rounded(m: &[[f64; 3]; 3]) -> [[f32; 3]; 3] {
     m.map(|row| row.map(|x| x as f32))
 }
 
+/// One axis of the fix carried by `dt_s` in [`AttitudeState::derive`]: (r + v dt + k r
+/// dt^2 / 2, v + k r dt). Out of line: the derivation unrolled it over the three axes
+/// (docs/target.md, `m3-flash3`).
+#[inline(never)]
+fn carry(r: f32, v: f32, k: f32, dt_s: f32) -> (f32, f32) {
+    (r + v * dt_s + 0.5 * k * r * dt_s * dt_s, v + k * r * dt_s)
+}
+
 /// Hamilton product.
 fn q_mul(a: [f32; 4], b: [f32; 4]) -> [f32; 4] {
     [
@@ -272,9 +280,9 @@ fn cross(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
 /// dOmega/dt = -(w2 + w3) x w1 - w3 x w2 - Omega x W_c + b^T dW/dt. Zero where the
 /// pitch is within 0.6 deg of +-90 deg (the axes are then degenerate).
 pub fn euler_accel(b: &[[f32; 3]; 3], omega: [f32; 3], r: [f32; 3], v: [f32; 3]) -> [f32; 3] {
-    let to_camera = |x: [f32; 3]| -> [f32; 3] {
-        core::array::from_fn(|j| b[0][j] * x[0] + b[1][j] * x[1] + b[2][j] * x[2])
-    };
+    // b^T x: x^T b, the same products (each commutes exactly) summed in the same order;
+    // on the M3 one out-of-line copy for both uses.
+    let to_camera = |x: [f32; 3]| -> [f32; 3] { row_times(&x, b) };
     let h = cross(r, v);
     let (r2, h2) = (dot(r, r), dot(h, h));
     if !(r2 > 0.0 && h2 > 0.0) {

@@ -242,6 +242,13 @@ pub fn i64_to_f32(x: i64, exp2: i32) -> f32 {
     f32::from_bits(u64_to_f32(x.unsigned_abs(), exp2).to_bits() | sign)
 }
 
+/// [`i64_to_f32`] out of line: the NAV route's per-update conversions (the propagated
+/// state's, the integer instant's fields) share one copy (docs/target.md, flash).
+#[inline(never)]
+pub fn i64_to_f32_call(x: i64, exp2: i32) -> f32 {
+    i64_to_f32(x, exp2)
+}
+
 /// [`i64_to_f32`] of a magnitude.
 #[inline(always)]
 pub fn u64_to_f32(x: u64, exp2: i32) -> f32 {

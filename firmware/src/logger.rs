@@ -97,7 +97,9 @@ fn write_all(fd: Option<RawFd>, mut bytes: &[u8]) {
 /// The open stdout handle, opening it first if needed; `None` if that fails.
 ///
 /// # Safety
-/// Only the context holding the logger may call this.
+/// Only the context holding the logger may call this. Out of line: `acquire`, `write`
+/// and `release` each inlined the open (docs/target.md, `m3-flash3`).
+#[inline(never)]
 unsafe fn stdout_fd() -> Option<RawFd> {
     // SAFETY: the caller holds the logger: nobody else touches the cell.
     let fd = unsafe { &mut *STATE.fd.get() };

@@ -305,7 +305,13 @@ impl<'h> SegmentRays<'h> {
     }
 
     /// d0 = B (p1, 0, -f) and dy = B (0, 1, 0).
-    #[inline(always)]
+    // Out of line on the M3 (docs/target.md, `m3-flash3`): inlined in two or three
+    // places, a soft-float copy in each.
+    #[cfg_attr(all(target_arch = "arm", not(target_abi = "eabihf")), inline(never))]
+    #[cfg_attr(
+        not(all(target_arch = "arm", not(target_abi = "eabihf"))),
+        inline(always)
+    )]
     pub(crate) fn directions(frame: &ItrfFrame, p1_m: f32, focal_m: f32) -> ([f32; 3], [f32; 3]) {
         let b = &frame.camera_to_itrf;
         (
@@ -421,7 +427,12 @@ struct Ray {
     jc: f32,
 }
 
-#[inline(always)]
+// Out of line on the M3 (three copies inlined there).
+#[cfg_attr(all(target_arch = "arm", not(target_abi = "eabihf")), inline(never))]
+#[cfg_attr(
+    not(all(target_arch = "arm", not(target_abi = "eabihf"))),
+    inline(always)
+)]
 fn clamp(x: f32, lo: f32, hi: f32) -> f32 {
     if x > lo {
         if x < hi {

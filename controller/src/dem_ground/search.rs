@@ -292,6 +292,7 @@ impl DemGround {
     }
 
     /// Notes the sample's height for the next update's start, and its change.
+    #[cfg_attr(all(target_arch = "arm", not(target_abi = "eabihf")), inline(never))]
     pub(super) fn remember(&mut self, k: usize, j: usize, h_m: f32) {
         let Some(slot) = self.history_m.get_mut(k).and_then(|s| s.get_mut(j)) else {
             return;
@@ -376,7 +377,13 @@ impl DemGround {
 
     /// The tile at height h on the ray: [`DemGround::locate`], then the bilinear height
     /// and its gradient along the ray.
-    #[inline(always)]
+    // Out of line on the M3 (docs/target.md, `m3-flash3`): inlined in two or three
+    // places, a soft-float copy in each.
+    #[cfg_attr(all(target_arch = "arm", not(target_abi = "eabihf")), inline(never))]
+    #[cfg_attr(
+        not(all(target_arch = "arm", not(target_abi = "eabihf"))),
+        inline(always)
+    )]
     pub(super) fn evaluate(&self, rays: &SegmentRays, ray: &Ray, h: f32) -> Evaluation {
         let t = &self.frame;
         let Some(at) = self.locate(rays, ray, h) else {

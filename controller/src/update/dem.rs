@@ -206,7 +206,9 @@ impl Controller {
 }
 
 /// The heights of the tile the DEM route was made for: the one given (tests, bench) or
-/// the upload's in force (`Controller::refresh_dem_ground`).
+/// the upload's in force (`Controller::refresh_dem_ground`). Out of line on the M3 (two
+/// copies inlined there).
+#[cfg_attr(all(target_arch = "arm", not(target_abi = "eabihf")), inline(never))]
 fn tile_heights<'a>(
     given: &'a Option<core_math::earth::dem::DemTile<'static, i16>>,
     store: &'a crate::dem::Dem,

@@ -8,7 +8,7 @@ use core_math::earth::{Attitude, General, GeneralInstant};
 use core_math::wide::div_64_32;
 use core_math::ModelError;
 
-use super::fixed::i64_to_f32;
+use super::fixed::i64_to_f32_call as to_f32;
 
 /// A finite f32 as m 2^e exactly (m signed, |m| < 2^24; zero and subnormals as 0; a
 /// non-finite one as a mantissa times 2^105, past every format, so the f32 route).
@@ -53,12 +53,6 @@ fn mul(a: i64, b: i64) -> i64 {
 #[inline(never)]
 fn mul_shr(a: i64, b: i64, k: u32) -> i64 {
     (a * b + (1 << (k - 1))) >> k
-}
-
-/// `x` 2^`exp2` rounded to f32 (`fixed::i64_to_f32`), one copy for the twelve fields.
-#[inline(never)]
-fn to_f32(x: i64, exp2: i32) -> f32 {
-    i64_to_f32(x, exp2)
 }
 
 /// a b 2^-30 rounded, of two Q30 values (one 32 x 32 -> 64 product).
@@ -163,7 +157,7 @@ fn instant_q(
         return None;
     }
     let z = r2q.leading_zeros() & !1;
-    let s = core_math::earth::fixed::sqrt_u64(r2q << z);
+    let s = core_math::earth::fixed::sqrt_per_update(r2q << z);
     let h = -7 - (z / 2) as i32;
     let inv = i64::from(div_64_32(1 << 30, 0, s));
     // x / |r| in Q`frac` (x's mantissa times inv: below 2^55).
@@ -194,7 +188,7 @@ fn instant_q(
         .iter()
         .map(|&x| x.unsigned_abs() * x.unsigned_abs())
         .fold(0u64, u64::wrapping_add);
-    let nu = i64::from(core_math::earth::fixed::sqrt_u64(nu2));
+    let nu = i64::from(core_math::earth::fixed::sqrt_per_update(nu2));
     if !(1 << 20..1 << 32).contains(&nu) {
         return None;
     }
@@ -266,7 +260,8 @@ fn instant_q(
             times_r(i64::from(cols[2][2]), 30),
         ],
         r_z_m: r[2],
-        r2_m2: super::fixed::u64_to_f32(r2q, -14),
+        // r2q < 2^61: the same bits as its u64 conversion.
+        r2_m2: to_f32(r2q as i64, -14),
         r2_minus_a2_m2: r2_minus_a2,
         // W_B = A^T W_L + w_A: Q39, the rates' part from Q35.
         w_b_rad_s: core::array::from_fn(|k| to_f32(w_b[k] + (w_a[k] << 4), -39)),

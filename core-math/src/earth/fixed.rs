@@ -546,7 +546,8 @@ impl EarthFixedUpdate {
         let m3 = i64::from(self.m[2]);
         // (m.u')^2: Q66 -> Q30, < 0.026.
         let alpha = (1u32 << 30) + ((m3 * m3) >> 36) as u32;
-        let ninv_s = i64::from(neg_inv_sigma(b31, alpha, self)?);
+        // Once per update: the root out of line.
+        let ninv_s = i64::from(neg_inv_sigma(b31, alpha, self, sqrt_per_update)?);
         // -V_k / sigma: Q40 x Q24 = Q64, |.| < 2^61.2, to Q63.
         let [w1, w2, _] = self.w;
         let vf1 = (i64::from(w2) << 30) + ((i64::from(self.v[0]) * ninv_s) >> 1);
@@ -913,7 +914,7 @@ impl Backend<Earth> for EarthFixed {
         // alpha = |u'|^2 + (m.u')^2, Q30 (the square's high word), < 3.08.
         let alpha = px.uu + ((i64::from(s31) * i64::from(s31)) >> 32) as u32;
         // -1/sigma, Q24 (> -2^30.2).
-        let ninv_s = neg_inv_sigma(b31, alpha, up)?;
+        let ninv_s = neg_inv_sigma(b31, alpha, up, sqrt_u64)?;
         // V_k + t_k V3, Q70 -> Q39 (rounded), |.| < 2^-8: below 2^31 as V_k < 2^-9.
         let v3 = up.v[2];
         let p1 = (mac(k.v0[0], v3, t1) >> 31) as i32;
@@ -956,9 +957,15 @@ fn mulhi(a: u32, b: u32) -> u32 {
 
 /// -1/sigma (1/sigma the near root's reciprocal) in Q24 from |beta| (Q31) and alpha
 /// (Q30), with the update's C and |r|^2/C; a ray whose discriminant is negative misses.
-/// Negative, so that its products are plainly signed ones (SMLAL).
+/// Negative, so that its products are plainly signed ones (SMLAL). `sqrt` is
+/// [`sqrt_u64`], inline per pixel or out of line per update.
 #[inline(always)]
-fn neg_inv_sigma(b31: u32, alpha: u32, up: &EarthFixedUpdate) -> Result<i32, ModelError> {
+fn neg_inv_sigma(
+    b31: u32,
+    alpha: u32,
+    up: &EarthFixedUpdate,
+    sqrt: fn(u64) -> u32,
+) -> Result<i32, ModelError> {
     // beta^2 and alpha C, Q62, < 2^63.7 and 2^62.7.
     let bb = u64::from(b31) * u64::from(b31);
     let ac = u64::from(alpha) * u64::from(up.c);
@@ -967,7 +974,7 @@ fn neg_inv_sigma(b31: u32, alpha: u32, up: &EarthFixedUpdate) -> Result<i32, Mod
         return Err(ModelError::LineOfSightMissesEarth);
     }
     // sqrt(disc), Q31.
-    let root = sqrt_u64(disc);
+    let root = sqrt(disc);
     // (sqrt(disc) + |beta|) / 2, Q30, the numerator of 1/sigma (< 3.56): the halving
     // add that needs no 33rd bit.
     let num = (root & b31) + ((root ^ b31) >> 1);
@@ -988,9 +995,10 @@ fn times_focal(x: i64, px: &EarthFixedPixel) -> i64 {
     shr(top, px.shift)
 }
 
-/// [`sqrt_u64`] out of line, for the per-update code (one copy in flash).
+/// [`sqrt_u64`] out of line, for the per-update code (one copy in flash; the
+/// controller's integer instant takes it too).
 #[inline(never)]
-fn sqrt_per_update(x: u64) -> u32 {
+pub fn sqrt_per_update(x: u64) -> u32 {
     sqrt_u64(x)
 }
 

@@ -421,7 +421,12 @@ impl<T: Real> General<T> {
 }
 
 /// g = c'/s = -W x u - V / s at the pixel u and 1/s.
-#[inline(always)]
+// Out of line on the Cortex-M3: only its cold and DEM routes take it there.
+#[cfg_attr(all(target_arch = "arm", not(target_abi = "eabihf")), inline(never))]
+#[cfg_attr(
+    not(all(target_arch = "arm", not(target_abi = "eabihf"))),
+    inline(always)
+)]
 fn g_of<T: Real>(up: &GeneralUpdate<T>, u: [T; 3], inv_s: T) -> [T; 3] {
     let (w, v) = (up.w_b_rad_s, up.v_b_mps);
     [
@@ -579,7 +584,13 @@ impl<T: Real> GeneralRowMotion<T> {
     /// (v1, v2) at the row's pixel p2 (m): [`Backend::motion`] at u = (p1, p2, -f), with
     /// its checks and errors (a pixel facing away from the ground, a miss, v1 too slow,
     /// in that order), rounded differently.
-    #[inline(always)]
+    // Out of line on the Cortex-M3, where only the DEM route and cold fallbacks take the
+    // row form, a soft-float copy at each (docs/target.md, `m3-flash3`).
+    #[cfg_attr(all(target_arch = "arm", not(target_abi = "eabihf")), inline(never))]
+    #[cfg_attr(
+        not(all(target_arch = "arm", not(target_abi = "eabihf"))),
+        inline(always)
+    )]
     pub fn motion_at(&self, p2_m: T) -> Result<ImageMotion<T>, ModelError> {
         if !self.faces_ground_over(p2_m, p2_m) {
             return Err(ModelError::LineOfSightMissesEarth);
@@ -602,7 +613,13 @@ impl<T: Real> GeneralRowMotion<T> {
     /// errors for one check instead of three. A negative discriminant makes the square
     /// root NaN and v1 with it, which the speed check refuses; only then is the error
     /// told apart (the line of sight misses, or v1 is too slow), as `motion_at` would.
-    #[inline(always)]
+    // Out of line on the Cortex-M3, where only the DEM route and cold fallbacks take the
+    // row form, a soft-float copy at each (docs/target.md, `m3-flash3`).
+    #[cfg_attr(all(target_arch = "arm", not(target_abi = "eabihf")), inline(never))]
+    #[cfg_attr(
+        not(all(target_arch = "arm", not(target_abi = "eabihf"))),
+        inline(always)
+    )]
     pub fn motion_at_facing(&self, p2_m: T) -> Result<ImageMotion<T>, ModelError> {
         let p2 = p2_m;
         let beta = self.beta[0] + self.beta[1] * p2;
