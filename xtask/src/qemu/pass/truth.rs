@@ -341,7 +341,7 @@ impl Report {
             self.firmware.2
         );
         println!(
-            "  after a lost frame (the attitude in force older than 0.1 s or the fix older than 1.05 s): {:.3e} (at {:.2} s segment {}); the budget of issue 23, {MODEL_GAIN_BUDGET:.0e}, is {}",
+            "  after a lost frame (the attitude in force older than 0.1 s or the fix older than 1.05 s): {:.3e} (at {:.2} s segment {}), counted apart; issue 23's budget, {MODEL_GAIN_BUDGET:.0e}, on the line above: {}",
             self.after_loss.0,
             self.after_loss.1 as f64 * 1e-6,
             self.after_loss.2,
