@@ -8,30 +8,15 @@
 # float_canary (soft-float calls), or its verdict would mean nothing.
 # Prints the function's static instruction count. docs/fixed-point.md.
 set -eu
-cd "$(dirname "$0")/.."
+here=$(cd "$(dirname "$0")" && pwd)
+cd "$here/.."
 target=thumbv7m-none-eabi
 out=target/no-float
 cargo build --quiet --release --manifest-path tools/no-float/Cargo.toml \
     --target "$target" --target-dir "$out"
 lib="$out/$target/release/libno_float_probe.a"
 
-objdump=""
-if command -v llvm-objdump >/dev/null 2>&1; then
-    objdump=llvm-objdump
-else
-    # rustup's llvm-tools component ships one.
-    sysroot=$(rustc --print sysroot)
-    host=$(rustc -vV | sed -n 's/^host: //p')
-    cand="$sysroot/lib/rustlib/$host/bin/llvm-objdump"
-    if [ ! -x "$cand" ] && command -v rustup >/dev/null 2>&1; then
-        rustup component add llvm-tools >/dev/null 2>&1 || true
-    fi
-    if [ -x "$cand" ]; then objdump=$cand; fi
-fi
-if [ -z "$objdump" ]; then
-    echo "check-no-float: no llvm-objdump (install LLVM, or rustup component add llvm-tools)" >&2
-    exit 1
-fi
+objdump=$(sh "$here/find-objdump.sh")
 
 # The disassembly of one symbol, with relocations (the archive is not linked, so calls
 # show their target only as a relocation).

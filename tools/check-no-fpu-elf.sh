@@ -10,22 +10,7 @@ set -eu
 no_fpu_elf=$1
 fpu_elf=$2
 
-objdump=""
-if command -v llvm-objdump >/dev/null 2>&1; then
-    objdump=llvm-objdump
-else
-    sysroot=$(rustc --print sysroot)
-    host=$(rustc -vV | sed -n 's/^host: //p')
-    cand="$sysroot/lib/rustlib/$host/bin/llvm-objdump"
-    if [ ! -x "$cand" ] && command -v rustup >/dev/null 2>&1; then
-        rustup component add llvm-tools >/dev/null 2>&1 || true
-    fi
-    if [ -x "$cand" ]; then objdump=$cand; fi
-fi
-if [ -z "$objdump" ]; then
-    echo "check-no-fpu-elf: no llvm-objdump (install LLVM, or rustup component add llvm-tools)" >&2
-    exit 1
-fi
+objdump=$(sh "$(cd "$(dirname "$0")" && pwd)/find-objdump.sh")
 
 # FPU instructions of an ELF, one line each (address and instruction).
 fpu_lines() {
