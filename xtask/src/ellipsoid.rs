@@ -106,7 +106,7 @@ struct Errors {
     pixel: f64,
     /// Drift angle atan(v2 / v1), round Earth minus WGS 84 (rad).
     drift_rad: f64,
-    /// The firmware's f32 closed form (geometry rounded to f32) against the f64
+    /// The paper's f32 closed form (geometry rounded to f32) against the f64
     /// reference of the same round-Earth geometry: |v_P| ratio - 1.
     f32_arith: f64,
     /// Geocentric latitude of the ground point on WGS 84 (deg).
@@ -144,11 +144,11 @@ struct Row {
 #[derive(Clone, Debug)]
 pub struct EllipsoidSummary {
     /// Every error over the whole sweep. `round`: the relative error of |v_P| (and, to
-    /// first order, of the line period) of the firmware's round Earth against WGS 84,
+    /// first order, of the line period) of the paper's round Earth against WGS 84,
     /// signed (> 0: the model's image is too fast, its line period too short); `local`
     /// and `pixel` the same with the local geocentric radius at the sub-satellite point
     /// and with each pixel's own ground-point radius (one step); `f32_arith` the f32
-    /// closed form (the firmware's arithmetic) on the same cases, for comparison.
+    /// closed form (the arithmetic the firmware once flew) on the same cases, for comparison.
     all: Stats,
     /// TDI stages of the default scene.
     stages: u32,
@@ -423,7 +423,7 @@ fn render(s: &EllipsoidSummary) -> Result<String> {
         "\nFigures ({CMD}):\n\n\
          - Truth: `core_math::EarthReference` over WGS 84 (its check against an \
          independent numerical model: `cargo test -p core-math --test two_routes`).\n\
-         - Round Earth (R = 6371 km, H = |r| - R), the firmware's model: worst {} at \
+         - Round Earth (R = 6371 km, H = |r| - R), the paper's model (which the firmware no longer flies): worst {} at \
          latitude {:+.1} deg (u = {:.0} deg, roll {:+.0} deg, n = {:+.0}, ground point at latitude {:+.1} deg); \
          range {} to {}, RMS {} ({CMD}). \
          Line period error there: {} ({CMD}).\n\
@@ -431,7 +431,7 @@ fn render(s: &EllipsoidSummary) -> Result<String> {
          ({:.1}x smaller) ({CMD}).\n\
          - Round Earth of the geocentric radius at each pixel's ground point (one step): \
          worst {} ({CMD}).\n\
-         - The firmware's f32 arithmetic (closed form, geometry rounded to f32) against the \
+         - The round-Earth closed form's f32 arithmetic (geometry rounded to f32) against the \
          f64 reference on the same round-Earth cases: worst {} ({CMD}); the round Earth's \
          error is {:.1e} times larger ({CMD}).\n\
          - MTF_mismatch at Nyquist, {stages} stages, sinc(pi N |dv/v| / 2), for the worst error \
