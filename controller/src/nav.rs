@@ -89,7 +89,7 @@ impl Nav {
 /// difference that cancels, is the NAV frame's (formed in f64) plus 2 r.dr + dr.dr. The
 /// results round like the f64 sum rounded to f32, without the soft-f64 additions (their
 /// cost: docs/controller.md, "What it costs"). A core without an FPU takes the same
-/// series in integers ([`Propagator::parts_at_int`], with the feature `earth-fixed`).
+/// series in integers (`Propagator::parts_at_int`, with the feature `earth-fixed`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Propagator {
     pub state: StateVector,

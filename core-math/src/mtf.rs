@@ -336,7 +336,7 @@ impl<T: Real> StageRule<T> {
     /// close to x_f / (d sqrt(1 + kappa r^2)), d = max(e, t), r = min/max, a form exact
     /// at r = 0 and r = 1 (kappa from the root of sinc^2) and within 0.9 % between for
     /// floors from 0.5 up (1.8 % at 0.25). The guess is then moved by at most
-    /// [`GUESS_STEPS`] stages until the count meets the floor and the next one does not.
+    /// `GUESS_STEPS` stages until the count meets the floor and the next one does not.
     /// That certifies it: on the main lobe the product falls strictly, and past either
     /// factor's first zero it stays under 0.22 < [`MIN_MTF_FLOOR`]. Should the guess
     /// be further off (counts of tens of thousands of stages), the bracket and
@@ -533,7 +533,7 @@ pub mod int {
         }
     }
 
-    /// sin(pi y)/(pi y) for y in Q30 on [0, 1], in Q30: [`SINC_PI_Q30`] by Horner's rule
+    /// sin(pi y)/(pi y) for y in Q30 on [0, 1], in Q30: `SINC_PI_Q30` by Horner's rule
     /// in 32 x 32 -> 64 products, within 5e-9 of the exact value (truncation 1.7e-10,
     /// ten roundings of 2^-31, the constants' 2^-31 each; measured:
     /// `core-math/tests/mtf_period.rs`).

@@ -52,7 +52,7 @@ pub fn scale<T: Copy + Mul<Output = T>>(s: T, a: [T; 3]) -> [T; 3] {
     [s * a[0], s * a[1], s * a[2]]
 }
 
-/// A scalar with a correctly rounded square root: what [`norm`] and [`unit`] need.
+/// A scalar with a correctly rounded square root: what [`norm`] and [`unit()`] need.
 pub trait Sqrt: Copy {
     fn sqrt(self) -> Self;
 }

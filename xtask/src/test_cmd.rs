@@ -17,6 +17,15 @@ pub fn run() -> Result<()> {
     // The default members are the host crates; the target crates are linted by
     // `qemu::test_target` for thumbv7em.
     cargo(&["clippy", "--all-targets", "--", "-D", "warnings"])?;
+    // The API docs of the math and the controller, every feature on: a broken or
+    // private intra-doc link fails here rather than rotting unseen.
+    eprintln!("xtask: cargo doc --no-deps -p core-math -p controller --all-features (RUSTDOCFLAGS=-D warnings)");
+    crate::qemu::status(
+        crate::qemu::cargo_command()
+            .args(["doc", "--no-deps", "--all-features"])
+            .args(["--package", "core-math", "--package", "controller"])
+            .env("RUSTDOCFLAGS", "-D warnings"),
+    )?;
     // Host unit, property and golden tests of the math and the controller, optimised
     // since the property tests evaluate the reference chain tens of thousands of times,
     // but without the flight profile's fat LTO (Cargo.toml, `host-test`: it made this

@@ -71,7 +71,7 @@ pub struct DemStats {
     /// Evaluations of the tile those took (the samples off the tile or marched take
     /// one or more too, not counted).
     pub evaluations: u32,
-    /// Samples the march in height decided ([`DemGround::trace`]).
+    /// Samples the march in height decided (`DemGround::trace`).
     pub traced: u32,
     /// Samples neither could place (grazing rays, traces too long): the segment's
     /// TERRAIN height.

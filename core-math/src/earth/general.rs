@@ -570,13 +570,13 @@ pub struct GeneralRow<T> {
 /// per-pixel work as a polynomial in p2, with q = sqrt(disc) - beta = C / s.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct GeneralRowMotion<T> {
-    /// beta = rho.u = beta[0] + beta[1] p2 (m^2).
+    /// beta = rho.u = beta\[0\] + beta\[1\] p2 (m^2).
     pub beta: [T; 2],
-    /// disc = beta^2 - C alpha = disc[0] + disc[1] p2 + disc[2] p2^2 (m^4).
+    /// disc = beta^2 - C alpha = disc\[0\] + disc\[1\] p2 + disc\[2\] p2^2 (m^4).
     pub disc: [T; 3],
-    /// v1 = v1[0] + v1[1] p2 - v1[2] q (m/s).
+    /// v1 = v1\[0\] + v1\[1\] p2 - v1\[2\] q (m/s).
     pub v1: [T; 3],
-    /// v2 = v2[0] + v2[1] p2 + v2[2] p2^2 - (v2[3] + v2[4] p2) q (m/s).
+    /// v2 = v2\[0\] + v2\[1\] p2 + v2\[2\] p2^2 - (v2\[3\] + v2\[4\] p2) q (m/s).
     pub v2: [T; 5],
 }
 

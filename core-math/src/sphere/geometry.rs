@@ -166,7 +166,7 @@ pub fn orbital_rate_rad_s(earth_radius_m: f64, altitude_m: f64) -> f64 {
     libm::sqrt(GM_M3_S2 / (r * r * r))
 }
 
-/// The paper's round-Earth model (the default of [`Backend`]).
+/// The paper's round-Earth model (a [`crate::Model`]; feature `sphere`).
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Sphere;
 

@@ -109,7 +109,7 @@ fn take_away(r: f64, s: f64) -> (f64, bool) {
 /// x - n y with n the integer nearest x / y, ties to even, as IEEE 754's (and C's)
 /// `remainder`, for finite x and finite y > 0 (NaN otherwise): exact, so equal to
 /// `libm::remainder` wherever that is defined, without its 712 bytes of code. From
-/// [`fmod`]'s r: |r| - y when |r| > y / 2, or |r| = y / 2 and the truncated quotient is
+/// `fmod`'s r: |r| - y when |r| > y / 2, or |r| = y / 2 and the truncated quotient is
 /// odd (exact: y / 2 < |r| < y), with the sign of x.
 pub fn remainder(x: f64, y: f64) -> f64 {
     let (r, odd) = rem_trunc(x, y);

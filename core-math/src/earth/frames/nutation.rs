@@ -22,8 +22,8 @@ const DEPLAN: f64 = 0.388 * ARCSEC_TO_RAD / 1.0e3;
 type Term = ([i8; 5], [i32; 4], [i16; 2]);
 
 /// The 77 luni-solar terms of `iauNut00b`, in SOFA's order: the transcription. The
-/// flight binary holds them as [`PACKED`] (and [`TERM1`]), 18 bytes a term instead of 28
-/// (docs/target.md, flash); [`unpack`] gives them back.
+/// flight binary holds them as [`PACKED`] (and `TERM1`), 18 bytes a term instead of 28
+/// (docs/target.md, flash); `unpack` gives them back.
 #[rustfmt::skip]
 pub const TERMS: [Term; 77] = [
     // 1-10
@@ -116,7 +116,7 @@ pub const TERMS: [Term; 77] = [
 /// Terms 2-77 by columns: each multiplier plus 2 in three bits (l in bits 0-2, l' 3-5,
 /// F 6-8, D 9-11, Om 12-14: SOFA's multipliers here lie in -2..=4); the two large
 /// coefficients (longitude sin, obliquity cos) as i32; the other four as i16. Term 1
-/// alone needs more than 16 bits for two of those four: it is [`TERM1`].
+/// alone needs more than 16 bits for two of those four: it is `TERM1`.
 pub struct Packed {
     multipliers: [u16; 76],
     large: [[i32; 2]; 76],
