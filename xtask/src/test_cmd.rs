@@ -46,6 +46,7 @@ pub fn run() -> Result<()> {
     crate::qemu::test_target()?;
     crate::no_panic::check()?;
     no_fpu_elf_check()?;
+    crate::qemu::board::check_flash_budgets()?;
     eprintln!(
         "\nxtask test: all checks passed in {:.0} s",
         t0.elapsed().as_secs_f64()

@@ -44,6 +44,15 @@ impl Board {
         }
     }
 
+    /// The flight binary's flash budget (bytes): 80 KiB on the Cortex-M4F boards (issue
+    /// 23, with the DEM route), 96 KiB on the Cortex-M3 (issue 24), docs/target.md.
+    pub fn flash_budget_bytes(self) -> u64 {
+        match self {
+            Board::Mps2An386 | Board::Stm32f405 => 80 * 1024,
+            Board::Mps2An385 => 96 * 1024,
+        }
+    }
+
     /// The Rust target: hard-float Cortex-M4F, or the Cortex-M3's soft float.
     pub fn target(self) -> &'static str {
         match self {
@@ -165,6 +174,30 @@ pub fn size(args: &SizeArgs) -> Result<()> {
     Ok(())
 }
 
+/// Each board's release flight binary within its flash budget, or an error naming the
+/// excess (`cargo xtask test`).
+pub fn check_flash_budgets() -> Result<()> {
+    for board in Board::ALL {
+        let elf = super::build_firmware(board, "firmware", true, &[], &[])?;
+        let (flash, budget) = (
+            crate::footprint::flash_bytes(&elf)?,
+            board.flash_budget_bytes(),
+        );
+        anyhow::ensure!(
+            flash <= budget,
+            "{}: the flight binary is {flash} bytes of flash, over its budget of {budget} by {} \
+             (docs/target.md, flash)",
+            board.name(),
+            flash - budget
+        );
+        eprintln!(
+            "xtask: {} flash {flash} bytes, budget {budget}",
+            board.name()
+        );
+    }
+    Ok(())
+}
+
 fn size_line(board: Board, elf: &Path) -> Result<String> {
     let flash = crate::footprint::flash_bytes(elf)?;
     let bytes = std::fs::read(elf).with_context(|| format!("reading {}", elf.display()))?;
@@ -194,8 +227,9 @@ fn size_line(board: Board, elf: &Path) -> Result<String> {
     let retained = region("__sretained", "__eretained");
     let dem = region("__sretained_dem", "__eretained_dem");
     Ok(format!(
-        "{:<11} flash {flash}, static RAM: {}, retained {retained} + DEM tile memory {dem}, total {}",
+        "{:<11} flash {flash} (budget {}), static RAM: {}, retained {retained} + DEM tile memory {dem}, total {}",
         board.name(),
+        board.flash_budget_bytes(),
         ram.join(", "),
         sections + retained + dem
     ))
