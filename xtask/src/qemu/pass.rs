@@ -476,6 +476,19 @@ fn play(elf: &Path, pass: &Pass, plan: Option<reset::Plan>) -> Result<Played> {
         }
         _ => count_failures.push("no final STATUS frame".into()),
     }
+    // Issues 23 and 24's stack budget, against the firmware's own high-water mark (its
+    // last log line; after a reset, the one since the reset).
+    let marks: Vec<usize> = log
+        .iter()
+        .filter_map(|m| stack_high_water_bytes(m))
+        .collect();
+    match marks.iter().max() {
+        None => count_failures.push("the firmware logged no stack high-water mark".into()),
+        Some(&b) if b > STACK_BUDGET_BYTES => count_failures.push(format!(
+            "stack high-water mark {b} bytes, over the budget of {STACK_BUDGET_BYTES}"
+        )),
+        Some(_) => {}
+    }
     Ok(Played {
         tx_bytes: uplink.len(),
         rx_bytes: downlink_bytes.len(),
@@ -493,6 +506,15 @@ fn play(elf: &Path, pass: &Pass, plan: Option<reset::Plan>) -> Result<Played> {
         truth,
         reset,
     })
+}
+
+/// The stack the firmware may use (bytes): issue 23's and 24's budget.
+const STACK_BUDGET_BYTES: usize = 12 * 1024;
+
+/// N of the firmware's log line "stack high-water mark: N bytes ..." (firmware/src/main.rs).
+fn stack_high_water_bytes(message: &str) -> Option<usize> {
+    let rest = message.split_once("stack high-water mark: ")?.1;
+    rest.split_once(" bytes")?.0.parse().ok()
 }
 
 /// Updates whose PERIODS payload differs between the firmware and the twin, matched by
@@ -685,7 +707,7 @@ struct QemuRun {
     status: i32,
     /// Everything it sent.
     downlink: Vec<u8>,
-    /// Its decoded log (kept only with a reset trigger).
+    /// Its decoded log.
     log: Vec<String>,
     /// With a reset trigger: the update instant after which the machine was reset.
     reset_after_us: Option<u64>,
@@ -724,7 +746,7 @@ fn run_qemu(
     let options = runner::Options {
         extra_args,
         serial: Some("chardev:telemetry".into()),
-        capture: trigger.is_some(),
+        capture: true,
         log_to_stderr: false,
         link_ready: Some(link_ready),
     };
