@@ -511,10 +511,16 @@ fn play(elf: &Path, pass: &Pass, plan: Option<reset::Plan>) -> Result<Played> {
 /// The stack the firmware may use (bytes): issue 23's and 24's budget.
 const STACK_BUDGET_BYTES: usize = 12 * 1024;
 
+/// The text of a firmware log line between `after` and the next `before`, parsed (the
+/// figures the checks read from the log).
+fn log_field<T: std::str::FromStr>(message: &str, after: &str, before: &str) -> Option<T> {
+    let rest = message.split_once(after)?.1;
+    rest.split_once(before)?.0.trim().parse().ok()
+}
+
 /// N of the firmware's log line "stack high-water mark: N bytes ..." (firmware/src/main.rs).
 fn stack_high_water_bytes(message: &str) -> Option<usize> {
-    let rest = message.split_once("stack high-water mark: ")?.1;
-    rest.split_once(" bytes")?.0.parse().ok()
+    log_field(message, "stack high-water mark: ", " bytes")
 }
 
 /// Updates whose PERIODS payload differs between the firmware and the twin, matched by

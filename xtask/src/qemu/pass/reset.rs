@@ -288,20 +288,15 @@ impl Report {
             format!("{}, {n} since power-on", c.name())
         });
         // "restored after the reset: N periods programmed D us after the board came up"
-        let restored_us = log.iter().find_map(|m| {
+        let restored_us: Option<u64> = log.iter().find_map(|m| {
             let rest = m.strip_prefix("restored after the reset: ")?;
-            let (_, after) = rest.split_once("programmed ")?;
-            after.split_once(" us")?.0.trim().parse().ok()
+            super::log_field(rest, "programmed ", " us")
         });
         // "boot: reset cause C, N resets since power-on, core clock F Hz"
-        let core_clock_hz: Option<f64> = log.iter().rev().find_map(|m| {
-            let rest = m.strip_prefix("boot: ")?;
-            rest.split_once("core clock ")?
-                .1
-                .strip_suffix(" Hz")?
-                .parse()
-                .ok()
-        });
+        let core_clock_hz: Option<f64> = log
+            .iter()
+            .rev()
+            .find_map(|m| super::log_field(m.strip_prefix("boot: ")?, "core clock ", " Hz"));
         let decoded = firmware.decoded();
         let fresh_at_us = decoded
             .iter()
