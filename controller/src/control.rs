@@ -20,8 +20,7 @@ use core_math::earth::Attitude;
 
 use crate::config::Config;
 use crate::dem::{Dem, DemStatus, DemStore};
-use crate::fault::ResetCause;
-use crate::fault::{Counters, Fault};
+use crate::fault::{Counters, Fault, ResetCause};
 use crate::nav::Propagator;
 use crate::plan::Plan;
 use crate::scene::{Scene, MAX_SEGMENTS};

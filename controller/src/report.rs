@@ -6,8 +6,7 @@ use heapless::Vec;
 use crate::bytes::{Reader, Writer};
 use crate::control::{Controller, Mode, SegmentOutput};
 use crate::dem::DemStatus;
-use crate::fault::Fault;
-use crate::fault::ResetCause;
+use crate::fault::{Fault, ResetCause};
 use crate::scene::MAX_SEGMENTS;
 
 /// PERIODS payload: mode, count, flags, 1 reserved, the yaw steering request (f32, rad),

@@ -7,7 +7,7 @@ use super::*;
 use core_math::wide::Wide;
 use core_math::ModelError;
 
-pub(crate) use core_math::wide::{i64_to_f32, i64_to_f32_call, u64_to_f32};
+pub(crate) use core_math::wide::{i64_to_f32, u64_to_f32};
 
 /// A finite f32 >= 0 in I24F40 bits, truncated, saturating; 0 for any other.
 #[inline(always)]

@@ -8,7 +8,7 @@ use core_math::earth::{Attitude, General, GeneralInstant};
 use core_math::wide::div_64_32;
 use core_math::ModelError;
 
-use super::fixed::i64_to_f32_call as to_f32;
+use core_math::wide::i64_to_f32_call as to_f32;
 
 /// A finite f32 as m 2^e exactly (m signed, |m| < 2^24; zero and subnormals as 0; a
 /// non-finite one as a mantissa times 2^105, past every format, so the f32 route).
