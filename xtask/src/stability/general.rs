@@ -15,9 +15,7 @@ use core_math::accuracy::{
 use core_math::earth::{circular_state, limb_margin_rad, Attitude, EarthCamera, EarthGeometry};
 use core_math::sample::{roll_at_limb_margin, EarthCase};
 use core_math::vector::norm;
-use core_math::{
-    Backend, EarthReference, Ellipsoid, ImageMotion, ModelError, EARTH_RATE_RAD_S, GENERAL_F32,
-};
+use core_math::{Backend, EarthReference, Ellipsoid, ModelError, EARTH_RATE_RAD_S};
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -28,7 +26,7 @@ use super::doc::lg;
 use super::general_fixed::{FAR_TARGET, NEAR_TARGET};
 use super::grid::{self, Cell as _, Column, Panel, Spec, Worst};
 use super::maps::I0_SSO_DEG;
-use crate::accuracy::U_F32;
+use crate::accuracy::{Motion, GENERAL_F32_MOTION, U_F32};
 
 /// The paper's camera on the detector line through the optical axis.
 pub const CAMERA: EarthCamera = EarthCamera {
@@ -205,11 +203,7 @@ pub trait Tested: Clone + Copy + std::fmt::Debug + Default + Send + 'static {
     /// widened back to f64 where it rounds them itself on the way in.
     fn inputs(g: &EarthGeometry<f64>) -> Result<EarthGeometry<f64>, ModelError>;
     /// The backend's motion at those inputs, widened to f64.
-    fn motion(
-        c: &EarthCamera,
-        g: &EarthGeometry<f64>,
-        n_px: f64,
-    ) -> Result<ImageMotion<f64>, ModelError>;
+    const MOTION: Motion;
     /// What [`describe`] adds after the place.
     fn note(o: &GOutcome) -> String;
     /// Each stated bound a cell (or an aggregate) breaks, one line each.
@@ -227,21 +221,10 @@ impl Tested for F32 {
     const KEY: &'static str = "G";
     const MAP_KEY: &'static str = "";
     const COLUMNS: &'static [Column<GCell<Self>>] = &COLUMNS;
+    const MOTION: Motion = GENERAL_F32_MOTION;
 
     fn inputs(g: &EarthGeometry<f64>) -> Result<EarthGeometry<f64>, ModelError> {
         Ok(*g)
-    }
-
-    fn motion(
-        c: &EarthCamera,
-        g: &EarthGeometry<f64>,
-        n_px: f64,
-    ) -> Result<ImageMotion<f64>, ModelError> {
-        let m = GENERAL_F32.evaluate(c, &g.to::<f32>(), n_px)?;
-        Ok(ImageMotion {
-            v1_mps: f64::from(m.v1_mps),
-            v2_mps: f64::from(m.v2_mps),
-        })
     }
 
     fn note(o: &GOutcome) -> String {
@@ -331,7 +314,7 @@ pub fn evaluate<B: Tested>(c: &EarthCase) -> Result<GOutcome, GSkip> {
     let r = EarthReference
         .evaluate(&c.camera, &g64, c.n_px)
         .map_err(|_| GSkip::Outside)?;
-    let m = B::motion(&c.camera, &g64, c.n_px).map_err(GSkip::Refused)?;
+    let m = (B::MOTION)(&c.camera, &g64, c.n_px).map_err(GSkip::Refused)?;
     if !(m.v1_mps.is_finite() && m.v2_mps.is_finite()) {
         return Err(GSkip::NonFinite);
     }

@@ -13,12 +13,13 @@
 
 use anyhow::Result;
 use core_math::accuracy::EARTH_F32_KAPPA_LIMIT;
-use core_math::earth::fixed::{geometry_from_f64, motion_to_f64};
-use core_math::earth::{EarthCamera, EarthGeometry};
-use core_math::{Backend, ImageMotion, ModelError, EARTH_FIXED};
+use core_math::earth::fixed::geometry_from_f64;
+use core_math::earth::EarthGeometry;
+use core_math::ModelError;
 
 use std::path::Path;
 
+use crate::accuracy::{Motion, EARTH_FIXED_MOTION};
 use crate::markdown::{e2, sig};
 
 use super::doc::lg;
@@ -44,14 +45,7 @@ impl Tested for Fixed {
     }
 
     /// The inputs rounded again, which gives them back exactly.
-    fn motion(
-        c: &EarthCamera,
-        g: &EarthGeometry<f64>,
-        n_px: f64,
-    ) -> Result<ImageMotion<f64>, ModelError> {
-        let q = geometry_from_f64(g)?;
-        Ok(motion_to_f64(&EARTH_FIXED.evaluate(c, &q, n_px)?))
-    }
+    const MOTION: Motion = EARTH_FIXED_MOTION;
 
     fn note(o: &GOutcome) -> String {
         format!(", kappa {}", sig(o.kappa))
