@@ -208,11 +208,6 @@ pub(crate) fn round_geometry(
     })
 }
 
-/// [`round_geometry`] of `state`.
-fn model_geometry(state: &StateVector, roll_rad: f64, radius_m: f64) -> Result<Geometry<f64>> {
-    round_geometry(state, roll_rad, radius_m).map_err(|e| anyhow!("ellipsoid: orbit state: {e:?}"))
-}
-
 fn reference(camera: &Camera, g: &Geometry<f64>, n: f64) -> Result<ImageMotion<f64>> {
     Reference
         .evaluate(camera, g, n)
@@ -249,13 +244,17 @@ fn case(camera: &Camera, r_model: f64, u_rad: f64, roll_rad: f64, n: f64) -> Res
     let g = truth.ground_m;
     let ground_lat_deg = (g[2] / norm(g)).asin().to_degrees();
     let radius = |lat_rad| Ellipsoid::WGS84.geocentric_radius_m(lat_rad);
+    // The round Earth of radius `r_m` from the same state vector: geometry and motion.
+    let sphere = |r_m: f64| -> Result<(Geometry<f64>, ImageMotion<f64>)> {
+        let g = round_geometry(&state, roll_rad, r_m)
+            .map_err(|e| anyhow!("ellipsoid: orbit state: {e:?}"))?;
+        Ok((g, reference(camera, &g, n)?))
+    };
 
-    let g_round = model_geometry(&state, roll_rad, r_model)?;
-    let round = reference(camera, &g_round, n)?;
+    let (g_round, round) = sphere(r_model)?;
     let pos = state.position_m;
     let lat = (pos[2] / norm(pos)).asin();
-    let g_local = model_geometry(&state, roll_rad, radius(lat))?;
-    let local = reference(camera, &g_local, n)?;
+    let (g_local, local) = sphere(radius(lat))?;
     // The sub-satellite sphere's ground point: Y = (0, g2, R + g3) in the orbit frame
     // (the chain's frame G lifted by R, which is the orbit frame at t = 0).
     let px = Reference
@@ -267,8 +266,7 @@ fn case(camera: &Camera, r_model: f64, u_rad: f64, roll_rad: f64, n: f64) -> Res
     let up = g_local.earth_radius_m + chain.g_m[2];
     let ground: [f64; 3] = std::array::from_fn(|i| chain.g_m[1] * normal[i] + up * up_dir[i]);
     let lat_ground = (ground[2] / norm(ground)).asin();
-    let g_pixel = model_geometry(&state, roll_rad, radius(lat_ground))?;
-    let pixel = reference(camera, &g_pixel, n)?;
+    let (_, pixel) = sphere(radius(lat_ground))?;
     let f32m = CLOSED_F32
         .evaluate(camera, &g_round.to::<f32>(), n)
         .map_err(|e| anyhow!("ellipsoid: f32 closed form at n {n}: {e:?}"))?;
