@@ -14,12 +14,13 @@
 
 use anyhow::{anyhow, Result};
 use core_math::accuracy::{earth_kappa, EARTH_F32_KAPPA_LIMIT};
-use core_math::earth::limb_margin_rad;
+use core_math::earth::fixed::{geometry_from_f64, motion_to_f64};
+use core_math::earth::{limb_margin_rad, EarthCamera, EarthGeometry};
 use core_math::sample::SplitMix64;
 use core_math::sphere::accuracy::F32_REL_TOLERANCE;
 use core_math::sphere::{Geometry, Reference, CLOSED_F32, CLOSED_F64};
 use core_math::{
-    Backend, Camera, EarthReference, ImageMotion, ModelError, GENERAL_F32, GENERAL_F64,
+    Backend, Camera, EarthReference, ImageMotion, ModelError, EARTH_FIXED, GENERAL_F32, GENERAL_F64,
 };
 
 use crate::eval::Model;
@@ -78,6 +79,26 @@ pub fn run(args: &Args) -> Result<()> {
     print_report(&stats, quick, t0.elapsed().as_secs_f64());
     Ok(())
 }
+
+/// A real-Earth form under test: its motion at a camera, geometry and pixel, widened to
+/// f64, from the inputs in f64 as the other forms and the reference take them.
+pub(crate) type Motion =
+    fn(&EarthCamera, &EarthGeometry<f64>, f64) -> Result<ImageMotion<f64>, ModelError>;
+
+/// `GENERAL_F32`: the attitude rounded to f32 by the call.
+pub(crate) const GENERAL_F32_MOTION: Motion = |c, g, n_px| {
+    let m = GENERAL_F32.evaluate(c, &g.to::<f32>(), n_px)?;
+    Ok(ImageMotion {
+        v1_mps: f64::from(m.v1_mps),
+        v2_mps: f64::from(m.v2_mps),
+    })
+};
+
+/// `EARTH_FIXED`: the inputs rounded to I24F40 (`geometry_from_f64`).
+pub(crate) const EARTH_FIXED_MOTION: Motion = |c, g, n_px| {
+    let q = geometry_from_f64(g)?;
+    Ok(motion_to_f64(&EARTH_FIXED.evaluate(c, &q, n_px)?))
+};
 
 pub(crate) fn bucket(margin_deg: f64) -> usize {
     BUCKETS_DEG
@@ -276,12 +297,7 @@ fn earth(quick: bool) -> Result<()> {
             .to_degrees();
         let r = EarthReference.evaluate(&c.camera, &c.geometry, c.n_px);
         let f = GENERAL_F64.evaluate(&c.camera, &c.geometry, c.n_px);
-        let s = GENERAL_F32
-            .evaluate(&c.camera, &c.geometry.to::<f32>(), c.n_px)
-            .map(|m| ImageMotion {
-                v1_mps: f64::from(m.v1_mps),
-                v2_mps: f64::from(m.v2_mps),
-            });
+        let s = GENERAL_F32_MOTION(&c.camera, &c.geometry, c.n_px);
         let Ok(r) = r else {
             misses += 1;
             let all_miss = f == Err(ModelError::LineOfSightMissesEarth)

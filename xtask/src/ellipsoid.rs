@@ -208,11 +208,6 @@ pub(crate) fn round_geometry(
     })
 }
 
-/// [`round_geometry`] of `state`.
-fn model_geometry(state: &StateVector, roll_rad: f64, radius_m: f64) -> Result<Geometry<f64>> {
-    round_geometry(state, roll_rad, radius_m).map_err(|e| anyhow!("ellipsoid: orbit state: {e:?}"))
-}
-
 fn reference(camera: &Camera, g: &Geometry<f64>, n: f64) -> Result<ImageMotion<f64>> {
     Reference
         .evaluate(camera, g, n)
@@ -249,13 +244,17 @@ fn case(camera: &Camera, r_model: f64, u_rad: f64, roll_rad: f64, n: f64) -> Res
     let g = truth.ground_m;
     let ground_lat_deg = (g[2] / norm(g)).asin().to_degrees();
     let radius = |lat_rad| Ellipsoid::WGS84.geocentric_radius_m(lat_rad);
+    // The round Earth of radius `r_m` from the same state vector: geometry and motion.
+    let sphere = |r_m: f64| -> Result<(Geometry<f64>, ImageMotion<f64>)> {
+        let g = round_geometry(&state, roll_rad, r_m)
+            .map_err(|e| anyhow!("ellipsoid: orbit state: {e:?}"))?;
+        Ok((g, reference(camera, &g, n)?))
+    };
 
-    let g_round = model_geometry(&state, roll_rad, r_model)?;
-    let round = reference(camera, &g_round, n)?;
+    let (g_round, round) = sphere(r_model)?;
     let pos = state.position_m;
     let lat = (pos[2] / norm(pos)).asin();
-    let g_local = model_geometry(&state, roll_rad, radius(lat))?;
-    let local = reference(camera, &g_local, n)?;
+    let (g_local, local) = sphere(radius(lat))?;
     // The sub-satellite sphere's ground point: Y = (0, g2, R + g3) in the orbit frame
     // (the chain's frame G lifted by R, which is the orbit frame at t = 0).
     let px = Reference
@@ -267,8 +266,7 @@ fn case(camera: &Camera, r_model: f64, u_rad: f64, roll_rad: f64, n: f64) -> Res
     let up = g_local.earth_radius_m + chain.g_m[2];
     let ground: [f64; 3] = std::array::from_fn(|i| chain.g_m[1] * normal[i] + up * up_dir[i]);
     let lat_ground = (ground[2] / norm(ground)).asin();
-    let g_pixel = model_geometry(&state, roll_rad, radius(lat_ground))?;
-    let pixel = reference(camera, &g_pixel, n)?;
+    let (_, pixel) = sphere(radius(lat_ground))?;
     let f32m = CLOSED_F32
         .evaluate(camera, &g_round.to::<f32>(), n)
         .map_err(|e| anyhow!("ellipsoid: f32 closed form at n {n}: {e:?}"))?;
@@ -373,27 +371,38 @@ pub fn summary() -> Result<EllipsoidSummary> {
 
 /// The markdown block between the doc's markers.
 fn render(s: &EllipsoidSummary) -> Result<String> {
-    let stages = s.stages;
-    let mtf = |e: f64| s.mtf(e);
-    let rule = StageRule::<f64>::new(s.mtf_floor).map_err(|e| anyhow!("ellipsoid: {e:?}"))?;
-    let max_m = |e: f64| rule.max_stages(e.abs(), s.max_stages).unwrap_or(0);
+    let (stages, cases, floor, limit) = (s.stages, s.cases, s.mtf_floor, s.max_stages);
+    let rule = StageRule::<f64>::new(floor).map_err(|e| anyhow!("ellipsoid: {e:?}"))?;
     let all = &s.all;
+    let at = &all.round.at;
+    // The worst of each error: round Earth, sub-satellite radius, ground-point radius,
+    // f32 arithmetic; as printed, as MTF, as a share of the budget, as a stage count.
     let (w, l, p, a) = (
         all.round.worst,
         all.local.worst,
         all.pixel.worst,
         all.f32_arith.worst,
     );
+    let [sw, sl, sp, sa] = [w, l, p, a].map(signed);
+    let [mw, ml, mp, ma] = [w, l, p, a].map(|e| s.mtf(e));
+    let [bw, bl, bp, ba] = [w, l, p, a].map(|e| 100.0 * e.abs() / s.budget_rel);
+    let [nw, nl, np] = [w, l, p].map(|e| rule.max_stages(e.abs(), limit).unwrap_or(0));
+    let (lo, hi, rms) = (
+        signed(all.round.min),
+        signed(all.round.max),
+        all.round.rms(),
+    );
+    let (period, budget) = (signed(-w / (1.0 + w)), e2(s.budget_rel));
+    let (by_local, by_f32) = (w.abs() / l.abs(), w.abs() / a.abs());
     let mut o = String::new();
     o.push_str(&format!(
-        "{BEGIN}\n\nEvery figure in this block is printed by {CMD}: {} cases, argument of \
+        "{BEGIN}\n\nEvery figure in this block is printed by {CMD}: {cases} cases, argument of \
          latitude u = 0-359 deg in 1 deg steps, roll -25, 0, +25 deg, every active segment's \
          first, middle and last pixel (n from the array centre), circular orbit of radius \
          6371 + 645 km, i0 = {INCLINATION_DEG} deg, default scene (f = 0.555 m, A = 13 um, \
          {stages} TDI stages). Error = |v_P(model)| / |v_P(WGS 84)| - 1: > 0 when the model's \
          image is too fast (line period too short). Latitude: geocentric, of the \
          sub-satellite point.\n\n",
-        s.cases,
     ));
     o.push_str(
         "| roll (deg) | pixels | round Earth: range | worst at lat (u), deg | RMS \
@@ -423,54 +432,31 @@ fn render(s: &EllipsoidSummary) -> Result<String> {
         "\nFigures ({CMD}):\n\n\
          - Truth: `core_math::EarthReference` over WGS 84 (its check against an \
          independent numerical model: `cargo test -p core-math --test two_routes`).\n\
-         - Round Earth (R = 6371 km, H = |r| - R), the paper's model (which the firmware no longer flies): worst {} at \
+         - Round Earth (R = 6371 km, H = |r| - R), the paper's model (which the firmware no longer flies): worst {sw} at \
          latitude {:+.1} deg (u = {:.0} deg, roll {:+.0} deg, n = {:+.0}, ground point at latitude {:+.1} deg); \
-         range {} to {}, RMS {} ({CMD}). \
-         Line period error there: {} ({CMD}).\n\
-         - Round Earth of the local geocentric radius at the sub-satellite point: worst {} \
-         ({:.1}x smaller) ({CMD}).\n\
+         range {lo} to {hi}, RMS {} ({CMD}). \
+         Line period error there: {period} ({CMD}).\n\
+         - Round Earth of the local geocentric radius at the sub-satellite point: worst {sl} \
+         ({by_local:.1}x smaller) ({CMD}).\n\
          - Round Earth of the geocentric radius at each pixel's ground point (one step): \
-         worst {} ({CMD}).\n\
+         worst {sp} ({CMD}).\n\
          - The round-Earth closed form's f32 arithmetic (geometry rounded to f32) against the \
-         f64 reference on the same round-Earth cases: worst {} ({CMD}); the round Earth's \
-         error is {:.1e} times larger ({CMD}).\n\
+         f64 reference on the same round-Earth cases: worst {sa} ({CMD}); the round Earth's \
+         error is {by_f32:.1e} times larger ({CMD}).\n\
          - MTF_mismatch at Nyquist, {stages} stages, sinc(pi N |dv/v| / 2), for the worst error \
-         alone: round Earth {:.4}, sub-satellite radius {:.4}, ground-point radius {:.6}, \
-         f32 arithmetic {:.9} ({CMD}).\n\
-         - The scene's MTF floor {:.2} allows |dv/v| <= {} at {stages} stages; the round \
-         Earth alone uses {:.0} % of it, the sub-satellite radius {:.0} %, the ground-point \
-         radius {:.2} %, the f32 arithmetic {:.4} % ({CMD}).\n\
-         - Largest stage count meeting the floor with that error alone (scene limit {}): \
-         round Earth {}, sub-satellite radius {}, ground-point radius {} ({CMD}).\n\n{END}",
-        signed(w),
-        all.round.at.lat_deg,
-        all.round.at.u_deg,
-        all.round.at.roll_deg,
-        all.round.at.n_px,
-        all.round.at.ground_lat_deg,
-        signed(all.round.min),
-        signed(all.round.max),
-        e2(all.round.rms()),
-        signed(-w / (1.0 + w)),
-        signed(l),
-        w.abs() / l.abs(),
-        signed(p),
-        signed(a),
-        w.abs() / a.abs(),
-        mtf(w),
-        mtf(l),
-        mtf(p),
-        mtf(a),
-        s.mtf_floor,
-        e2(s.budget_rel),
-        100.0 * w.abs() / s.budget_rel,
-        100.0 * l.abs() / s.budget_rel,
-        100.0 * p.abs() / s.budget_rel,
-        100.0 * a.abs() / s.budget_rel,
-        s.max_stages,
-        max_m(w),
-        max_m(l),
-        max_m(p),
+         alone: round Earth {mw:.4}, sub-satellite radius {ml:.4}, ground-point radius {mp:.6}, \
+         f32 arithmetic {ma:.9} ({CMD}).\n\
+         - The scene's MTF floor {floor:.2} allows |dv/v| <= {budget} at {stages} stages; the round \
+         Earth alone uses {bw:.0} % of it, the sub-satellite radius {bl:.0} %, the ground-point \
+         radius {bp:.2} %, the f32 arithmetic {ba:.4} % ({CMD}).\n\
+         - Largest stage count meeting the floor with that error alone (scene limit {limit}): \
+         round Earth {nw}, sub-satellite radius {nl}, ground-point radius {np} ({CMD}).\n\n{END}",
+        at.lat_deg,
+        at.u_deg,
+        at.roll_deg,
+        at.n_px,
+        at.ground_lat_deg,
+        e2(rms),
     ));
     Ok(o)
 }

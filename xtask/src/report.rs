@@ -23,20 +23,15 @@
 use anyhow::{anyhow, Context, Result};
 use core_math::accuracy::{earth_kappa, EARTH_F32_KAPPA_LIMIT};
 use core_math::earth;
-use core_math::earth::fixed::{
-    geometry_from_f64 as earth_fixed_geometry, motion_to_f64 as earth_fixed_motion,
-};
 use core_math::sample::SplitMix64 as Rng;
 use core_math::sphere::accuracy::limb_margin_rad;
 use core_math::sphere::fixed_point::{geometry_from_f64, motion_to_f64};
 use core_math::sphere::{
     Geometry, MicroF32, NaiveF32, Reference, CLOSED_F32, CLOSED_F64, CLOSED_MICROMATH, FIXED,
 };
-use core_math::{
-    Backend, Camera, EarthReference, ImageMotion, EARTH_FIXED, GENERAL_F32, GENERAL_F64,
-};
+use core_math::{Backend, Camera, EarthReference, ImageMotion, GENERAL_F64};
 
-use crate::accuracy::{percentile, U_F32};
+use crate::accuracy::{percentile, EARTH_FIXED_MOTION, GENERAL_F32_MOTION, U_F32};
 use crate::markdown;
 use crate::plot::{Plot, Series};
 use crate::qemu::board::Board;
@@ -348,22 +343,11 @@ fn earth_sweep(seed: u64, cases: usize, errors: &mut [Errors]) -> (usize, EarthF
         done += 1;
         let is_near = margin.to_degrees() < NEAR_LIMB_DEG;
         near += usize::from(is_near);
-        let widen = |m: ImageMotion<f32>| ImageMotion {
-            v1_mps: f64::from(m.v1_mps),
-            v2_mps: f64::from(m.v2_mps),
-        };
-        let fixed = earth_fixed_geometry(&c.geometry)
-            .and_then(|g| EARTH_FIXED.evaluate(&c.camera, &g, c.n_px))
-            .ok()
-            .map(|m| earth_fixed_motion(&m));
         let motions = [
             Some(r),
             GENERAL_F64.evaluate(&c.camera, &c.geometry, c.n_px).ok(),
-            GENERAL_F32
-                .evaluate(&c.camera, &c.geometry.to::<f32>(), c.n_px)
-                .ok()
-                .map(widen),
-            fixed,
+            GENERAL_F32_MOTION(&c.camera, &c.geometry, c.n_px).ok(),
+            EARTH_FIXED_MOTION(&c.camera, &c.geometry, c.n_px).ok(),
         ];
         let sp = r.speed_mps();
         let rel = |m: ImageMotion<f64>| (m.v1_mps - r.v1_mps).hypot(m.v2_mps - r.v2_mps) / sp;

@@ -26,10 +26,9 @@ use std::time::Instant;
 use crate::accuracy::U_F32;
 use crate::accuracy::{bucket, BUCKETS_DEG};
 use crate::markdown::{e2, f2, sig, sig_range};
-use doc::{agg_table, describe, parts};
-use grid::Cell as _;
+use doc::{describe, parts, COLUMNS};
 use maps::{Cell, Map, MAPS};
-use point::{Outcome, Point, U_FIXED};
+use point::{Point, U_FIXED};
 
 /// The stated bounds: f32 error (at the same or at the unrounded inputs) <= C_F32 kappa u,
 /// fixed error <= C_FIXED kappa u_fx, at every sample of every map.
@@ -65,7 +64,8 @@ pub fn run(args: &Args) -> Result<()> {
     let xsecs = t2.elapsed().as_secs_f64();
     let mut values = figures(&maps, secs);
     values.extend(general::figures(&gmaps, gsecs));
-    values.extend(general_fixed::figures(&xmaps, xsecs));
+    values.extend(general::f32_figures(&gmaps));
+    values.extend(general::figures(&xmaps, xsecs));
     println!("{}", values["summary_table"]);
     println!("{}", values["bound_line"]);
     println!("sweep: {} samples in {secs:.1} s", values["samples_total"]);
@@ -147,45 +147,17 @@ fn figures(maps: &[Map], secs: f64) -> BTreeMap<String, String> {
     put("samples_total", total.to_string());
 
     // Summary: one row per map, and the whole.
-    let mut rows: Vec<(String, Cell)> = Vec::new();
-    let mut all = Vec::new();
+    let mut rows = Vec::new();
     for m in maps {
         let letter = m.spec.letter;
         let a = m.aggregate(|_, _| true);
-        let mut put = |what: &str, s: String| put(&format!("{letter}.{what}"), s);
-        put("grid", m.grid_text(a.n.into()));
-        put("others", m.spec.others.into());
-        for (what, w) in [("worst_f32", &a.ratio_f32), ("max_kappa", &a.kappa)] {
-            if let Some((p, o)) = &w.at {
-                for (k, s) in sample_figures(what, p, o) {
-                    put(&k, s);
-                }
-            }
-        }
-        put("ratio_f32", f2(a.ratio_f32.max));
-        put("ratio_f32_in", f2(a.ratio_f32_in.max));
-        put("kappa_min", sig(a.kappa_min));
-        put("kappa_max", sig(a.kappa.max));
-        put("e_f32", e2(a.err.f32));
-        put("e_f32_in", e2(a.err.f32_in));
-        put("e_fixed", e2(a.err.fixed_worst()));
-        rows.push((format!("{letter}: {}", m.spec.title), a.clone()));
-        all.push(a);
+        put(&format!("{letter}.grid"), m.grid_text(a.n.into()));
+        put(&format!("{letter}.others"), m.spec.others.into());
+        cell_figures(&mut put, letter, &a);
+        rows.push((format!("{letter}: {}", m.spec.title), a));
     }
-    let whole = merge(&all);
-    put("kappa_min", sig(whole.kappa_min));
-    put("ratio_f32", f2(whole.ratio_f32.max));
-    put("ratio_f32_in", f2(whole.ratio_f32_in.max));
-    put("ratio_fixed", f2(whole.ratio_fixed.max));
-    for (what, w) in [("f32", &whole.ratio_f32), ("fixed", &whole.ratio_fixed)] {
-        if let Some((p, o)) = &w.at {
-            for (k, s) in sample_figures(&format!("worst.{what}"), p, o) {
-                put(&k, s);
-            }
-        }
-    }
-    rows.push(("all maps".into(), whole.clone()));
-    put("summary_table", agg_table("map", &rows));
+    let whole: Cell = grid::merged(maps);
+    cell_figures(&mut put, "all", &whole);
     put(
         "bound_line",
         format!(
@@ -193,6 +165,9 @@ fn figures(maps: &[Map], secs: f64) -> BTreeMap<String, String> {
             whole.ratio_f32.max, whole.ratio_f32_in.max, whole.ratio_fixed.max
         ),
     );
+    let v1_all = whole.v1_term_ratio;
+    rows.push(("all maps".into(), whole));
+    put("summary_table", grid::table("map", &COLUMNS, &rows));
 
     // Map A by limb margin and by altitude.
     let a_map = map_by_key(maps, "altitude-limb");
@@ -206,21 +181,12 @@ fn figures(maps: &[Map], secs: f64) -> BTreeMap<String, String> {
             )
         })
         .collect();
-    put("limb_table", agg_table("limb margin", &band_rows));
-    let near = &band_rows[BUCKETS_DEG.len() - 1].1;
-    put("limb.kappa_max", sig(near.kappa.max));
-    put("limb.e_f32", e2(near.err.f32));
-    put("limb.e_f32_in", e2(near.err.f32_in));
-    put("limb.e_fixed", e2(near.err.fixed_worst()));
-    put("limb.ratio_f32_in", f2(near.ratio_f32_in.max));
-    put("limb.kq", sig_range(near.kq.0, near.kq.1));
-    if let Some((p, o)) = &near.kappa.at {
-        for (k, s) in sample_figures("limb.max_kappa", p, o) {
-            put(&k, s);
-        }
-    }
-    let far = &band_rows[0].1;
-    put("far.kappa", sig_range(far.kappa_min, far.kappa.max));
+    put(
+        "limb_table",
+        grid::table("limb margin", &COLUMNS, &band_rows),
+    );
+    cell_figures(&mut put, "limb", &band_rows[BUCKETS_DEG.len() - 1].1);
+    cell_figures(&mut put, "far", &band_rows[0].1);
     if let Some((slope, n)) = doc::limb_slope(a_map, 0.1) {
         put("limb.slope", format!("{slope:.3}"));
         put("limb.slope_n", n.to_string());
@@ -234,17 +200,10 @@ fn figures(maps: &[Map], secs: f64) -> BTreeMap<String, String> {
             )
         })
         .collect();
-    put(
-        "altitude_table",
-        agg_table("altitude (limb margin >= 1 deg)", &alt_rows),
-    );
-    let (alt_lo, alt_hi) = (&alt_rows[0].1, &alt_rows[alt_rows.len() - 1].1);
-    put("alt.fixed_lo", e2(alt_lo.err.fixed_worst()));
-    put("alt.fixed_hi", e2(alt_hi.err.fixed_worst()));
-    put("alt.f32_lo", e2(alt_lo.err.f32));
-    put("alt.f32_hi", e2(alt_hi.err.f32));
-    put("alt.ratio_fixed_lo", f2(alt_lo.ratio_fixed.max));
-    put("alt.ratio_fixed_hi", f2(alt_hi.ratio_fixed.max));
+    let first = "altitude (limb margin >= 1 deg)";
+    put("altitude_table", grid::table(first, &COLUMNS, &alt_rows));
+    cell_figures(&mut put, "alt_lo", &alt_rows[0].1);
+    cell_figures(&mut put, "alt_hi", &alt_rows[alt_rows.len() - 1].1);
     // The fixed backend's bracket scale: |b/c0| in its units of 2^-10 rad/s (i0 97.98 deg).
     for h_km in [200.0, 2000.0] {
         let g = Point::circular(0.0, 0.0, maps::I0_SSO_DEG, 0.0, h_km).g;
@@ -273,15 +232,7 @@ fn figures(maps: &[Map], secs: f64) -> BTreeMap<String, String> {
         put("A.max_e_fixed.times_q", e2(c.err.fixed_worst() * q2.sqrt()));
     }
 
-    // Map B: how close its cells come to the limb.
-    let b_map = map_by_key(maps, "roll-field");
-    let min_margin = b_map
-        .cells
-        .iter()
-        .filter(|c| c.n > 0)
-        .map(|c| c.min_margin_rad)
-        .fold(f64::INFINITY, f64::min);
-    put("B.min_margin_deg", sig(min_margin.to_degrees()));
+    // Map B: where the limb is (its cells' closest approach is `B.min_margin_deg`).
     let b_limb = (point::EARTH_RADIUS_M / (point::EARTH_RADIUS_M + 645e3)).asin();
     put("B.limb_deg", f2(b_limb.to_degrees()));
 
@@ -309,10 +260,6 @@ fn figures(maps: &[Map], secs: f64) -> BTreeMap<String, String> {
         "v1.bound_i0",
         format!("{:.1}", (w / om).acos().to_degrees()),
     );
-    let mut v1_all = f64::NEG_INFINITY;
-    for a in &all {
-        v1_all = v1_all.max(a.v1_term_ratio);
-    }
     put("v1.max_all", format!("{v1_all:.4}"));
     let c_cells_min = c_map
         .cells
@@ -326,30 +273,41 @@ fn figures(maps: &[Map], secs: f64) -> BTreeMap<String, String> {
     v
 }
 
-/// The values the document may quote about one sample (a map's worst or largest-kappa
-/// case), as (`{prefix}.<what>`, text): where it is, kappa and its parts, and the
-/// errors. Every such sample gets the same set, so the template can quote any of them the
-/// same way; the keys it does not use are ignored by [`doc::fill`].
-fn sample_figures(prefix: &str, p: &Point, o: &Outcome) -> [(String, String); 6] {
-    let key = |what: &str| format!("{prefix}.{what}");
-    [
-        (key("at"), describe(p, o)),
-        (key("kappa"), sig(o.kappa)),
-        (key("parts"), parts(o)),
-        (key("e_f32"), e2(o.err.f32)),
+/// The values the document may quote about an aggregate of cells, as (`{p}.<what>`,
+/// text), and about the sample behind each of its maxima (`{p}.<maximum>.<what>`: where
+/// it is, kappa and its parts, the errors). Every aggregate gets the same set, so that
+/// the template can quote any of them the same way; the keys it does not use are ignored
+/// by [`doc::fill`].
+fn cell_figures(put: &mut impl FnMut(&str, String), p: &str, a: &Cell) {
+    let mut put = |what: &str, s: String| put(&format!("{p}.{what}"), s);
+    put("ratio_f32", f2(a.ratio_f32.max));
+    put("ratio_f32_in", f2(a.ratio_f32_in.max));
+    put("ratio_fixed", f2(a.ratio_fixed.max));
+    put("kappa_min", sig(a.kappa_min));
+    put("kappa_max", sig(a.kappa.max));
+    put("kappa_range", sig_range(a.kappa_min, a.kappa.max));
+    put("kq", sig_range(a.kq.0, a.kq.1));
+    put("min_margin_deg", sig(a.min_margin_rad.to_degrees()));
+    put("e_f32", e2(a.err.f32));
+    put("e_f32_in", e2(a.err.f32_in));
+    put("e_fixed", e2(a.err.fixed_worst()));
+    for (what, w) in [
+        ("worst_f32", &a.ratio_f32),
+        ("worst_fixed", &a.ratio_fixed),
+        ("max_kappa", &a.kappa),
+    ] {
+        let Some((pt, o)) = &w.at else { continue };
+        put(&format!("{what}.at"), describe(pt, o));
+        put(&format!("{what}.kappa"), sig(o.kappa));
+        put(&format!("{what}.parts"), parts(o));
+        put(&format!("{what}.e_f32"), e2(o.err.f32));
         // In units of u, for the whole's worst f32 case.
-        (key("e_f32_u"), format!("{:.1}", o.err.f32 / U_F32)),
-        (key("e_fixed"), e2(o.err.fixed_worst())),
-    ]
-}
-
-/// Maxima over several aggregates.
-fn merge(all: &[Cell]) -> Cell {
-    let mut m = Cell::empty();
-    for a in all {
-        m.merge(a);
+        put(
+            &format!("{what}.e_f32_u"),
+            format!("{:.1}", o.err.f32 / U_F32),
+        );
+        put(&format!("{what}.e_fixed"), e2(o.err.fixed_worst()));
     }
-    m
 }
 
 #[cfg(test)]
@@ -367,8 +325,7 @@ mod tests {
         let maps: Vec<Map> = grid::sweep_all(&MAPS, 6, Some(2));
         let bad = grid::broken(&maps);
         assert!(bad.is_empty(), "{}", bad.join("\n"));
-        let all: Vec<Cell> = maps.iter().map(|m| m.aggregate(|_, _| true)).collect();
-        let a = merge(&all);
+        let a: Cell = grid::merged(&maps);
         assert!(a.n > 2_000, "{} cases", a.n);
         assert_eq!(a.refused, 0);
         // The limb: map A's lowest row is within 1e-4 deg, where kappa is in the thousands.
@@ -406,10 +363,7 @@ mod tests {
         let maps: Vec<general::GMap> = grid::sweep_all(&general::GMAPS, 4, None);
         let bad = grid::broken(&maps);
         assert!(bad.is_empty(), "{}", bad.join("\n"));
-        let mut a = general::GCell::empty();
-        for m in &maps {
-            a.merge(&m.aggregate(|_, _| true));
-        }
+        let a: general::GCell = grid::merged(&maps);
         assert!(a.n > 5_000, "{} cases", a.n);
         assert_eq!(a.refused, 0);
         assert!(a.min_margin_rad.to_degrees() < 0.02, "{}", a.min_margin_rad);
@@ -441,10 +395,7 @@ mod tests {
         let maps: Vec<general_fixed::FMap> = grid::sweep_all(&general::GMAPS, 4, None);
         let bad = grid::broken(&maps);
         assert!(bad.is_empty(), "{}", bad.join("\n"));
-        let mut a = general::GCell::<general_fixed::Fixed>::empty();
-        for m in &maps {
-            a.merge(&m.aggregate(|_, _| true));
-        }
+        let a: general::GCell<general_fixed::Fixed> = grid::merged(&maps);
         assert!(a.n > 5_000, "{} cases", a.n);
         assert_eq!((a.refused, a.non_finite), (0, 0));
         assert!(a.min_margin_rad.to_degrees() < 0.02, "{}", a.min_margin_rad);

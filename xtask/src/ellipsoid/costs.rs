@@ -306,12 +306,25 @@ fn still(g: &mut EarthGeometry<f64>) {
     g.attitude.yaw_rate_rad_s = 0.0;
 }
 
-/// Attitude and camera of the paper: roll only, the detector line through the optical
-/// axis.
+/// The paper's error of the line period at the truth's geometry `g`: its round Earth
+/// from the same state vector and roll against the truth, compared by `err`.
+fn vs_paper(g: &EarthGeometry<f64>, cam: &EarthCamera, n: f64, err: ErrFn) -> Option<f64> {
+    let t = truth(g, cam, n)?;
+    Some(err(&t, &paper(&g.state, g.attitude.roll_rad, cam, n)?))
+}
+
+/// Attitude, camera and ground of the paper: roll only, the detector line through the
+/// optical axis, ground height 0.
 fn paper_case(g: &mut EarthGeometry<f64>, cam: &mut EarthCamera) {
     g.attitude = roll_only(g.attitude.roll_rad);
+    g.ground_h_m = 0.0;
     cam.p1_m = 0.0;
 }
+
+/// A row's measure over the default scene's cases, at the case and its state vector.
+type OnCase<'a> = &'a dyn Fn(&Case, &StateVector) -> Option<f64>;
+/// A row's measure over the envelope's draws, each adjusted by the row first.
+type OnDraw<'a> = &'a dyn Fn(&mut EarthGeometry<f64>, &mut EarthCamera, f64) -> Option<f64>;
 
 pub fn costs(grid: Grid) -> Costs {
     let cam = EarthCamera {
@@ -320,8 +333,12 @@ pub fn costs(grid: Grid) -> Costs {
         p1_m: 0.0,
     };
     let cases = default_cases(&grid);
-    let circ = |c: &Case| orbit_state(c.u_rad);
-    let draws = grid.envelope_draws;
+    // A row's two columns: the default scene on the orbit `state` gives, the envelope.
+    let default = |state: fn(&Case) -> StateVector, f: OnCase| Some(over_default(&cases, f, state));
+    let envelope = |f: OnDraw| Some(over_envelope(grid.envelope_draws, f));
+    let circ: fn(&Case) -> StateVector = |c| orbit_state(c.u_rad);
+    // The truth of the default scene: WGS 84, the roll alone.
+    let wgs_roll = |c: &Case, s: &StateVector| wgs(*s, roll_only(c.roll_rad), 0.0);
     let mut rows = Vec::new();
 
     // (a) The ellipsoid against the round Earth.
@@ -329,24 +346,14 @@ pub fn costs(grid: Grid) -> Costs {
         label: "(a) WGS 84 -> sphere R = 6371 km, H = |r| - R",
         truth: "WGS 84, h = 0, circular orbit, roll only",
         model: "paper's round Earth from the state vector (`Reference`)",
-        default: Some(over_default(
-            &cases,
-            |c, s| {
-                let t = truth(&wgs(*s, roll_only(c.roll_rad), 0.0), &cam, c.n)?;
-                Some(period_err(&t, &paper(s, c.roll_rad, &cam, c.n)?))
-            },
-            circ,
-        )),
-        envelope: Some(over_envelope(draws, |g, cam, n| {
+        default: default(circ, &|c, s| {
+            vs_paper(&wgs_roll(c, s), &cam, c.n, period_err)
+        }),
+        envelope: envelope(&|g, cam, n| {
             paper_case(g, cam);
             g.state = circularise(&g.state);
-            g.ground_h_m = 0.0;
-            let t = truth(g, cam, n)?;
-            Some(period_err(
-                &t,
-                &paper(&g.state, g.attitude.roll_rad, cam, n)?,
-            ))
-        })),
+            vs_paper(g, cam, n, period_err)
+        }),
         envelope_note: "circular, roll only, p1 = 0, h = 0",
     });
 
@@ -355,20 +362,16 @@ pub fn costs(grid: Grid) -> Costs {
         label: "(b) terrain 9 km -> ground height 0",
         truth: "WGS 84, h = 9 km",
         model: "the same with h = 0",
-        default: Some(over_default(
-            &cases,
-            |c, s| {
-                let g = wgs(*s, roll_only(c.roll_rad), TERRAIN_M);
-                dropped(&g, &cam, c.n, |m| m.ground_h_m = 0.0)
-            },
-            circ,
-        )),
-        envelope: Some(over_envelope(draws, |g, cam, n| {
+        default: default(circ, &|c, s| {
+            let g = wgs(*s, roll_only(c.roll_rad), TERRAIN_M);
+            dropped(&g, &cam, c.n, |m| m.ground_h_m = 0.0)
+        }),
+        envelope: envelope(&|g, cam, n| {
             still(g);
             g.attitude.yaw_rad = 0.0;
             g.ground_h_m = TERRAIN_M;
             dropped(g, cam, n, |m| m.ground_h_m = 0.0)
-        })),
+        }),
         envelope_note: "rates 0, yaw 0, h = 9 km, the rest of the envelope",
     });
 
@@ -377,7 +380,7 @@ pub fn costs(grid: Grid) -> Costs {
         a_m: R_PAPER_M,
         flattening: 0.0,
     };
-    let ecc = |c: &Case| {
+    let ecc: fn(&Case) -> StateVector = |c| {
         eccentric_state(
             R_PAPER_M + ALTITUDE_M,
             ECCENTRICITY,
@@ -408,23 +411,23 @@ pub fn costs(grid: Grid) -> Costs {
             label,
             truth: truth_text,
             model: model_text,
-            default: Some(over_default(
-                &cases,
-                |c, s| {
-                    let mut g = wgs(*s, roll_only(c.roll_rad), 0.0);
-                    g.ellipsoid = sphere;
-                    let t = truth(&g, &cam, c.n)?;
-                    Some(err(&t, &paper(s, c.roll_rad, &cam, c.n)?))
-                },
-                ecc,
-            )),
-            envelope: Some(over_envelope(draws, |g, cam, n| {
+            default: default(ecc, &|c, s| {
+                let g = wgs_roll(c, s);
+                vs_paper(
+                    &EarthGeometry {
+                        ellipsoid: sphere,
+                        ..g
+                    },
+                    &cam,
+                    c.n,
+                    err,
+                )
+            }),
+            envelope: envelope(&|g, cam, n| {
                 paper_case(g, cam);
-                g.ground_h_m = 0.0;
                 g.ellipsoid = sphere;
-                let t = truth(g, cam, n)?;
-                Some(err(&t, &paper(&g.state, g.attitude.roll_rad, cam, n)?))
-            })),
+                vs_paper(g, cam, n, err)
+            }),
             envelope_note,
         });
     }
@@ -442,17 +445,13 @@ pub fn costs(grid: Grid) -> Costs {
                 "WGS 84, roll and pitch 45 deg",
             ][k],
             model: "the same with pitch 0",
-            default: Some(over_default(
-                &cases,
-                |c, s| {
-                    let mut a = roll_only(c.roll_rad);
-                    a.pitch_rad = pitch;
-                    dropped(&wgs(*s, a, 0.0), &cam, c.n, |m| m.attitude.pitch_rad = 0.0)
-                },
-                circ,
-            )),
+            default: default(circ, &|c, s| {
+                let mut g = wgs_roll(c, s);
+                g.attitude.pitch_rad = pitch;
+                dropped(&g, &cam, c.n, |m| m.attitude.pitch_rad = 0.0)
+            }),
             envelope: (k == 0).then(|| {
-                over_envelope(draws, |g, cam, n| {
+                over_envelope(grid.envelope_draws, |g, cam, n| {
                     still(g);
                     g.attitude.yaw_rad = 0.0;
                     dropped(g, cam, n, |m| m.attitude.pitch_rad = 0.0)
@@ -466,68 +465,56 @@ pub fn costs(grid: Grid) -> Costs {
         label: "(d) steering yaw -> yaw 0",
         truth: "WGS 84, roll, yaw steered (v2 = 0 on the boresight)",
         model: "the same with yaw 0",
-        default: Some(over_default(
-            &cases,
-            |c, s| {
-                let mut g = wgs(*s, roll_only(c.roll_rad), 0.0);
-                g.attitude.yaw_rad = steering_yaw(&g, &cam)?;
-                dropped(&g, &cam, c.n, |m| m.attitude.yaw_rad = 0.0)
-            },
-            circ,
-        )),
-        envelope: Some(over_envelope(draws, |g, cam, n| {
+        default: default(circ, &|c, s| {
+            let mut g = wgs_roll(c, s);
+            g.attitude.yaw_rad = steering_yaw(&g, &cam)?;
+            dropped(&g, &cam, c.n, |m| m.attitude.yaw_rad = 0.0)
+        }),
+        envelope: envelope(&|g, cam, n| {
             still(g);
             g.attitude.yaw_rad /= 18.0;
             dropped(g, cam, n, |m| m.attitude.yaw_rad = 0.0)
-        })),
+        }),
         envelope_note: "rates 0, yaw within +-10 deg (at any yaw unbounded: v1 -> 0 as the \
                         yaw nears 90 deg), the rest of the envelope",
     });
 
-    // (e) Eq. 16 against the contract's period.
-    rows.push(Row {
-        label: "(e) pixel / |v_P| (Eq. 16) -> pixel / |v1|, yaw unsteered",
-        truth: "WGS 84, roll, yaw 0: pixel / |v1|",
-        model: "the same motion: pixel / |v_P|",
-        default: Some(over_default(
-            &cases,
-            |c, s| {
-                Some(eq16_err(&truth(
-                    &wgs(*s, roll_only(c.roll_rad), 0.0),
-                    &cam,
-                    c.n,
-                )?))
-            },
-            circ,
-        )),
-        envelope: Some(over_envelope(draws, |g, cam, n| {
-            still(g);
-            g.attitude.yaw_rad = 0.0;
+    // (e) Eq. 16 against the contract's period, the yaw unsteered and steered.
+    let eq16 = [
+        (
+            "(e) pixel / |v_P| (Eq. 16) -> pixel / |v1|, yaw unsteered",
+            "WGS 84, roll, yaw 0: pixel / |v1|",
+            "rates 0, yaw 0, the rest of the envelope",
+            false,
+        ),
+        (
+            "(e) pixel / |v_P| (Eq. 16) -> pixel / |v1|, yaw steered",
+            "WGS 84, roll, steering yaw: pixel / |v1|",
+            "rates 0, the steering yaw, the rest of the envelope",
+            true,
+        ),
+    ];
+    for (label, truth_text, envelope_note, steered) in eq16 {
+        // The truth at `g` with yaw 0 (or the steering yaw), in both periods.
+        let err = |g: &mut EarthGeometry<f64>, cam: &EarthCamera, n: f64| {
+            if steered {
+                g.attitude.yaw_rad = steering_yaw(g, cam)?;
+            }
             Some(eq16_err(&truth(g, cam, n)?))
-        })),
-        envelope_note: "rates 0, yaw 0, the rest of the envelope",
-    });
-    rows.push(Row {
-        label: "(e) pixel / |v_P| (Eq. 16) -> pixel / |v1|, yaw steered",
-        truth: "WGS 84, roll, steering yaw: pixel / |v1|",
-        model: "the same motion: pixel / |v_P|",
-        default: Some(over_default(
-            &cases,
-            |c, s| {
-                let mut g = wgs(*s, roll_only(c.roll_rad), 0.0);
-                g.attitude.yaw_rad = steering_yaw(&g, &cam)?;
-                Some(eq16_err(&truth(&g, &cam, c.n)?))
-            },
-            circ,
-        )),
-        envelope: Some(over_envelope(draws, |g, cam, n| {
-            still(g);
-            g.attitude.yaw_rad = 0.0;
-            g.attitude.yaw_rad = steering_yaw(g, cam)?;
-            Some(eq16_err(&truth(g, cam, n)?))
-        })),
-        envelope_note: "rates 0, the steering yaw, the rest of the envelope",
-    });
+        };
+        rows.push(Row {
+            label,
+            truth: truth_text,
+            model: "the same motion: pixel / |v_P|",
+            default: default(circ, &|c, s| err(&mut wgs_roll(c, s), &cam, c.n)),
+            envelope: envelope(&|g, cam, n| {
+                still(g);
+                g.attitude.yaw_rad = 0.0;
+                err(g, cam, n)
+            }),
+            envelope_note,
+        });
+    }
 
     // Angle rates ignored (the paper has none): the envelope only.
     rows.push(Row {
@@ -535,7 +522,7 @@ pub fn costs(grid: Grid) -> Costs {
         truth: "WGS 84, the attitude with its rates",
         model: "the same with the rates 0",
         default: None,
-        envelope: Some(over_envelope(draws, |g, cam, n| dropped(g, cam, n, still))),
+        envelope: envelope(&|g, cam, n| dropped(g, cam, n, still)),
         envelope_note: "the whole envelope (unbounded where the rates cancel v1)",
     });
 

@@ -4,9 +4,9 @@ use anyhow::{Context, Result};
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use crate::markdown::{e2, f2, sig, sig_range, table};
+use crate::markdown::{e2, f2, sig, sig_range};
 
-use super::grid;
+use super::grid::{self, Column};
 use super::maps::{Cell, Map};
 use super::point::{Outcome, Point, INPUTS};
 use super::{C_F32, C_FIXED};
@@ -140,45 +140,21 @@ pub fn write_pngs(map: &Map, dir: &Path) -> Result<()> {
     )
 }
 
-const AGG_HEADER: [&str; 12] = [
-    "cases",
-    "kappa min - max",
-    "f32 err \\|v\\|",
-    "f32 err v1",
-    "f32 err, unrounded inputs",
-    "fixed err \\|v\\|",
-    "fixed err v1",
-    "f32 err/(kappa u)",
-    "f32 unrounded err/(kappa u)",
-    "fixed err/(kappa u_fx)",
-    "kappa q",
-    "refused",
+/// The round-Earth tables' columns.
+pub const COLUMNS: [Column<Cell>; 12] = [
+    ("cases", |a| a.n.to_string()),
+    ("kappa min - max", |a| sig_range(a.kappa_min, a.kappa.max)),
+    ("f32 err \\|v\\|", |a| e2(a.err.f32)),
+    ("f32 err v1", |a| e2(a.err.f32_v1)),
+    ("f32 err, unrounded inputs", |a| e2(a.err.f32_in)),
+    ("fixed err \\|v\\|", |a| e2(a.err.fixed_worst())),
+    ("fixed err v1", |a| e2(a.err.fixed_v1)),
+    ("f32 err/(kappa u)", |a| f2(a.ratio_f32.max)),
+    ("f32 unrounded err/(kappa u)", |a| f2(a.ratio_f32_in.max)),
+    ("fixed err/(kappa u_fx)", |a| f2(a.ratio_fixed.max)),
+    ("kappa q", |a| sig_range(a.kq.0, a.kq.1)),
+    ("refused", |a| a.refused.to_string()),
 ];
-
-fn agg_row(first: String, a: &Cell) -> Vec<String> {
-    vec![
-        first,
-        a.n.to_string(),
-        sig_range(a.kappa_min, a.kappa.max),
-        e2(a.err.f32),
-        e2(a.err.f32_v1),
-        e2(a.err.f32_in),
-        e2(a.err.fixed_worst()),
-        e2(a.err.fixed_v1),
-        f2(a.ratio_f32.max),
-        f2(a.ratio_f32_in.max),
-        f2(a.ratio_fixed.max),
-        sig_range(a.kq.0, a.kq.1),
-        a.refused.to_string(),
-    ]
-}
-
-pub fn agg_table(first: &str, rows: &[(String, Cell)]) -> String {
-    let mut header = vec![first];
-    header.extend(AGG_HEADER);
-    let rows: Vec<Vec<String>> = rows.iter().map(|(n, a)| agg_row(n.clone(), a)).collect();
-    table(&header, &rows)
-}
 
 /// kappa's parts at a point, largest first, as "roll 6.2, altitude 3.0, ...".
 pub fn parts(o: &Outcome) -> String {

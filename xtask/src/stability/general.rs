@@ -15,19 +15,18 @@ use core_math::accuracy::{
 use core_math::earth::{circular_state, limb_margin_rad, Attitude, EarthCamera, EarthGeometry};
 use core_math::sample::{roll_at_limb_margin, EarthCase};
 use core_math::vector::norm;
-use core_math::{
-    Backend, EarthReference, Ellipsoid, ImageMotion, ModelError, EARTH_RATE_RAD_S, GENERAL_F32,
-};
+use core_math::{Backend, EarthReference, Ellipsoid, ModelError, EARTH_RATE_RAD_S};
 
+use std::collections::BTreeMap;
 use std::path::Path;
 
-use crate::markdown::{e2, f2, sig, sig_range, table};
+use crate::markdown::{e2, f2, sig, sig_range};
 
 use super::doc::lg;
 use super::general_fixed::{FAR_TARGET, NEAR_TARGET};
-use super::grid::{self, Cell as _, Panel, Spec, Worst};
+use super::grid::{self, Cell as _, Column, Panel, Spec, Worst};
 use super::maps::I0_SSO_DEG;
-use crate::accuracy::U_F32;
+use crate::accuracy::{Motion, GENERAL_F32_MOTION, U_F32};
 
 /// The paper's camera on the detector line through the optical axis.
 pub const CAMERA: EarthCamera = EarthCamera {
@@ -193,20 +192,24 @@ pub const GMAPS: [Spec<EarthCase>; 5] = [
 /// A real-Earth backend under test against `EarthReference`: the inputs it takes, and
 /// its motion widened to f64. Both backends share one path ([`evaluate`], [`GCell`]);
 /// each keeps its own checks and wording.
-pub trait Tested: Clone + Copy + std::fmt::Debug + Default + Send {
+pub trait Tested: Clone + Copy + std::fmt::Debug + Default + Send + 'static {
+    /// The template keys of its figures: `{KEY}.*` for all the maps together,
+    /// `{MAP_KEY}<letter>.*` for each map.
+    const KEY: &'static str;
+    const MAP_KEY: &'static str;
+    /// The columns of its table, after the map's name.
+    const COLUMNS: &'static [Column<GCell<Self>>];
     /// The inputs the reference takes for the case's `g`: the backend's own inputs,
     /// widened back to f64 where it rounds them itself on the way in.
     fn inputs(g: &EarthGeometry<f64>) -> Result<EarthGeometry<f64>, ModelError>;
     /// The backend's motion at those inputs, widened to f64.
-    fn motion(
-        c: &EarthCamera,
-        g: &EarthGeometry<f64>,
-        n_px: f64,
-    ) -> Result<ImageMotion<f64>, ModelError>;
+    const MOTION: Motion;
     /// What [`describe`] adds after the place.
     fn note(o: &GOutcome) -> String;
     /// Each stated bound a cell (or an aggregate) breaks, one line each.
     fn broken(c: &GCell<Self>) -> Vec<String>;
+    /// The line `cargo xtask stability` prints under its table, for all the maps.
+    fn bound_line(all: &GCell<Self>) -> String;
 }
 
 /// `GENERAL_F32`, the attitude rounded to f32 by the backend itself; the reference at
@@ -215,20 +218,13 @@ pub trait Tested: Clone + Copy + std::fmt::Debug + Default + Send {
 pub struct F32;
 
 impl Tested for F32 {
+    const KEY: &'static str = "G";
+    const MAP_KEY: &'static str = "";
+    const COLUMNS: &'static [Column<GCell<Self>>] = &COLUMNS;
+    const MOTION: Motion = GENERAL_F32_MOTION;
+
     fn inputs(g: &EarthGeometry<f64>) -> Result<EarthGeometry<f64>, ModelError> {
         Ok(*g)
-    }
-
-    fn motion(
-        c: &EarthCamera,
-        g: &EarthGeometry<f64>,
-        n_px: f64,
-    ) -> Result<ImageMotion<f64>, ModelError> {
-        let m = GENERAL_F32.evaluate(c, &g.to::<f32>(), n_px)?;
-        Ok(ImageMotion {
-            v1_mps: f64::from(m.v1_mps),
-            v2_mps: f64::from(m.v2_mps),
-        })
     }
 
     fn note(o: &GOutcome) -> String {
@@ -255,6 +251,17 @@ impl Tested for F32 {
             ));
         }
         bad
+    }
+
+    fn bound_line(all: &GCell<F32>) -> String {
+        format!(
+            "general model (>= {MIN_MARGIN_DEG} deg inside the limb): max err/(kappa u32) {:.2}, \
+             bound {EARTH_F32_KAPPA_C}; max kappa {}; max f32 err {} (line period {})",
+            all.ratio.max,
+            sig(all.kappa.max),
+            e2(all.err.max),
+            e2(all.err_v1.max)
+        )
     }
 }
 
@@ -307,7 +314,7 @@ pub fn evaluate<B: Tested>(c: &EarthCase) -> Result<GOutcome, GSkip> {
     let r = EarthReference
         .evaluate(&c.camera, &g64, c.n_px)
         .map_err(|_| GSkip::Outside)?;
-    let m = B::motion(&c.camera, &g64, c.n_px).map_err(GSkip::Refused)?;
+    let m = (B::MOTION)(&c.camera, &g64, c.n_px).map_err(GSkip::Refused)?;
     if !(m.v1_mps.is_finite() && m.v2_mps.is_finite()) {
         return Err(GSkip::NonFinite);
     }
@@ -541,152 +548,105 @@ pub fn write_pngs(m: &GMap, dir: &Path) -> Result<()> {
 /// A 96-stage segment's line-period mismatch budget, 0.351 / 96 (`docs/derivation.md`).
 pub const SEGMENT_BUDGET: f64 = 0.351 / 96.0;
 
-const TABLE_HEADER: [&str; 11] = [
-    "map",
-    "cases",
-    "kappa min - max",
-    "f32 err \\|dv\\|/\\|v\\|",
-    "f32 err v1 (line period)",
-    "err, kappa <= 30 and >= 1 deg in",
-    "cases err > 2e-6",
-    "smallest kappa with err > 2e-6",
-    "max err/(kappa u)",
-    "min limb margin (deg)",
-    "refused",
+/// `GENERAL_F32`'s table.
+const COLUMNS: [Column<GCell>; 10] = [
+    ("cases", |a| a.n.to_string()),
+    ("kappa min - max", |a| sig_range(a.kappa_min, a.kappa.max)),
+    ("f32 err \\|dv\\|/\\|v\\|", |a| e2(a.err.max)),
+    ("f32 err v1 (line period)", |a| e2(a.err_v1.max)),
+    ("err, kappa <= 30 and >= 1 deg in", |a| or_dash(&a.tame)),
+    ("cases err > 2e-6", |a| a.over_tol.to_string()),
+    ("smallest kappa with err > 2e-6", |a| match a.over_tol {
+        0 => "-".into(),
+        _ => sig(a.over_tol_kappa_min),
+    }),
+    ("max err/(kappa u)", |a| f2(a.ratio.max)),
+    ("min limb margin (deg)", |a| {
+        sig(a.min_margin_rad.to_degrees())
+    }),
+    ("refused", |a| a.refused.to_string()),
 ];
 
-fn row(name: &str, a: &GCell) -> Vec<String> {
-    vec![
-        name.to_string(),
-        a.n.to_string(),
-        sig_range(a.kappa_min, a.kappa.max),
-        e2(a.err.max),
-        e2(a.err_v1.max),
-        if a.tame.max > 0.0 {
-            e2(a.tame.max)
-        } else {
-            "-".into()
-        },
-        a.over_tol.to_string(),
-        if a.over_tol > 0 {
-            sig(a.over_tol_kappa_min)
-        } else {
-            "-".into()
-        },
-        f2(a.ratio.max),
-        sig(a.min_margin_rad.to_degrees()),
-        a.refused.to_string(),
-    ]
+/// The largest value of `w`, or "-" where no case raised it.
+pub fn or_dash(w: &Worst<GSample>) -> String {
+    w.at.map_or("-".into(), |_| e2(w.max))
 }
 
-/// Every value the document's general-model section quotes, by template key (`G.*`).
-pub fn figures(maps: &[GMap], secs: f64) -> std::collections::BTreeMap<String, String> {
-    let mut v = std::collections::BTreeMap::new();
+/// Every value the document quotes about backend `B`'s maps, by template key:
+/// `{B::KEY}.*` for all the maps together (with `.secs`, `.table`, `.bound_line`), and
+/// `{B::MAP_KEY}<letter>.*` for each map (D' as Dy) and map E's table by limb margin.
+pub fn figures<B: Tested>(maps: &[GMap<B>], secs: f64) -> BTreeMap<String, String> {
+    let mut v = BTreeMap::new();
     let mut put = |k: &str, s: String| {
         v.insert(k.to_string(), s);
     };
-    put("G.secs", format!("{secs:.1}"));
-    put("G.c", format!("{EARTH_F32_KAPPA_C}"));
-    put("G.min_margin", format!("{MIN_MARGIN_DEG}"));
+    let (key, mk) = (B::KEY, B::MAP_KEY);
+    put(&format!("{key}.secs"), format!("{secs:.1}"));
     let mut rows = Vec::new();
-    let mut all = GCell::empty();
     for m in maps {
         let a = m.aggregate(|_, _| true);
-        let l = m.spec.letter.replace('\'', "y");
-        let mut put = |what: &str, s: String| put(&format!("{l}.{what}"), s);
-        put("grid", m.grid_text(a.n));
-        put("others", m.spec.others.into());
-        put("ratio", f2(a.ratio.max));
-        put("kappa_max", sig(a.kappa.max));
-        put("err", e2(a.err.max));
-        put("over_tol", a.over_tol.to_string());
-        put("over_tol_kappa", sig(a.over_tol_kappa_min));
-        for (what, w) in [
-            ("worst", &a.ratio),
-            ("max_kappa", &a.kappa),
-            ("max_err", &a.err),
-            ("tame", &a.tame),
-        ] {
-            case_figures::<F32>(&mut put, what, w);
-        }
-        rows.push(row(&format!("{}: {}", m.spec.letter, m.spec.title), &a));
-        all.merge(&a);
+        let l = format!("{mk}{}", m.spec.letter.replace('\'', "y"));
+        put(&format!("{l}.grid"), m.grid_text(a.n));
+        put(&format!("{l}.others"), m.spec.others.into());
+        cell_figures(&mut put, &l, &a);
+        rows.push((format!("{}: {}", m.spec.letter, m.spec.title), a));
     }
-    rows.push(row("all general maps", &all));
-    put("G.samples", all.n.to_string());
-    put("G.ratio", f2(all.ratio.max));
-    put("G.err", e2(all.err.max));
-    put("G.err_v1", e2(all.err_v1.max));
-    put("G.err_v1_steady", e2(all.steady.max));
+    let all = grid::merged(maps);
+    cell_figures(&mut put, key, &all);
+    put(&format!("{key}.bound_line"), B::bound_line(&all));
+    rows.push(("all general maps".into(), all));
     put(
-        "G.err_v1_steady_pct",
-        f2(100.0 * all.steady.max / SEGMENT_BUDGET),
+        &format!("{key}.table"),
+        grid::table("map", B::COLUMNS, &rows),
     );
-    put("G.err_tame", format!("{:.3e}", all.tame.max));
-    for (what, w) in [
-        ("worst", &all.ratio),
-        ("max_err_v1", &all.err_v1),
-        ("steady", &all.steady),
-    ] {
-        case_figures::<F32>(&mut put, &format!("G.{what}"), w);
+    // Map E by limb-margin band (log10 of the margin in deg, the map's y).
+    if let Some(e) = maps.iter().find(|m| m.spec.letter == "E") {
+        let bands = [
+            (-2.0, -1.0, "0.01 - 0.1 deg"),
+            (-1.0, 0.0, "0.1 - 1 deg"),
+            (0.0, 1.0, "1 - 10 deg"),
+        ];
+        let band = |&(lo, hi, name): &(f64, f64, &str)| {
+            (name.to_string(), e.aggregate(|_, y| y >= lo && y < hi))
+        };
+        let rows: Vec<_> = bands.iter().map(band).collect();
+        let table = grid::table("limb margin", B::COLUMNS, &rows);
+        put(&format!("{mk}E.band_table"), table);
     }
-    put("G.table", table(&TABLE_HEADER, &rows));
-    put(
-        "G.bound_line",
-        format!(
-            "general model (>= {MIN_MARGIN_DEG} deg inside the limb): max err/(kappa u32) {:.2}, \
-             bound {EARTH_F32_KAPPA_C}; max kappa {}; max f32 err {} (line period {})",
-            all.ratio.max,
-            sig(all.kappa.max),
-            e2(all.err.max),
-            e2(all.err_v1.max)
-        ),
-    );
+    v
+}
+
+/// What only `GENERAL_F32`'s section quotes: the bound and the budget, and the parts of
+/// maps D, E and F it discusses.
+pub fn f32_figures(maps: &[GMap]) -> BTreeMap<String, String> {
+    let mut v = BTreeMap::new();
+    let mut put = |k: &str, s: String| {
+        v.insert(k.to_string(), s);
+    };
+    put("G.c", format!("{EARTH_F32_KAPPA_C}"));
+    put("G.min_margin", format!("{MIN_MARGIN_DEG}"));
+    put("G.err_tame", format!("{:.3e}", grid::merged(maps).tame.max));
     // The line period against a 96-stage segment's budget.
     put("G.budget", format!("{SEGMENT_BUDGET:.2e}"));
-    put("G.budget_pct", f2(100.0 * all.err_v1.max / SEGMENT_BUDGET));
-    put(
-        "G.budget_kappa",
-        sig(SEGMENT_BUDGET / (EARTH_F32_KAPPA_C * U_F32)),
-    );
+    let kappa_at = |err: f64| err / (EARTH_F32_KAPPA_C * U_F32);
+    put("G.budget_kappa", sig(kappa_at(SEGMENT_BUDGET)));
     put(
         "G.tol_kappa",
-        format!(
-            "{:.0}",
-            EARTH_F32_REL_TOLERANCE / (EARTH_F32_KAPPA_C * U_F32)
-        ),
+        format!("{:.0}", kappa_at(EARTH_F32_REL_TOLERANCE)),
     );
-
-    // Map E by limb-margin band.
+    // Map E by distance to the limb: at least 1 deg, under 1 deg, 0.01 - 0.1 deg.
     if let Some(e) = maps.iter().find(|m| m.spec.letter == "E") {
-        put(
-            "E.band_table",
-            band_table(TABLE_HEADER, |name, lo, hi| {
-                row(name, &e.aggregate(|_, y| y >= lo && y < hi))
-            }),
-        );
-        put(
-            "E.mid_kappa_min",
-            sig(e.aggregate(|_, y| y < 0.0).kappa_min),
-        );
-        let far = e.aggregate(|_, y| y >= 0.0);
-        put("E.far_over_tol", far.over_tol.to_string());
-        put("E.far_over_tol_kappa", sig(far.over_tol_kappa_min));
-        let near = e.aggregate(|_, y| y < -1.0);
-        put("E.near_kappa", sig_range(near.kappa_min, near.kappa.max));
+        cell_figures(&mut put, "E.ge1deg", &e.aggregate(|_, y| y >= 0.0));
+        cell_figures(&mut put, "E.lt1deg", &e.aggregate(|_, y| y < 0.0));
+        cell_figures(&mut put, "E.lt0.1deg", &e.aggregate(|_, y| y < -1.0));
         // kappa x margin over each cell's largest-kappa case: kappa ~ 1/q ~ 1/sqrt(margin).
-        let km: Vec<f64> = e
-            .cells
-            .iter()
-            .filter_map(|c| c.kappa.at)
-            .map(|(_, o)| o.kappa * o.margin_rad.sqrt())
-            .collect();
+        let km = e.cells.iter().filter_map(|c| c.kappa.at);
         let (lo, hi) = km
-            .iter()
-            .fold((f64::INFINITY, 0.0f64), |(l, h), &x| (l.min(x), h.max(x)));
+            .map(|(_, o)| o.kappa * o.margin_rad.sqrt())
+            .fold((f64::INFINITY, 0.0f64), |(l, h), x| (l.min(x), h.max(x)));
         put("E.ksqrtm", sig_range(lo, hi));
     }
-    // Maps D: kappa at least 1 deg inside the limb.
+    // Maps D: the cells at least 1 deg inside the limb.
     for l in ["D", "D'"] {
         if let Some(d) = maps.iter().find(|m| m.spec.letter == l) {
             let mut a = GCell::empty();
@@ -695,22 +655,15 @@ pub fn figures(maps: &[GMap], secs: f64) -> std::collections::BTreeMap<String, S
                     a.merge(c);
                 }
             }
-            let l = l.replace('\'', "y");
-            put(
-                &format!("{l}.far_kappa"),
-                sig_range(a.kappa_min, a.kappa.max),
-            );
-            put(&format!("{l}.far_err"), e2(a.err.max));
+            cell_figures(&mut put, &format!("{}.ge1deg", l.replace('\'', "y")), &a);
         }
     }
     // Map F: the fraction of the rate square where kappa > 30 and where err > 2e-6.
     if let Some(f) = maps.iter().find(|m| m.spec.letter == "F") {
         let n = f.cells.iter().filter(|c| c.n > 0).count() as f64;
         let frac = |p: &dyn Fn(&GCell) -> bool| {
-            format!(
-                "{:.1}",
-                100.0 * f.cells.iter().filter(|c| c.n > 0 && p(c)).count() as f64 / n
-            )
+            let k = f.cells.iter().filter(|c| c.n > 0 && p(c)).count();
+            format!("{:.1}", 100.0 * k as f64 / n)
         };
         put(
             "F.pct_stiff",
@@ -734,14 +687,46 @@ pub fn figures(maps: &[GMap], secs: f64) -> std::collections::BTreeMap<String, S
     v
 }
 
+/// The values the document may quote about an aggregate of cases, as (`{p}.<what>`,
+/// text), and about the case behind each of its maxima ([`case_figures`]). Every
+/// aggregate gets the same set, so that the template can quote any of them the same
+/// way; the keys it does not use are ignored.
+fn cell_figures<B: Tested>(put: &mut impl FnMut(&str, String), p: &str, a: &GCell<B>) {
+    let mut put = |what: &str, s: String| put(&format!("{p}.{what}"), s);
+    put("samples", a.n.to_string());
+    put("ratio", f2(a.ratio.max));
+    put("kappa_min", sig(a.kappa_min));
+    put("kappa_max", sig(a.kappa.max));
+    put("kappa_range", sig_range(a.kappa_min, a.kappa.max));
+    put("err", e2(a.err.max));
+    put("err_v1", e2(a.err_v1.max));
+    put("tame", e2(a.tame.max));
+    put("near", e2(a.near.max));
+    put("steady", e2(a.steady.max));
+    // Percentages of a 96-stage segment's line-period budget.
+    put("budget_pct", f2(100.0 * a.err_v1.max / SEGMENT_BUDGET));
+    put("steady_pct", f2(100.0 * a.steady.max / SEGMENT_BUDGET));
+    put("over_tol", a.over_tol.to_string());
+    put("over_tol_kappa", sig(a.over_tol_kappa_min));
+    put("over", a.over.to_string());
+    put("over_kappa", sig(a.over_kappa_min));
+    put("of_target", format!("{:.3}", a.of_target_checked.max));
+    for (what, w) in [
+        ("worst", &a.ratio),
+        ("max_kappa", &a.kappa),
+        ("max_err", &a.err),
+        ("max_err_v1", &a.err_v1),
+        ("tame", &a.tame),
+        ("steady", &a.steady),
+        ("near", &a.near),
+    ] {
+        case_figures::<B>(&mut put, what, w);
+    }
+}
+
 /// The values the document may quote about one case (a map's worst, largest-kappa, ...),
-/// as (`{prefix}.<what>`, text). Every such case gets the same set, so that the template
-/// can quote any of them the same way; the keys it does not use are ignored.
-pub fn case_figures<B: Tested>(
-    put: &mut impl FnMut(&str, String),
-    prefix: &str,
-    w: &Worst<GSample>,
-) {
+/// as (`{prefix}.<what>`, text).
+fn case_figures<B: Tested>(put: &mut impl FnMut(&str, String), prefix: &str, w: &Worst<GSample>) {
     let Some((c, o)) = &w.at else { return };
     put(&format!("{prefix}.at"), describe::<B>(c, o));
     put(&format!("{prefix}.kappa"), sig(o.kappa));
@@ -749,23 +734,4 @@ pub fn case_figures<B: Tested>(
     put(&format!("{prefix}.v1"), e2(o.v1));
     let period_ms = 1e3 * CAMERA.pixel_m / o.v1.abs();
     put(&format!("{prefix}.period_ms"), sig(period_ms));
-}
-
-/// Map E's table by limb-margin band (log10 of the margin in deg, the map's y): the
-/// `row` of each band (its name, y from, y to) under `header`, first column renamed.
-pub fn band_table<const N: usize>(
-    mut header: [&str; N],
-    row: impl Fn(&str, f64, f64) -> Vec<String>,
-) -> String {
-    let bands = [
-        (-2.0, -1.0, "0.01 - 0.1 deg"),
-        (-1.0, 0.0, "0.1 - 1 deg"),
-        (0.0, 1.0, "1 - 10 deg"),
-    ];
-    let rows: Vec<Vec<String>> = bands
-        .iter()
-        .map(|&(lo, hi, name)| row(name, lo, hi))
-        .collect();
-    header[0] = "limb margin";
-    table(&header, &rows)
 }

@@ -13,19 +13,18 @@
 
 use anyhow::Result;
 use core_math::accuracy::EARTH_F32_KAPPA_LIMIT;
-use core_math::earth::fixed::{geometry_from_f64, motion_to_f64};
-use core_math::earth::{EarthCamera, EarthGeometry};
-use core_math::{Backend, ImageMotion, ModelError, EARTH_FIXED};
+use core_math::earth::fixed::geometry_from_f64;
+use core_math::earth::EarthGeometry;
+use core_math::ModelError;
 
 use std::path::Path;
 
-use crate::markdown::{e2, sig, table};
+use crate::accuracy::{Motion, EARTH_FIXED_MOTION};
+use crate::markdown::{e2, sig};
 
 use super::doc::lg;
-use super::general::{
-    case_figures, describe, GCell, GMap, GOutcome, GSample, Tested, MIN_MARGIN_DEG,
-};
-use super::grid::{Cell as _, Panel, Worst};
+use super::general::{describe, or_dash, GCell, GMap, GOutcome, Tested, MIN_MARGIN_DEG};
+use super::grid::{Column, Panel};
 
 /// The issue's targets (relative |dv| / |v|) from 1 deg and from 0.01 deg inside the limb.
 pub const FAR_TARGET: f64 = 2e-6;
@@ -37,19 +36,16 @@ pub const NEAR_TARGET: f64 = 2e-5;
 pub struct Fixed;
 
 impl Tested for Fixed {
+    const KEY: &'static str = "X";
+    const MAP_KEY: &'static str = "X";
+    const COLUMNS: &'static [Column<GCell<Self>>] = &COLUMNS;
+
     fn inputs(g: &EarthGeometry<f64>) -> Result<EarthGeometry<f64>, ModelError> {
         Ok(geometry_from_f64(g)?.to_f64())
     }
 
     /// The inputs rounded again, which gives them back exactly.
-    fn motion(
-        c: &EarthCamera,
-        g: &EarthGeometry<f64>,
-        n_px: f64,
-    ) -> Result<ImageMotion<f64>, ModelError> {
-        let q = geometry_from_f64(g)?;
-        Ok(motion_to_f64(&EARTH_FIXED.evaluate(c, &q, n_px)?))
-    }
+    const MOTION: Motion = EARTH_FIXED_MOTION;
 
     fn note(o: &GOutcome) -> String {
         format!(", kappa {}", sig(o.kappa))
@@ -79,12 +75,24 @@ impl Tested for Fixed {
         }
         bad
     }
+
+    fn bound_line(all: &FCell) -> String {
+        format!(
+            "EARTH_FIXED (>= {MIN_MARGIN_DEG} deg inside the limb): max err/target {:.3} \
+             (2e-5 from 0.01 deg; 2e-6 from 1 deg where kappa <= {EARTH_F32_KAPPA_LIMIT}); \
+             max err {}; {} case(s) over the bare target, smallest kappa {}; {} refused",
+            all.of_target_checked.max,
+            e2(all.err.max),
+            all.over,
+            sig(all.over_kappa_min),
+            all.refused
+        )
+    }
 }
 
 /// A swept map of the fixed backend.
 pub type FMap = GMap<Fixed>;
 type FCell = GCell<Fixed>;
-type FSample = GSample;
 
 /// Writes the map's PNG of the fixed error into `dir`.
 pub fn write_pngs(m: &FMap, dir: &Path) -> Result<()> {
@@ -100,104 +108,22 @@ pub fn write_pngs(m: &FMap, dir: &Path) -> Result<()> {
     m.write_pngs(&panels, dir)
 }
 
-const TABLE_HEADER: [&str; 10] = [
-    "map",
-    "cases",
-    "max err \\|dv\\|/\\|v\\|",
-    "err v1",
-    "err >= 1 deg in (target 2e-6)",
-    "same, kappa <= 30",
-    "err 0.01 - 1 deg (target 2e-5)",
-    "min limb margin (deg)",
-    "cases over target (smallest kappa)",
-    "refused (first error)",
+const COLUMNS: [Column<FCell>; 9] = [
+    ("cases", |a| a.n.to_string()),
+    ("max err \\|dv\\|/\\|v\\|", |a| e2(a.err.max)),
+    ("err v1", |a| e2(a.err_v1.max)),
+    ("err >= 1 deg in (target 2e-6)", |a| or_dash(&a.far)),
+    ("same, kappa <= 30", |a| or_dash(&a.tame)),
+    ("err 0.01 - 1 deg (target 2e-5)", |a| or_dash(&a.near)),
+    ("min limb margin (deg)", |a| {
+        sig(a.min_margin_rad.to_degrees())
+    }),
+    ("cases over target (smallest kappa)", |a| match a.over {
+        0 => "0".into(),
+        n => format!("{n} ({})", sig(a.over_kappa_min)),
+    }),
+    ("refused (first error)", |a| match a.refused_by {
+        Some(e) => format!("{} ({e:?})", a.refused),
+        None => a.refused.to_string(),
+    }),
 ];
-
-fn or_dash(w: &Worst<FSample>) -> String {
-    if w.at.is_some() {
-        e2(w.max)
-    } else {
-        "-".into()
-    }
-}
-
-fn row(name: &str, a: &FCell) -> Vec<String> {
-    vec![
-        name.to_string(),
-        a.n.to_string(),
-        e2(a.err.max),
-        e2(a.err_v1.max),
-        or_dash(&a.far),
-        or_dash(&a.tame),
-        or_dash(&a.near),
-        sig(a.min_margin_rad.to_degrees()),
-        if a.over > 0 {
-            format!("{} ({})", a.over, sig(a.over_kappa_min))
-        } else {
-            "0".into()
-        },
-        match a.refused_by {
-            Some(e) => format!("{} ({e:?})", a.refused),
-            None => a.refused.to_string(),
-        },
-    ]
-}
-
-/// Every value the document's fixed-backend section quotes, by template key (`X.*`).
-pub fn figures(maps: &[FMap], secs: f64) -> std::collections::BTreeMap<String, String> {
-    let mut v = std::collections::BTreeMap::new();
-    let mut put = |k: &str, s: String| {
-        v.insert(k.to_string(), s);
-    };
-    put("X.secs", format!("{secs:.1}"));
-    let mut rows = Vec::new();
-    let mut all = FCell::empty();
-    for m in maps {
-        let a = m.aggregate(|_, _| true);
-        rows.push(row(&format!("{}: {}", m.spec.letter, m.spec.title), &a));
-        all.merge(&a);
-    }
-    rows.push(row("all general maps", &all));
-    put("X.samples", all.n.to_string());
-    put("X.err", e2(all.err.max));
-    put("X.err_v1", e2(all.err_v1.max));
-    put("X.far_tame", e2(all.tame.max));
-    put("X.near", e2(all.near.max));
-    put("X.over", all.over.to_string());
-    put("X.over_kappa", sig(all.over_kappa_min));
-    put(
-        "X.of_target_checked",
-        format!("{:.3}", all.of_target_checked.max),
-    );
-    for (what, w) in [
-        ("max_err", &all.err),
-        ("far_tame", &all.tame),
-        ("near", &all.near),
-    ] {
-        case_figures::<Fixed>(&mut put, &format!("X.{what}"), w);
-    }
-    put("X.table", table(&TABLE_HEADER, &rows));
-    put(
-        "X.bound_line",
-        format!(
-            "EARTH_FIXED (>= {MIN_MARGIN_DEG} deg inside the limb): max err/target {:.3} \
-             (2e-5 from 0.01 deg; 2e-6 from 1 deg where kappa <= {EARTH_F32_KAPPA_LIMIT}); \
-             max err {}; {} case(s) over the bare target, smallest kappa {}; {} refused",
-            all.of_target_checked.max,
-            e2(all.err.max),
-            all.over,
-            sig(all.over_kappa_min),
-            all.refused
-        ),
-    );
-    // Map E by limb-margin band.
-    if let Some(e) = maps.iter().find(|m| m.spec.letter == "E") {
-        put(
-            "XE.band_table",
-            super::general::band_table(TABLE_HEADER, |name, lo, hi| {
-                row(name, &e.aggregate(|_, y| y >= lo && y < hi))
-            }),
-        );
-    }
-    v
-}

@@ -121,6 +121,34 @@ pub fn broken<C: Cell>(maps: &[Map<C>]) -> Vec<String> {
     maps.iter().flat_map(key_each).collect()
 }
 
+/// All the cases of `maps`: each map's cells merged, then the maps in order.
+pub fn merged<C: Cell>(maps: &[Map<C>]) -> C {
+    let mut all = C::empty();
+    for m in maps {
+        all.merge(&m.aggregate(|_, _| true));
+    }
+    all
+}
+
+/// One column of a table of cells: its header, and a cell's entry.
+pub type Column<C> = (&'static str, fn(&C) -> String);
+
+/// The markdown table of `rows` (name, cell): a first column headed `first`, then
+/// `columns`.
+pub fn table<C>(first: &str, columns: &[Column<C>], rows: &[(String, C)]) -> String {
+    let header: Vec<&str> = std::iter::once(first)
+        .chain(columns.iter().map(|c| c.0))
+        .collect();
+    let entries = |(name, c): &(String, C)| {
+        let each = columns.iter().map(|(_, f)| f(c));
+        std::iter::once(name.clone())
+            .chain(each)
+            .collect::<Vec<_>>()
+    };
+    let rows: Vec<Vec<String>> = rows.iter().map(entries).collect();
+    crate::markdown::table(&header, &rows)
+}
+
 /// A swept map: the cells, row-major from the bottom row (index iy * nx + ix).
 pub struct Map<C: Cell> {
     pub spec: &'static Spec<C::Point>,
