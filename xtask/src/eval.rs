@@ -83,9 +83,9 @@ pub fn run(args: &Args) -> Result<()> {
 /// The whole command on a CSV text: one output row per input row, always.
 pub fn eval_csv(model: Model, backend: &str, text: &str) -> Result<String> {
     match (model, backend) {
-        (Model::Sphere, "reference") => sphere_rows(text, |c| evaluate(&Reference, c, |g| g)),
-        (Model::Sphere, "f64") => sphere_rows(text, |c| evaluate(&CLOSED_F64, c, |g| g)),
-        (Model::Sphere, "f32") => sphere_rows(text, |c| evaluate(&CLOSED_F32, c, |g| g.to())),
+        (Model::Sphere, "reference") => sphere_rows(text, |c| evaluate(&Reference, c)),
+        (Model::Sphere, "f64") => sphere_rows(text, |c| evaluate(&CLOSED_F64, c)),
+        (Model::Sphere, "f32") => sphere_rows(text, |c| evaluate(&CLOSED_F32, c)),
         (Model::Sphere, "fixed") => sphere_rows(text, evaluate_fixed),
         (Model::Sphere, other) => bail!("unknown backend `{other}` (reference|f64|f32|fixed)"),
         (Model::Earth, _) => eval_earth(backend, text, None),
@@ -258,17 +258,14 @@ fn write_rows(
     out.into_string()
 }
 
-/// A backend's numbers, in its own precision (shortest text that reads back to the
-/// same value).
-fn evaluate<B: Backend<Sphere>>(
-    backend: &B,
-    case: &SphereCase,
-    to_real: impl Fn(Geometry<f64>) -> Geometry<B::Real>,
-) -> Result<Vec<String>, RowError>
+/// A backend's numbers, the geometry rounded to its precision once, in its own
+/// precision (shortest text that reads back to the same value).
+fn evaluate<B: Backend<Sphere>>(backend: &B, case: &SphereCase) -> Result<Vec<String>, RowError>
 where
     B::Real: Real + Display,
 {
-    let m = backend.evaluate(&case.camera, &to_real(case.geometry), case.n_px)?;
+    let g = case.geometry.to::<B::Real>();
+    let m = backend.evaluate(&case.camera, &g, case.n_px)?;
     Ok(sphere_numbers(&case.camera, &m)?)
 }
 
