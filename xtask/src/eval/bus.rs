@@ -91,7 +91,7 @@ impl RowCells<'_> {
     }
 }
 
-/// The case of a Part II row (see [`eval_bus_rows`] for the order of the checks). With
+/// The case of an earth row (see [`eval_bus_rows`] for the order of the checks). With
 /// a DEM (`on_dem`) `ground_h_m` is ignored (0 where absent) and `gps_s` is needed.
 pub(super) fn bus_case(cells: &RowCells, on_dem: bool) -> Result<BusCase, RowError> {
     let [x, y, z, vx, vy, vz] = STATE_COLUMNS.map(|n| cells.required(n));
@@ -228,7 +228,7 @@ impl BusCase {
     }
 }
 
-/// The reference's numbers for a Part II case, on the ellipsoid or on the DEM.
+/// The reference's numbers for an earth case, on the ellipsoid or on the DEM.
 pub(super) fn evaluate_bus_reference(
     case: &BusCase,
     dem: Option<&DemTile<'_, f64>>,
@@ -242,7 +242,7 @@ pub(super) fn evaluate_bus_reference(
     Ok(earth_numbers(&case.camera, &m)?)
 }
 
-/// The general form's numbers for a Part II case, in its own precision: Part I's
+/// The general form's numbers for an earth case, in its own precision: Part I's
 /// geometry or the quaternion's (`General::update_inertial`), rounded to `T` once; on a
 /// DEM, the general form's own search in `T` for the range
 /// (`General::dem_inv_range`, `General::motion_at_inv_range`).
