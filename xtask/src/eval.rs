@@ -1,10 +1,11 @@
 //! `cargo xtask eval [--model <sphere|earth>] --backend <...> --input CASES.csv`: a model
 //! on user-supplied cases, CSV out, so the firmware's numbers can be checked on the
-//! ground. `sphere` (the default) is the paper's round Earth; `earth` the real-Earth
-//! model, with the columns `shared/EARTH-MODEL.md` ("Eval CSV") specifies. One generic
-//! path serves both: a model names its columns ([`Columns`]) and any [`Backend`] of it
-//! is evaluated the same way. An earth file with a `frame` or quaternion column, or any
-//! earth file given a DEM (`--dem`), is Part II's ("Eval CSV, Part II"): [`bus`].
+//! ground. `sphere` (the default) is the paper's round Earth, its columns
+//! [`SPHERE_INPUTS`]; `earth` the real-Earth model, with the columns
+//! `shared/EARTH-MODEL.md` ("Eval CSV") specifies. Every earth file is read by [`bus`],
+//! whose columns are Part I's with Part II's ("Eval CSV, Part II": the bus's frames,
+//! time, quaternions, a DEM's ground) optional on top. Both models share the output
+//! ([`write_rows`]): each input row as given, then its numbers or its error's name.
 
 use std::fmt::Display;
 
@@ -22,9 +23,8 @@ use core_math::sphere::{
     speed_line_period_s, Geometry, Reference, Sphere, CLOSED_F32, CLOSED_F64, FIXED,
 };
 use core_math::{
-    line_period_s, Backend, Camera, Earth, EarthReference, Ellipsoid, General, ImageMotion,
-    Model as MathModel, ModelError, Param, Real, StateVector, EARTH_FIXED, EARTH_RATE_RAD_S,
-    GENERAL_F32, GENERAL_F64,
+    line_period_s, Backend, Camera, EarthReference, Ellipsoid, General, ImageMotion, ModelError,
+    Param, Real, StateVector, EARTH_FIXED, EARTH_RATE_RAD_S, GENERAL_F32, GENERAL_F64,
 };
 
 use crate::csv::{Table, Writer};
@@ -76,200 +76,96 @@ pub fn run(args: &Args) -> Result<()> {
     let (grid, heights) = parse_dem(&dem_text).with_context(|| format!("DEM {dem}"))?;
     let tile = DemTile::new(grid, &heights)
         .map_err(|e| anyhow::anyhow!("DEM {dem}: the tile is refused: {e}"))?;
-    print!("{}", eval_csv_on_dem(&args.backend, &text, &tile)?);
+    print!("{}", eval_earth(&args.backend, &text, Some(&tile))?);
     Ok(())
-}
-
-/// The earth model on a CSV text with the ground a DEM tile: Part II's path for every
-/// file, one output row per input row.
-pub fn eval_csv_on_dem(backend: &str, text: &str, tile: &DemTile<'_, f64>) -> Result<String> {
-    let dem = Some(tile);
-    match backend {
-        "reference" => eval_bus_rows(text, dem, |c| evaluate_bus_reference(c, dem)),
-        "f64" => eval_bus_rows(text, dem, |c| evaluate_bus_general(&GENERAL_F64, c, dem)),
-        "f32" => eval_bus_rows(text, dem, |c| evaluate_bus_general(&GENERAL_F32, c, dem)),
-        "fixed" => bail!(
-            "eval: the fixed-point backend has no DEM ground (its per-pixel work is the \
-             ellipsoid's root): use --dem with reference|f64|f32, or drop --dem"
-        ),
-        other => bail!(
-            "eval: unknown backend `{other}` for the earth model on a DEM (reference|f64|f32)"
-        ),
-    }
 }
 
 /// The whole command on a CSV text: one output row per input row, always.
 pub fn eval_csv(model: Model, backend: &str, text: &str) -> Result<String> {
     match (model, backend) {
-        (Model::Sphere, "reference") => eval_rows(text, |c| evaluate(&Reference, c, |g| g)),
-        (Model::Sphere, "f64") => eval_rows(text, |c| evaluate(&CLOSED_F64, c, |g| g)),
-        (Model::Sphere, "f32") => eval_rows(text, |c| evaluate(&CLOSED_F32, c, |g| g.to())),
-        (Model::Sphere, "fixed") => eval_rows(text, evaluate_fixed),
+        (Model::Sphere, "reference") => sphere_rows(text, |c| evaluate(&Reference, c)),
+        (Model::Sphere, "f64") => sphere_rows(text, |c| evaluate(&CLOSED_F64, c)),
+        (Model::Sphere, "f32") => sphere_rows(text, |c| evaluate(&CLOSED_F32, c)),
+        (Model::Sphere, "fixed") => sphere_rows(text, evaluate_fixed),
         (Model::Sphere, other) => bail!("unknown backend `{other}` (reference|f64|f32|fixed)"),
-        (Model::Earth, "reference" | "f64" | "f32" | "fixed") if is_part2(text)? => match backend {
-            "reference" => eval_bus_rows(text, None, |c| evaluate_bus_reference(c, None)),
-            "f64" => eval_bus_rows(text, None, |c| evaluate_bus_general(&GENERAL_F64, c, None)),
-            "fixed" => eval_bus_rows(text, None, evaluate_bus_fixed),
-            _ => eval_bus_rows(text, None, |c| evaluate_bus_general(&GENERAL_F32, c, None)),
-        },
-        (Model::Earth, "reference") => eval_rows(text, |c| evaluate(&EarthReference, c, |g| g)),
-        (Model::Earth, "f64") => eval_rows(text, |c| evaluate(&GENERAL_F64, c, |g| g)),
-        (Model::Earth, "f32") => eval_rows(text, |c| evaluate(&GENERAL_F32, c, |g| g.to())),
-        (Model::Earth, "fixed") => eval_rows(text, evaluate_earth_fixed),
-        (Model::Earth, other) => {
+        (Model::Earth, _) => eval_earth(backend, text, None),
+    }
+}
+
+/// The earth model on a CSV text, its ground the row's ellipsoid or a DEM tile (`dem`):
+/// one output row per input row.
+pub fn eval_earth(backend: &str, text: &str, dem: Option<&DemTile<'_, f64>>) -> Result<String> {
+    match backend {
+        "reference" => eval_bus_rows(text, dem, |c| evaluate_bus_reference(c, dem)),
+        "f64" => eval_bus_rows(text, dem, |c| evaluate_bus_general(&GENERAL_F64, c, dem)),
+        "f32" => eval_bus_rows(text, dem, |c| evaluate_bus_general(&GENERAL_F32, c, dem)),
+        "fixed" if dem.is_none() => eval_bus_rows(text, None, evaluate_bus_fixed),
+        "fixed" => bail!(
+            "eval: the fixed-point backend has no DEM ground (its per-pixel work is the \
+             ellipsoid's root): use --dem with reference|f64|f32, or drop --dem"
+        ),
+        other if dem.is_some() => bail!(
+            "eval: unknown backend `{other}` for the earth model on a DEM (reference|f64|f32)"
+        ),
+        other => {
             bail!("eval: unknown backend `{other}` for the earth model (reference|f64|f32|fixed)")
         }
     }
 }
 
-/// What `eval` needs of a model: its CSV columns and how a case is built from them.
-pub trait Columns: MathModel + Sized {
-    /// Required input columns, in the order [`Columns::case`] takes them.
-    const INPUTS: &'static [&'static str];
-    /// Optional input columns and their defaults (a missing column or an empty cell).
-    const OPTIONAL: &'static [(&'static str, f64)];
-    /// Output columns, the last of which is `error`.
-    const OUTPUTS: &'static [&'static str];
-    /// The case of the inputs, then the optional values, in column order (SI units but
-    /// for the angles, in deg as the CSV gives them).
-    fn case(v: &[f64]) -> Case<Self>;
-    /// The output numbers from a motion, in the backend's own precision.
-    fn numbers<T: Real + Display>(
-        camera: &Self::Camera,
-        m: &ImageMotion<T>,
-    ) -> Result<Vec<String>, ModelError>;
+/// The round Earth's input columns, in the order [`sphere_rows`] reads them.
+const SPHERE_INPUTS: [&str; 8] = [
+    "n_px",
+    "phi_deg",
+    "i0_deg",
+    "gamma0_deg",
+    "h_m",
+    "f_m",
+    "pixel_m",
+    "r_m",
+];
+/// Output columns, the last of which is `error`.
+const SPHERE_OUTPUTS: [&str; 5] = ["v1_mps", "v2_mps", "v_mps", "line_period_s", "error"];
+const EARTH_OUTPUTS: [&str; 6] = [
+    "v1_mps",
+    "v2_mps",
+    "v_mps",
+    "line_period_s",
+    "drift_rad",
+    "error",
+];
+
+/// One round-Earth case in SI units: optics, geometry (f64, to be rounded by the
+/// backend), pixel.
+struct SphereCase {
+    camera: Camera,
+    geometry: Geometry<f64>,
+    n_px: f64,
 }
 
-/// One case in SI units: optics, geometry (f64, to be rounded by the backend), pixel.
-pub struct Case<M: MathModel> {
-    pub camera: M::Camera,
-    pub geometry: M::Geometry<f64>,
-    pub n_px: f64,
+/// v1, v2, |v| and the line period pixel/|v|.
+fn sphere_numbers<T: Real + Display>(
+    c: &Camera,
+    m: &ImageMotion<T>,
+) -> Result<Vec<String>, ModelError> {
+    let speed = m.speed_mps();
+    let period = speed_line_period_s(T::from_f64(c.pixel_m), speed)?;
+    Ok([m.v1_mps, m.v2_mps, speed, period]
+        .map(|x| x.to_string())
+        .to_vec())
 }
 
-impl Columns for Sphere {
-    const INPUTS: &'static [&'static str] = &[
-        "n_px",
-        "phi_deg",
-        "i0_deg",
-        "gamma0_deg",
-        "h_m",
-        "f_m",
-        "pixel_m",
-        "r_m",
-    ];
-    const OPTIONAL: &'static [(&'static str, f64)] = &[];
-    const OUTPUTS: &'static [&'static str] =
-        &["v1_mps", "v2_mps", "v_mps", "line_period_s", "error"];
-
-    fn case(v: &[f64]) -> Case<Sphere> {
-        let &[n_px, phi_deg, i0_deg, gamma0_deg, h_m, f_m, pixel_m, r_m] = v else {
-            unreachable!("eight input columns")
-        };
-        let rad = f64::to_radians;
-        Case {
-            camera: Camera {
-                focal_m: f_m,
-                pixel_m,
-            },
-            geometry: Geometry::circular(rad(phi_deg), rad(i0_deg), rad(gamma0_deg), h_m, r_m),
-            n_px,
-        }
+/// v1, v2, |v|, the line period pixel/|v1| and the drift atan(v2/v1).
+fn earth_numbers<T: Real + Display>(
+    c: &EarthCamera,
+    m: &ImageMotion<T>,
+) -> Result<Vec<String>, ModelError> {
+    let period = line_period_s(T::from_f64(c.pixel_m), m);
+    if !period.is_finite() {
+        return Err(ModelError::NoAlongTrackMotion);
     }
-
-    /// v1, v2, |v| and the line period pixel/|v|.
-    fn numbers<T: Real + Display>(
-        c: &Camera,
-        m: &ImageMotion<T>,
-    ) -> Result<Vec<String>, ModelError> {
-        let speed = m.speed_mps();
-        let period = speed_line_period_s(T::from_f64(c.pixel_m), speed)?;
-        Ok([m.v1_mps, m.v2_mps, speed, period]
-            .map(|x| x.to_string())
-            .to_vec())
-    }
-}
-
-impl Columns for Earth {
-    const INPUTS: &'static [&'static str] = &[
-        "x_m",
-        "y_m",
-        "z_m",
-        "vx_mps",
-        "vy_mps",
-        "vz_mps",
-        "roll_deg",
-        "pitch_deg",
-        "yaw_deg",
-        "roll_rate_dps",
-        "pitch_rate_dps",
-        "yaw_rate_dps",
-        "ground_h_m",
-        "f_m",
-        "pixel_m",
-        "n_px",
-    ];
-    const OPTIONAL: &'static [(&'static str, f64)] = &[
-        ("p1_m", 0.0),
-        ("a_m", Ellipsoid::WGS84.a_m),
-        ("flattening", Ellipsoid::WGS84.flattening),
-        ("earth_rate_rad_s", EARTH_RATE_RAD_S),
-    ];
-    const OUTPUTS: &'static [&'static str] = &[
-        "v1_mps",
-        "v2_mps",
-        "v_mps",
-        "line_period_s",
-        "drift_rad",
-        "error",
-    ];
-
-    fn case(v: &[f64]) -> Case<Earth> {
-        let &[x, y, z, vx, vy, vz, roll, pitch, yaw, roll_rate, pitch_rate, yaw_rate, ground_h_m, f_m, pixel_m, n_px, p1_m, a_m, flattening, earth_rate_rad_s] =
-            v
-        else {
-            unreachable!("sixteen input and four optional columns")
-        };
-        let rad = f64::to_radians;
-        Case {
-            camera: EarthCamera {
-                focal_m: f_m,
-                pixel_m,
-                p1_m,
-            },
-            geometry: EarthGeometry {
-                state: StateVector {
-                    position_m: [x, y, z],
-                    velocity_mps: [vx, vy, vz],
-                },
-                attitude: Attitude {
-                    roll_rad: rad(roll),
-                    pitch_rad: rad(pitch),
-                    yaw_rad: rad(yaw),
-                    roll_rate_rad_s: rad(roll_rate),
-                    pitch_rate_rad_s: rad(pitch_rate),
-                    yaw_rate_rad_s: rad(yaw_rate),
-                },
-                ground_h_m,
-                ellipsoid: Ellipsoid { a_m, flattening },
-                earth_rate_rad_s,
-            },
-            n_px,
-        }
-    }
-
-    /// v1, v2, |v|, the line period pixel/|v1| and the drift atan(v2/v1).
-    fn numbers<T: Real + Display>(
-        c: &EarthCamera,
-        m: &ImageMotion<T>,
-    ) -> Result<Vec<String>, ModelError> {
-        let period = line_period_s(T::from_f64(c.pixel_m), m);
-        if !period.is_finite() {
-            return Err(ModelError::NoAlongTrackMotion);
-        }
-        let numbers = [m.v1_mps, m.v2_mps, m.speed_mps(), period, m.drift_rad()];
-        Ok(numbers.map(|x| x.to_string()).to_vec())
-    }
+    let numbers = [m.v1_mps, m.v2_mps, m.speed_mps(), period, m.drift_rad()];
+    Ok(numbers.map(|x| x.to_string()).to_vec())
 }
 
 /// Why a row has no numbers.
@@ -298,20 +194,36 @@ impl From<ModelError> for RowError {
     }
 }
 
-/// The output text of Part I: [`write_rows`] with the model's outputs.
-fn eval_rows<M: Columns>(
+/// The round Earth's output text: [`write_rows`] with its outputs, a row's case read
+/// from [`SPHERE_INPUTS`] (angles in deg, as the CSV gives them).
+fn sphere_rows(
     text: &str,
-    eval: impl Fn(&Case<M>) -> Result<Vec<String>, RowError>,
+    eval: impl Fn(&SphereCase) -> Result<Vec<String>, RowError>,
 ) -> Result<String> {
     let table = Table::parse(text)?;
-    let required = table.columns(M::INPUTS)?;
-    let optional: Vec<Option<usize>> = M::OPTIONAL
-        .iter()
-        .map(|(name, _)| table.header.iter().position(|h| h == name))
-        .collect();
-    write_rows(&table, M::OUTPUTS, &[], |row| {
-        let v = parse_row(row, &required, &optional, M::OPTIONAL)?;
-        Ok((eval(&M::case(&v))?, Vec::new()))
+    let columns = table.columns(&SPHERE_INPUTS)?;
+    write_rows(&table, &SPHERE_OUTPUTS, &[], |row| {
+        let number = |c: &usize| {
+            let text = row.get(*c).map_or("", String::as_str);
+            text.parse::<f64>().map_err(|_| RowError::Unparsable)
+        };
+        let v = columns
+            .iter()
+            .map(number)
+            .collect::<Result<Vec<f64>, _>>()?;
+        let &[n_px, phi_deg, i0_deg, gamma0_deg, h_m, f_m, pixel_m, r_m] = v.as_slice() else {
+            unreachable!("eight input columns")
+        };
+        let rad = f64::to_radians;
+        let case = SphereCase {
+            camera: Camera {
+                focal_m: f_m,
+                pixel_m,
+            },
+            geometry: Geometry::circular(rad(phi_deg), rad(i0_deg), rad(gamma0_deg), h_m, r_m),
+            n_px,
+        };
+        Ok((eval(&case)?, Vec::new()))
     })
 }
 
@@ -346,61 +258,25 @@ fn write_rows(
     out.into_string()
 }
 
-/// The required values, then the optional ones (their default where the column or the
-/// cell is missing).
-fn parse_row(
-    row: &[String],
-    required: &[usize],
-    optional: &[Option<usize>],
-    defaults: &[(&str, f64)],
-) -> Result<Vec<f64>, RowError> {
-    let cell = |c: usize| row.get(c).map(String::as_str).unwrap_or("");
-    let number = |text: &str| text.parse::<f64>().map_err(|_| RowError::Unparsable);
-    let mut v = required
-        .iter()
-        .map(|&c| number(cell(c)))
-        .collect::<Result<Vec<f64>, _>>()?;
-    for (col, (_, default)) in optional.iter().zip(defaults) {
-        v.push(match col.map(cell) {
-            None | Some("") => *default,
-            Some(text) => number(text)?,
-        });
-    }
-    Ok(v)
-}
-
-/// A backend's numbers, in its own precision (shortest text that reads back to the
-/// same value).
-fn evaluate<M: Columns, B: Backend<M>>(
-    backend: &B,
-    case: &Case<M>,
-    to_real: impl Fn(M::Geometry<f64>) -> M::Geometry<B::Real>,
-) -> Result<Vec<String>, RowError>
+/// A backend's numbers, the geometry rounded to its precision once, in its own
+/// precision (shortest text that reads back to the same value).
+fn evaluate<B: Backend<Sphere>>(backend: &B, case: &SphereCase) -> Result<Vec<String>, RowError>
 where
     B::Real: Real + Display,
-    M::Geometry<f64>: Copy,
 {
-    let m = backend.evaluate(&case.camera, &to_real(case.geometry), case.n_px)?;
-    Ok(M::numbers(&case.camera, &m)?)
+    let g = case.geometry.to::<B::Real>();
+    let m = backend.evaluate(&case.camera, &g, case.n_px)?;
+    Ok(sphere_numbers(&case.camera, &m)?)
 }
 
 /// The fixed-point backend: the geometry rounded to I24F40, the results widened to f64
 /// (exact) and printed as f64; |v| and the line period in f64 from them.
-fn evaluate_fixed(case: &Case<Sphere>) -> Result<Vec<String>, RowError> {
+fn evaluate_fixed(case: &SphereCase) -> Result<Vec<String>, RowError> {
     let g = geometry_from_f64(&case.geometry)?;
     let m = motion_to_f64(&FIXED.evaluate(&case.camera, &g, case.n_px)?);
-    Ok(Sphere::numbers(&case.camera, &m)?)
+    Ok(sphere_numbers(&case.camera, &m)?)
 }
 
-/// The real Earth's fixed-point backend: the attitude rounded to I24F40, the results
-/// widened to f64 (exact) and printed as f64; |v|, the period and the drift in f64.
-fn evaluate_earth_fixed(case: &Case<Earth>) -> Result<Vec<String>, RowError> {
-    let g = earth_fixed::geometry_from_f64(&case.geometry)?;
-    let m = earth_fixed::motion_to_f64(&EARTH_FIXED.evaluate(&case.camera, &g, case.n_px)?);
-    Ok(Earth::numbers(&case.camera, &m)?)
-}
-
-// Part II (`shared/EARTH-MODEL.md`, "Eval CSV, Part II"): the bus's frames, time and
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -498,9 +374,9 @@ garbled,7016137,0,0,0,-1046.6,7464.5,x,0,0,0,0,0,0,0.555,13e-6,0,,
         );
         let (grid, heights) = parse_dem(&std::fs::read_to_string(path).unwrap()).unwrap();
         let tile = DemTile::new(grid, &heights).unwrap();
-        let err = eval_csv_on_dem("fixed", BUS_CASES, &tile).unwrap_err();
+        let err = eval_earth("fixed", BUS_CASES, Some(&tile)).unwrap_err();
         assert!(err.to_string().contains("no DEM ground"), "{err}");
-        assert!(eval_csv_on_dem("f64", BUS_CASES, &tile).is_ok());
+        assert!(eval_earth("f64", BUS_CASES, Some(&tile)).is_ok());
     }
 
     /// The derived outputs follow the definition from v1 and v2, and the backends agree.
@@ -618,7 +494,7 @@ ground_h_m,f_m,pixel_m,n_px
             let new = out(Model::Earth, backend, &with_frame);
             assert_eq!(new.rows.len(), old.rows.len());
             for row in 0..old.rows.len() {
-                for name in Earth::OUTPUTS.iter().chain(&["case"]) {
+                for name in EARTH_OUTPUTS.iter().chain(&["case"]) {
                     assert_eq!(new.field(row, name), old.field(row, name), "{row} {name}");
                 }
                 let lat = new.field(row, "ground_lat_deg");
@@ -628,6 +504,26 @@ ground_h_m,f_m,pixel_m,n_px
             assert!(new.num(0, "ground_lat_deg").abs() < 1e-9);
             assert!(new.num(0, "ground_lon_deg").abs() < 1e-9);
             assert!(new.num(0, "ground_height_m").abs() < 1e-6);
+        }
+    }
+    /// A row's numbers are read before any of core-math's checks (`unparsable_input`
+    /// first), and Part I's rows in a `frame` file keep Part I's first error: for a
+    /// state that is not finite with a zero focal length, the camera's (`invalid_input`,
+    /// as `bad_focal` above).
+    #[test]
+    fn row_checks_in_the_documented_order() {
+        let head = "frame,gps_s,x_m,y_m,z_m,vx_mps,vy_mps,vz_mps,roll_deg,pitch_deg,yaw_deg,\
+roll_rate_dps,pitch_rate_dps,yaw_rate_dps,ground_h_m,f_m,pixel_m,n_px\n";
+        for frame in ["", "inertial", "itrf"] {
+            let rows = format!(
+                "{head}{frame},1388000000,inf,0,0,0,7500,0,x,0,0,0,0,0,0,0.555,13e-6,0\n\
+                 {frame},1388000000,inf,0,0,0,7500,0,10,0,0,0,0,0,0,0,13e-6,0\n"
+            );
+            let out = out(Model::Earth, "f64", &rows);
+            assert_eq!(out.field(0, "error"), "unparsable_input", "{frame}");
+            if frame != "itrf" {
+                assert_eq!(out.field(1, "error"), "invalid_input", "{frame}");
+            }
         }
     }
 }

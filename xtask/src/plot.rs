@@ -272,25 +272,20 @@ impl Plot {
             for (i, s) in self.series.iter().enumerate() {
                 let style = s.style(i);
                 for (k, run) in self.runs(s).into_iter().enumerate() {
-                    let labelled = k == 0 && !s.label.is_empty();
-                    if s.dashed {
-                        let a = chart
-                            .draw_series([DashedPathElement::new(run, 10, 6, style)])
-                            .map_err(drawing)?;
-                        if labelled {
-                            a.label(&s.label).legend(move |(x, y)| {
-                                DashedPathElement::new([(x, y), (x + 30, y)], 10, 6, style)
-                            });
-                        }
-                    } else {
-                        let a = chart
-                            .draw_series([PathElement::new(run, style)])
-                            .map_err(drawing)?;
-                        if labelled {
-                            a.label(&s.label).legend(move |(x, y)| {
-                                PathElement::new([(x, y), (x + 30, y)], style)
-                            });
-                        }
+                    let drawn = match s.dashed {
+                        true => chart.draw_series([DashedPathElement::new(run, 10, 6, style)]),
+                        false => chart.draw_series([PathElement::new(run, style)]),
+                    };
+                    let drawn = drawn.map_err(drawing)?;
+                    if k == 0 && !s.label.is_empty() {
+                        let dashed = s.dashed;
+                        drawn.label(&s.label).legend(move |(x, y)| {
+                            let key = [(x, y), (x + 30, y)];
+                            match dashed {
+                                true => DashedPathElement::new(key, 10, 6, style).into_dyn(),
+                                false => PathElement::new(key, style).into_dyn(),
+                            }
+                        });
                     }
                 }
             }
@@ -348,18 +343,16 @@ fn check_size(width: u32, height: u32, (min_w, min_h): (u32, u32)) -> Result<()>
 /// Height under the plot: one line of tick labels and one of the axis name.
 const X_LABEL_AREA: u32 = (LABEL_PX + DESC_PX + 24.0) as u32;
 
+/// The widths (pixels) of an axis's tick labels, in order.
+fn label_widths(area: &Area<'_>, axis: &Axis) -> Result<Vec<u32>> {
+    let width = |v| area.estimate_text_size(&axis.label(v), &text(LABEL_PX));
+    let ticks = axis.key_points(BoldPoints(MAX_TICKS)).into_iter();
+    ticks.map(|v| Ok(width(v).map_err(drawing)?.0)).collect()
+}
+
 /// Width left of the plot: the widest tick label and the (rotated) axis name.
-fn y_label_area<DB: DrawingBackend>(
-    area: &DrawingArea<DB, plotters::coord::Shift>,
-    axis: &Axis,
-) -> Result<u32> {
-    let mut widest = 0;
-    for v in axis.key_points(BoldPoints(MAX_TICKS)) {
-        let (w, _) = area
-            .estimate_text_size(&axis.label(v), &text(LABEL_PX))
-            .map_err(drawing)?;
-        widest = widest.max(w);
-    }
+fn y_label_area(area: &Area<'_>, axis: &Axis) -> Result<u32> {
+    let widest = label_widths(area, axis)?.into_iter().max().unwrap_or(0);
     Ok(widest + DESC_PX as u32 + 24)
 }
 
@@ -422,18 +415,9 @@ fn labelled_chart<'a, 'b>(
 }
 
 /// Room right of the plot for half of the last x tick label, centred on the frame.
-fn right_margin<DB: DrawingBackend>(
-    area: &DrawingArea<DB, plotters::coord::Shift>,
-    x_axis: &Axis,
-) -> Result<u32> {
-    let last = x_axis.key_points(BoldPoints(MAX_TICKS)).pop();
-    let (w, _) = area
-        .estimate_text_size(
-            &last.map_or(String::new(), |v| x_axis.label(v)),
-            &text(LABEL_PX),
-        )
-        .map_err(drawing)?;
-    Ok(MARGIN.max(w / 2 + 6))
+fn right_margin(area: &Area<'_>, x_axis: &Axis) -> Result<u32> {
+    let last = label_widths(area, x_axis)?.pop().unwrap_or(0);
+    Ok(MARGIN.max(last / 2 + 6))
 }
 
 /// A black frame around the plot area (the mesh draws only the left and bottom axes).

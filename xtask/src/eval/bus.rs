@@ -1,46 +1,32 @@
-//! Part II of the eval (`shared/EARTH-MODEL.md`, "Eval CSV, Part II"): the bus's frames,
-//! time and quaternion attitude, the ground from a DEM tile, and the ground point's
-//! geodetic coordinates. A file takes this path when its header has a `frame` column or
-//! a quaternion column, or when a DEM is given; any other file is Part I's, through
-//! `eval_rows` exactly as before.
+//! The earth model's rows (`shared/EARTH-MODEL.md`, "Eval CSV" and "Eval CSV, Part
+//! II"): Part I's state, attitude angles and optics, and Part II's bus columns on top,
+//! the bus's frames, time and quaternion attitude, the ground from a DEM tile, and the
+//! ground point's geodetic coordinates. A file is Part II's when its header has a
+//! `frame` column or a quaternion column, or when a DEM is given; in any other file
+//! only Part I's columns are read, and its rows give what they always have.
 
 use super::*;
 
-/// `N` of Part I's input columns ([`Columns::INPUTS`] for [`Earth`]) from `start`: the
-/// bus path reads the same columns, named once.
-const fn part1_columns<const N: usize>(start: usize) -> [&'static str; N] {
-    let inputs = <Earth as Columns>::INPUTS;
-    let mut out = [""; N];
-    let mut i = 0;
-    while i < N {
-        out[i] = inputs[start + i];
-        i += 1;
-    }
-    out
-}
-
-/// Part I's state columns, read in the bus's `frame`.
-pub(super) const STATE_COLUMNS: [&str; 6] = part1_columns(0);
-/// Part I's attitude columns, replaced by the quaternion where a row has one.
-pub(super) const ANGLE_COLUMNS: [&str; 6] = part1_columns(6);
+/// Part I's state, read in the bus's `frame`.
+const STATE_COLUMNS: [&str; 6] = ["x_m", "y_m", "z_m", "vx_mps", "vy_mps", "vz_mps"];
+/// Part I's attitude, replaced by the quaternion where a row has one.
+const ANGLE_COLUMNS: [&str; 6] = [
+    "roll_deg",
+    "pitch_deg",
+    "yaw_deg",
+    "roll_rate_dps",
+    "pitch_rate_dps",
+    "yaw_rate_dps",
+];
 /// Columns every row needs.
-pub(super) const COMMON_COLUMNS: [&str; 4] = part1_columns(12);
-pub(super) const QUATERNION_COLUMNS: [&str; 4] = ["qw", "qx", "qy", "qz"];
-pub(super) const CAMERA_QUATERNION_COLUMNS: [&str; 4] = ["cam_qw", "cam_qx", "cam_qy", "cam_qz"];
-pub(super) const BODY_RATE_COLUMNS: [&str; 3] = ["wx_dps", "wy_dps", "wz_dps"];
+const COMMON_COLUMNS: [&str; 4] = ["ground_h_m", "f_m", "pixel_m", "n_px"];
+const QUATERNION_COLUMNS: [&str; 4] = ["qw", "qx", "qy", "qz"];
+const CAMERA_QUATERNION_COLUMNS: [&str; 4] = ["cam_qw", "cam_qx", "cam_qy", "cam_qz"];
+const BODY_RATE_COLUMNS: [&str; 3] = ["wx_dps", "wy_dps", "wz_dps"];
+/// Part I's optional columns; a Part I file's other columns are not read.
+const OPTIONAL_COLUMNS: [&str; 4] = ["p1_m", "a_m", "flattening", "earth_rate_rad_s"];
 /// Added after `error` whenever the input has a `frame` column.
-pub(super) const GROUND_OUTPUTS: [&str; 3] =
-    ["ground_lat_deg", "ground_lon_deg", "ground_height_m"];
-
-/// Whether a CSV text is evaluated as Part II: its header has `frame` or a quaternion
-/// column.
-pub(super) fn is_part2(text: &str) -> Result<bool> {
-    let table = Table::parse(text)?;
-    Ok(table
-        .header
-        .iter()
-        .any(|h| h == "frame" || QUATERNION_COLUMNS.contains(&h.as_str())))
-}
+const GROUND_OUTPUTS: [&str; 3] = ["ground_lat_deg", "ground_lon_deg", "ground_height_m"];
 
 /// A row's geometry: Part I's angles (the state converted to I) or the bus quaternion.
 pub(super) enum BusRowGeometry {
@@ -48,22 +34,23 @@ pub(super) enum BusRowGeometry {
     Quaternion(InertialGeometry<f64>),
 }
 
-/// One Part II case: optics, geometry in I at t (f64), pixel.
+/// One earth row's case: optics, geometry in I at t (f64), pixel.
 pub(super) struct BusCase {
     camera: EarthCamera,
     geometry: BusRowGeometry,
     n_px: f64,
 }
 
-/// A row's cells by column name; an empty cell is a missing column.
+/// A row's cells by column name; an empty cell is a missing column, and so is a column
+/// whose name `header` leaves empty.
 pub(super) struct RowCells<'a> {
-    header: &'a [String],
+    header: &'a [&'a str],
     row: &'a [String],
 }
 
 impl RowCells<'_> {
     fn text(&self, name: &str) -> Option<&str> {
-        let c = self.header.iter().position(|h| h == name)?;
+        let c = self.header.iter().position(|h| *h == name)?;
         self.row
             .get(c)
             .map(String::as_str)
@@ -104,7 +91,7 @@ impl RowCells<'_> {
     }
 }
 
-/// The case of a Part II row (see [`eval_bus_rows`] for the order of the checks). With
+/// The case of an earth row (see [`eval_bus_rows`] for the order of the checks). With
 /// a DEM (`on_dem`) `ground_h_m` is ignored (0 where absent) and `gps_s` is needed.
 pub(super) fn bus_case(cells: &RowCells, on_dem: bool) -> Result<BusCase, RowError> {
     let [x, y, z, vx, vy, vz] = STATE_COLUMNS.map(|n| cells.required(n));
@@ -189,22 +176,31 @@ pub(super) fn bus_case(cells: &RowCells, on_dem: bool) -> Result<BusCase, RowErr
         }
         None => {
             let [roll, pitch, yaw, roll_rate, pitch_rate, yaw_rate] = ANGLE_COLUMNS.map(|n| {
-                match cells.header.iter().any(|h| h == n) {
+                match cells.header.contains(&n) {
                     // Neither a quaternion nor the angles: the attitude is missing.
                     false => Err(RowError::Invalid),
                     true => cells.required(n).map(f64::to_radians),
                 }
             });
-            BusRowGeometry::Angles(EarthGeometry {
-                state: inertial_state(&state, &time, earth_rate_rad_s)?,
-                attitude: Attitude {
-                    roll_rad: roll?,
-                    pitch_rad: pitch?,
-                    yaw_rad: yaw?,
-                    roll_rate_rad_s: roll_rate?,
-                    pitch_rate_rad_s: pitch_rate?,
-                    yaw_rate_rad_s: yaw_rate?,
+            let attitude = Attitude {
+                roll_rad: roll?,
+                pitch_rad: pitch?,
+                yaw_rad: yaw?,
+                roll_rate_rad_s: roll_rate?,
+                pitch_rate_rad_s: pitch_rate?,
+                yaw_rate_rad_s: yaw_rate?,
+            };
+            // A state in I is Part I's, checked by core-math where Part I's always was.
+            let state = match frame {
+                StateFrame::Inertial => StateVector {
+                    position_m,
+                    velocity_mps,
                 },
+                _ => inertial_state(&state, &time, earth_rate_rad_s)?,
+            };
+            BusRowGeometry::Angles(EarthGeometry {
+                state,
+                attitude,
                 ground_h_m,
                 ellipsoid,
                 earth_rate_rad_s,
@@ -232,7 +228,7 @@ impl BusCase {
     }
 }
 
-/// The reference's numbers for a Part II case, on the ellipsoid or on the DEM.
+/// The reference's numbers for an earth case, on the ellipsoid or on the DEM.
 pub(super) fn evaluate_bus_reference(
     case: &BusCase,
     dem: Option<&DemTile<'_, f64>>,
@@ -243,10 +239,10 @@ pub(super) fn evaluate_bus_reference(
         (None, BusRowGeometry::Angles(g)) => EarthReference.evaluate(&case.camera, g, case.n_px)?,
         (None, BusRowGeometry::Quaternion(g)) => EarthReference::motion_of(g, &p)?,
     };
-    Ok(Earth::numbers(&case.camera, &m)?)
+    Ok(earth_numbers(&case.camera, &m)?)
 }
 
-/// The general form's numbers for a Part II case, in its own precision: Part I's
+/// The general form's numbers for an earth case, in its own precision: Part I's
 /// geometry or the quaternion's (`General::update_inertial`), rounded to `T` once; on a
 /// DEM, the general form's own search in `T` for the range
 /// (`General::dem_inv_range`, `General::motion_at_inv_range`).
@@ -272,19 +268,25 @@ pub(super) fn evaluate_bus_general<T: Real + Display>(
             backend.motion(&up, &p)?
         }
     };
-    Ok(Earth::numbers(&case.camera, &m)?)
+    Ok(earth_numbers(&case.camera, &m)?)
 }
 
-/// The real Earth's fixed-point backend on a Part II row: Part I's angles rounded to its
-/// I24F40 input, a quaternion's axes and rates taken in f64 (its update is f64 work).
+/// The real Earth's fixed-point backend: Part I's angles rounded to its I24F40 input
+/// (first, as Part I always has), a quaternion's axes and rates taken in f64 (its update
+/// is f64 work); the results widened to f64 (exact) and printed as f64, |v|, the period
+/// and the drift in f64.
 pub(super) fn evaluate_bus_fixed(case: &BusCase) -> Result<Vec<String>, RowError> {
-    let p = EARTH_FIXED.pixel(&case.camera, case.n_px)?;
-    let up = match &case.geometry {
-        BusRowGeometry::Angles(g) => EARTH_FIXED.update(&earth_fixed::geometry_from_f64(g)?)?,
-        BusRowGeometry::Quaternion(g) => EARTH_FIXED.update_inertial(g)?,
+    let (camera, n_px) = (&case.camera, case.n_px);
+    let m = match &case.geometry {
+        BusRowGeometry::Angles(g) => {
+            EARTH_FIXED.evaluate(camera, &earth_fixed::geometry_from_f64(g)?, n_px)?
+        }
+        BusRowGeometry::Quaternion(g) => {
+            let p = EARTH_FIXED.pixel(camera, n_px)?;
+            EARTH_FIXED.motion(&EARTH_FIXED.update_inertial(g)?, &p)?
+        }
     };
-    let m = earth_fixed::motion_to_f64(&EARTH_FIXED.motion(&up, &p)?);
-    Ok(Earth::numbers(&case.camera, &m)?)
+    Ok(earth_numbers(camera, &earth_fixed::motion_to_f64(&m))?)
 }
 
 /// G's geodetic latitude and longitude (deg) and height (m) on the row's ellipsoid, for
@@ -371,9 +373,9 @@ pub(super) fn parse_dem(text: &str) -> Result<(DemGrid, Vec<f64>)> {
     Ok((grid, heights))
 }
 
-/// The Part II output: as [`eval_rows`], with `ground_lat_deg,ground_lon_deg,
-/// ground_height_m` after `error` when the header has `frame` or a DEM is given. A row's checks, in
-/// order: its numbers (`unparsable_input`); a partial quaternion (some of its four
+/// The earth model's output text: [`write_rows`] with its outputs, and
+/// `ground_lat_deg,ground_lon_deg,ground_height_m` after `error` when the header has
+/// `frame` or a DEM is given. A row's checks, in order: its numbers (`unparsable_input`); a partial quaternion (some of its four
 /// cells), an unknown `frame` or `attitude_frame` (`invalid_input`); the quaternions
 /// (`invalid_quaternion`); a missing `gps_s` where the contract needs it
 /// (`invalid_input`); the time scales; then core-math's own checks. A row is refused
@@ -384,24 +386,38 @@ pub(super) fn eval_bus_rows(
     eval: impl Fn(&BusCase) -> Result<Vec<String>, RowError>,
 ) -> Result<String> {
     let table = Table::parse(text)?;
-    table.columns(&STATE_COLUMNS)?;
-    let common: Vec<&str> = COMMON_COLUMNS
-        .into_iter()
-        .filter(|c| dem.is_none() || *c != "ground_h_m")
-        .collect();
-    table.columns(&common)?;
-    if !table
-        .header
+    let has = |names: &[&str]| table.header.iter().any(|h| names.contains(&h.as_str()));
+    let (with_frame, with_q) = (has(&["frame"]), has(&QUATERNION_COLUMNS));
+    // Part I's columns, in Part I's order; the angles unless a quaternion replaces them.
+    let angles: &[&str] = if with_q { &[] } else { &ANGLE_COLUMNS };
+    let common = COMMON_COLUMNS
         .iter()
-        .any(|h| QUATERNION_COLUMNS.contains(&h.as_str()))
-    {
-        table.columns(&ANGLE_COLUMNS)?;
-    }
-    let with_ground = dem.is_some() || table.header.iter().any(|h| h == "frame");
+        .filter(|c| dem.is_none() || **c != "ground_h_m");
+    let required: Vec<&str> = STATE_COLUMNS
+        .iter()
+        .chain(angles)
+        .chain(common)
+        .copied()
+        .collect();
+    table.columns(&required)?;
+    // In a Part I file only Part I's columns are read (an empty name is no column).
+    let part1 = [
+        &STATE_COLUMNS[..],
+        &ANGLE_COLUMNS,
+        &COMMON_COLUMNS,
+        &OPTIONAL_COLUMNS,
+    ]
+    .concat();
+    let part2 = with_frame || with_q || dem.is_some();
+    let read = |h: &String| part2 || part1.contains(&h.as_str());
+    let header: Vec<&str> = (table.header.iter())
+        .map(|h| if read(h) { h.as_str() } else { "" })
+        .collect();
+    let with_ground = with_frame || dem.is_some();
     let extra: &[&str] = if with_ground { &GROUND_OUTPUTS } else { &[] };
-    write_rows(&table, Earth::OUTPUTS, extra, |row| {
+    write_rows(&table, &EARTH_OUTPUTS, extra, |row| {
         let cells = RowCells {
-            header: &table.header,
+            header: &header,
             row,
         };
         let case = bus_case(&cells, dem.is_some())?;
@@ -473,8 +489,7 @@ mod tests {
             ("f32", 2e-6),
             ("fixed", 2e-6),
         ] {
-            let out = Table::parse(&crate::eval::eval_csv(Model::Earth, backend, &text).unwrap())
-                .unwrap();
+            let out = Table::parse(&eval_earth(backend, &text, None).unwrap()).unwrap();
             assert_eq!(out.rows.len(), golden.rows.len());
             assert!(golden.rows.len() >= 300);
             for i in 0..out.rows.len() {
@@ -508,8 +523,7 @@ mod tests {
         let tile = DemTile::new(grid, &heights).unwrap();
         let text = input(&golden, &GOLDEN_OUTPUTS);
         for (backend, tol) in [("reference", 1e-9), ("f64", 1e-9), ("f32", 5e-6)] {
-            let out = Table::parse(&crate::eval::eval_csv_on_dem(backend, &text, &tile).unwrap())
-                .unwrap();
+            let out = Table::parse(&eval_earth(backend, &text, Some(&tile)).unwrap()).unwrap();
             assert_eq!(out.rows.len(), golden.rows.len());
             let mut hits = 0;
             for i in 0..out.rows.len() {
@@ -545,8 +559,7 @@ mod tests {
         let (grid, heights) = parse_dem(TILE).unwrap();
         let tile = DemTile::new(grid, &heights).unwrap();
         let text = input(&golden, &GOLDEN_OUTPUTS).replace("1500000000.0", "");
-        let out =
-            Table::parse(&crate::eval::eval_csv_on_dem("f64", &text, &tile).unwrap()).unwrap();
+        let out = Table::parse(&eval_earth("f64", &text, Some(&tile)).unwrap()).unwrap();
         let e = out.columns(&["error"]).unwrap()[0];
         assert!(out.rows.iter().all(|r| r[e] == "invalid_input"));
         assert!(out
