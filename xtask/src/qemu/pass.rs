@@ -225,7 +225,7 @@ struct Played {
     status: i32,
     tx_bytes: usize,
     rx_bytes: usize,
-    injected: Vec<(String, Option<Fault>)>,
+    injected: Vec<Option<Fault>>,
     noise_bytes: usize,
     reference: ReferenceCheck,
     /// The relative tolerance the reference check allowed on top of half a tick.
@@ -279,7 +279,7 @@ impl Played {
         problems.extend(self.reference.failures.iter().take(5).cloned());
         problems.extend(self.changed_examples.iter().take(5).cloned());
         problems.extend(self.count_failures.iter().cloned());
-        let counted = self.injected.iter().filter(|(_, f)| f.is_some()).count();
+        let counted = self.injected.iter().flatten().count();
         let noise = self.injected.len() - counted;
         if noise > 0 {
             let skipped = self.final_status.as_ref().map_or(0, |s| s.skipped_bytes);
@@ -442,11 +442,7 @@ fn play(elf: &Path, pass: &Pass, plan: Option<reset::Plan>) -> Result<Played> {
         _ if reset.is_some() => {}
         (Some(fw), Some(host)) => {
             for f in Fault::ALL {
-                let expected = stream
-                    .injected
-                    .iter()
-                    .filter(|(_, e)| *e == Some(f))
-                    .count() as u32;
+                let expected = stream.injected.iter().filter(|e| **e == Some(f)).count() as u32;
                 if fw.count(f) != expected {
                     count_failures.push(format!(
                         "fault counter {}: {} in the firmware's STATUS, {expected} injected",
