@@ -219,107 +219,43 @@ pub fn e2e_test(board: Board) -> Result<()> {
     Ok(())
 }
 
-/// Everything a played pass gave, and the verdicts.
+/// What a pass says after its table: its report lines and its failed checks, in the
+/// order printed (a failure as `FAILED: ...`).
+#[derive(Default)]
+struct Verdict(Vec<(bool, String)>);
+
+impl Verdict {
+    fn say(&mut self, line: String) {
+        self.0.push((false, line));
+    }
+
+    fn fail(&mut self, failure: String) {
+        self.0.push((true, failure));
+    }
+
+    /// Prints every line; an error if a check failed.
+    fn finish(&self) -> Result<()> {
+        for (failed, text) in &self.0 {
+            println!("{}{text}", if *failed { "FAILED: " } else { "" });
+        }
+        match self.0.iter().filter(|(failed, _)| *failed).count() {
+            0 => Ok(()),
+            n => Err(anyhow!("{n} check(s) failed (see above)")),
+        }
+    }
+}
+
+/// What a played pass gave: the firmware's downlink, the bytes each way, the verdict.
 struct Played {
     firmware: Downlink,
-    status: i32,
     tx_bytes: usize,
     rx_bytes: usize,
-    injected: Vec<Option<Fault>>,
-    noise_bytes: usize,
-    reference: ReferenceCheck,
-    /// The relative tolerance the reference check allowed on top of half a tick.
-    rel_tolerance: f64,
-    /// What it is made of, for the report.
-    tolerance_note: &'static str,
-    /// Updates whose PERIODS differ from the twin's (or exist in one run only).
-    changed: usize,
-    changed_examples: Vec<String>,
-    /// Final STATUS of the firmware.
-    final_status: Option<Status>,
-    count_failures: Vec<String>,
-    /// The truth checks of a built-in pass (none for a user's telemetry).
-    truth: Option<truth::Report>,
-    /// With `--reset-at`: what the reset cost.
-    reset: Option<reset::Report>,
+    verdict: Verdict,
 }
 
 impl Played {
-    fn rejected(&self) -> u32 {
-        self.final_status.as_ref().map_or(0, Status::total)
-    }
-
-    /// Prints the verdict lines (the last two in the fixed format) and fails on any
-    /// broken check.
     fn finish(&self) -> Result<()> {
-        let mut problems = Vec::new();
-        if self.status != 0 {
-            problems.push(format!("the firmware exited with status {}", self.status));
-        }
-        // A reset comes between two frames, when the firmware has sent all it owed: it
-        // cuts none.
-        if self.firmware.bad_frames > 0 || self.firmware.skipped_bytes > 0 {
-            problems.push(format!(
-                "the downlink had {} bad frames and {} stray bytes",
-                self.firmware.bad_frames, self.firmware.skipped_bytes
-            ));
-        }
-        if self.reference.compared == 0 {
-            problems.push("no period was compared with the reference".into());
-        }
-        if let Some(n) = self
-            .final_status
-            .map(|s| s.downlink_dropped)
-            .filter(|&n| n > 0)
-        {
-            problems.push(format!(
-                "the firmware dropped {n} downlink frames whole (its transmit queue had no room: STATUS)"
-            ));
-        }
-        problems.extend(self.reference.failures.iter().take(5).cloned());
-        problems.extend(self.changed_examples.iter().take(5).cloned());
-        problems.extend(self.count_failures.iter().cloned());
-        let counted = self.injected.iter().flatten().count();
-        let noise = self.injected.len() - counted;
-        if noise > 0 {
-            let skipped = self.final_status.as_ref().map_or(0, |s| s.skipped_bytes);
-            println!(
-                "noise: {} bytes in {noise} burst(s) injected; the decoder skipped {skipped} bytes (the noise and the remains of the rejected frames)",
-                self.noise_bytes
-            );
-        }
-        println!(
-            "reference: largest |ticks - reference| {:.4} ticks (allowed: 0.5 for the rounding to whole ticks + {:.0e} x ticks for {})",
-            self.reference.max_ticks, self.rel_tolerance, self.tolerance_note
-        );
-        for p in &problems {
-            println!("FAILED: {p}");
-        }
-        println!(
-            "reference check: max relative difference {:.3e} over {} periods ({} at a jump of the reference between two grounds, compared with it turned by the firmware's f32 attitude rounding, {F32_ATTITUDE_RAD:.0e} rad)",
-            self.reference.max_rel, self.reference.compared, self.reference.at_jumps
-        );
-        if let Some(t) = &self.truth {
-            t.print();
-            problems.extend(t.problems());
-        }
-        if let Some(r) = &self.reset {
-            r.print();
-            for p in r.problems() {
-                println!("FAILED: {p}");
-                problems.push(p);
-            }
-        }
-        println!(
-            "faults: injected {counted}, rejected {}, outputs changed by faults {}",
-            self.rejected(),
-            self.changed
-        );
-        if problems.is_empty() {
-            Ok(())
-        } else {
-            Err(anyhow!("{} check(s) failed (see above)", problems.len()))
-        }
+        self.verdict.finish()
     }
 }
 
@@ -352,49 +288,24 @@ fn play(elf: &Path, pass: &Pass, plan: Option<reset::Plan>) -> Result<Played> {
         )?),
         None => None,
     };
-    let cut = trigger.as_ref().map(|(t, _)| (t.cut, t.resume));
-    let QemuRun {
-        status,
-        downlink: downlink_bytes,
-        log,
-        reset_after_us,
-        boot_instructions,
-    } = run_qemu(elf, &uplink, trigger)?;
-    let firmware = Downlink::decode(&downlink_bytes);
+    let run = run_qemu(elf, &uplink, trigger)?;
+    let firmware = Downlink::decode(&run.downlink);
     let t_twin = Instant::now();
 
     // The twin: the stream without the injected faults, and a host run of the faulty
     // stream (whose STATUS must equal the firmware's: same code, same bytes).
     let clean = stream.clean();
-    let (twin, mut navs) = check::twin(&clean, config)?;
-    let (faulty_twin, _) = check::twin(&uplink, config)?;
+    let twin_run = check::HostRun::new(&clean, config)?;
+    let twin = twin_run.downlink();
+    let faulty_twin = check::HostRun::new(&uplink, config)?.downlink();
     let twin_s = t_twin.elapsed().as_secs_f64();
-
-    let reset = match (plan, reset_after_us, cut) {
-        (Some(plan), Some(t_us), Some((cut, resume))) => {
-            let got = reset::Uplink::split(&uplink, cut, resume);
-            let (clean_cut, clean_resume) = plan.cuts(&clean);
-            let clean_got = reset::Uplink::split(&clean, clean_cut, clean_resume);
-            // The reference takes the inputs the firmware had: none of the lost frames,
-            // and the attitude blend restarted by the reset.
-            navs = check::reset_inputs(clean_got.before, clean_got.rest, config)?;
-            Some(reset::Report::new(
-                t_us,
-                &firmware,
-                &twin,
-                &log,
-                got,
-                clean_got,
-                boot_instructions,
-                config,
-            )?)
+    let (navs, (changed, changed_examples), reset) = match plan {
+        None => (twin_run.inputs, compare_with_twin(&firmware, &twin), None),
+        Some(plan) => {
+            let (verdict, inputs, changed) =
+                reset::check(plan, &run, &firmware, &twin, &uplink, &clean, config)?;
+            (inputs, changed, Some(verdict))
         }
-        (Some(plan), ..) => bail!("the pass never reached {} s: no reset was made", plan.at_s),
-        (None, ..) => None,
-    };
-    let (changed, changed_examples) = match &reset {
-        None => compare_with_twin(&firmware, &twin),
-        Some(r) => r.changed_by_faults.clone(),
     };
     // The scene of the checks: the one the pass uploads at its start.
     let mut controller = check::new_controller(config)?;
@@ -434,17 +345,52 @@ fn play(elf: &Path, pass: &Pass, plan: Option<reset::Plan>) -> Result<Played> {
         twin_s + t_check.elapsed().as_secs_f64()
     );
 
+    let mut v = Verdict::default();
     let final_status = firmware.final_status().copied();
-    let faulty_twin_status = faulty_twin.final_status().copied();
-    let mut count_failures = Vec::new();
-    match (&final_status, &faulty_twin_status) {
+    let counted = stream.injected.iter().flatten().count();
+    let noise = stream.injected.len() - counted;
+    if noise > 0 {
+        let skipped = final_status.as_ref().map_or(0, |s| s.skipped_bytes);
+        v.say(format!(
+            "noise: {} bytes in {noise} burst(s) injected; the decoder skipped {skipped} bytes (the noise and the remains of the rejected frames)",
+            stream.noise_bytes()
+        ));
+    }
+    v.say(format!(
+        "reference: largest |ticks - reference| {:.4} ticks (allowed: 0.5 for the rounding to whole ticks + {rel_tolerance:.0e} x ticks for {tolerance_note})",
+        reference.max_ticks
+    ));
+    if run.status != 0 {
+        v.fail(format!("the firmware exited with status {}", run.status));
+    }
+    // A reset comes between two frames, when the firmware has sent all it owed: it cuts
+    // none.
+    if firmware.bad_frames > 0 || firmware.skipped_bytes > 0 {
+        v.fail(format!(
+            "the downlink had {} bad frames and {} stray bytes",
+            firmware.bad_frames, firmware.skipped_bytes
+        ));
+    }
+    if reference.compared == 0 {
+        v.fail("no period was compared with the reference".into());
+    }
+    if let Some(n) = final_status.map(|s| s.downlink_dropped).filter(|&n| n > 0) {
+        v.fail(format!(
+            "the firmware dropped {n} downlink frames whole (its transmit queue had no room: STATUS)"
+        ));
+    }
+    let examples = reference.failures.into_iter().take(5);
+    examples
+        .chain(changed_examples.into_iter().take(5))
+        .for_each(|e| v.fail(e));
+    match (&final_status, faulty_twin.final_status()) {
         // The counters start afresh at a reset: the recovery's own checks replace these.
         _ if reset.is_some() => {}
         (Some(fw), Some(host)) => {
             for f in Fault::ALL {
                 let expected = stream.injected.iter().filter(|e| **e == Some(f)).count() as u32;
                 if fw.count(f) != expected {
-                    count_failures.push(format!(
+                    v.fail(format!(
                         "fault counter {}: {} in the firmware's STATUS, {expected} injected",
                         f.name(),
                         fw.count(f)
@@ -452,7 +398,7 @@ fn play(elf: &Path, pass: &Pass, plan: Option<reset::Plan>) -> Result<Played> {
                 }
             }
             if fw != host {
-                count_failures.push(format!(
+                v.fail(format!(
                     "the firmware's final STATUS differs from the host run of the same bytes: {fw:?} vs {host:?}"
                 ));
             }
@@ -464,43 +410,45 @@ fn play(elf: &Path, pass: &Pass, plan: Option<reset::Plan>) -> Result<Played> {
                     d.in_force_id, d.tiles_committed, d.upload_id, g.nrows, g.ncols
                 );
                 if d.in_force_id != scenario::PASS_DEM_ID || d.tiles_committed != 1 {
-                    count_failures.push(format!(
+                    v.fail(format!(
                         "the DEM tile uploaded at the start is not in force: {d:?}"
                     ));
                 }
             }
         }
-        _ => count_failures.push("no final STATUS frame".into()),
+        _ => v.fail("no final STATUS frame".into()),
     }
     // Issues 23 and 24's stack budget, against the firmware's own high-water mark (its
     // last log line; after a reset, the one since the reset).
-    let marks: Vec<usize> = log
+    match run
+        .log
         .iter()
         .filter_map(|m| stack_high_water_bytes(m))
-        .collect();
-    match marks.iter().max() {
-        None => count_failures.push("the firmware logged no stack high-water mark".into()),
-        Some(&b) if b > STACK_BUDGET_BYTES => count_failures.push(format!(
+        .max()
+    {
+        None => v.fail("the firmware logged no stack high-water mark".into()),
+        Some(b) if b > STACK_BUDGET_BYTES => v.fail(format!(
             "stack high-water mark {b} bytes, over the budget of {STACK_BUDGET_BYTES}"
         )),
         Some(_) => {}
     }
+    v.say(format!(
+        "reference check: max relative difference {:.3e} over {} periods ({} at a jump of the reference between two grounds, compared with it turned by the firmware's f32 attitude rounding, {F32_ATTITUDE_RAD:.0e} rad)",
+        reference.max_rel, reference.compared, reference.at_jumps
+    ));
+    if let Some(t) = &truth {
+        t.verdict(&mut v);
+    }
+    v.0.extend(reset.into_iter().flat_map(|r| r.0));
+    v.say(format!(
+        "faults: injected {counted}, rejected {}, outputs changed by faults {changed}",
+        final_status.as_ref().map_or(0, Status::total)
+    ));
     Ok(Played {
         tx_bytes: uplink.len(),
-        rx_bytes: downlink_bytes.len(),
+        rx_bytes: run.downlink.len(),
         firmware,
-        status,
-        injected: stream.injected.clone(),
-        noise_bytes: stream.noise_bytes(),
-        reference,
-        rel_tolerance,
-        tolerance_note,
-        changed,
-        changed_examples,
-        final_status,
-        count_failures,
-        truth,
-        reset,
+        verdict: v,
     })
 }
 
@@ -568,7 +516,7 @@ fn describe(p: Option<&Vec<u8>>) -> String {
 /// largest in ticks, the count, the failures.
 fn reference_check(
     firmware: &Downlink,
-    inputs: &BTreeMap<u64, check::InForce>,
+    inputs: &check::Inputs,
     controller: &controller::Controller,
     rel_tolerance: f64,
     dem: Option<&(DemGrid, Vec<i16>)>,
