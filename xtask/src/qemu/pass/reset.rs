@@ -177,23 +177,10 @@ pub struct BootCount {
 
 impl BootCount {
     pub fn new(elf: &Path) -> Result<BootCount> {
-        let dir = elf.parent().context("the ELF has no folder")?;
-        let plugin = bench::build_plugin(dir)?;
-        let start = bench::symbol_address(elf, |n| n == "Reset").context("`Reset`")?;
-        let stop = bench::symbol_address(elf, |n| {
-            n.contains("FirstWrite") && n.contains("write_period")
-        })
-        .context("`FirstWrite::write_period`")?;
-        let out = dir.join("reset-boot-counts.txt");
-        let _ = std::fs::remove_file(&out);
-        Ok(BootCount {
-            plugin_args: format!(
-                "{},start={start:#x},stop={stop:#x},out={}",
-                plugin.display(),
-                out.display()
-            ),
-            out,
-        })
+        let out = elf.with_file_name("reset-boot-counts.txt");
+        let first_write = |n: &str| n.contains("FirstWrite") && n.contains("write_period");
+        let plugin_args = bench::stopwatch(elf, |n| n == "Reset", first_write, &out)?;
+        Ok(BootCount { plugin_args, out })
     }
 
     /// The count of the last reset that wrote a period (None: no restore wrote one).
