@@ -169,7 +169,7 @@ pub fn run(args: &RunArgs) -> Result<()> {
         started.elapsed().as_secs_f64(),
         pass.end_us as f64 * 1e-6
     );
-    result.finish()
+    result.verdict.finish()
 }
 
 /// `cargo xtask run --export-telemetry FILE`: the default pass's NAV samples as CSV.
@@ -202,7 +202,7 @@ pub fn e2e_test(board: Board) -> Result<()> {
     let pass = scenario::short_pass(dem, Config::default().update_period_us)?;
     let elf = build_firmware(board, "firmware", true, &[], &[])?;
     let result = play(&elf, &pass, None)?;
-    result.finish()?;
+    result.verdict.finish()?;
     // The same pass with a reset (docs/target.md, "Faults and resets").
     let loses_s = match board {
         Board::Stm32f405 => 0.0,
@@ -210,7 +210,7 @@ pub fn e2e_test(board: Board) -> Result<()> {
     };
     let plan = reset::Plan::new(RESET_TEST_AT_S, loses_s, pass.end_us)?;
     let reset = play(&elf, &pass, Some(plan))?;
-    reset.finish()?;
+    reset.verdict.finish()?;
     eprintln!(
         "xtask: end-to-end pass test (and with a reset at {RESET_TEST_AT_S} s losing {loses_s} s of frames) passed on {} in {:.1} s",
         board.name(),
@@ -251,12 +251,6 @@ struct Played {
     tx_bytes: usize,
     rx_bytes: usize,
     verdict: Verdict,
-}
-
-impl Played {
-    fn finish(&self) -> Result<()> {
-        self.verdict.finish()
-    }
 }
 
 /// Plays `pass` through the firmware `elf` and runs every check; with a reset `plan`,
@@ -310,7 +304,7 @@ fn play(elf: &Path, pass: &Pass, plan: Option<reset::Plan>) -> Result<Played> {
     // The scene of the checks: the one the pass uploads at its start.
     let mut controller = check::new_controller(config)?;
     controller
-        .set_scene(scenario::pass_scene(pass.truth.agile().is_some()))
+        .set_scene(scenario::pass_scene(pass.truth.as_deref().is_some()))
         .map_err(|f| anyhow!("the pass's scene was refused: {}", f.name()))?;
     let t_check = Instant::now();
     let (rel_tolerance, tolerance_note) = if config.fixed_point_pixels {
@@ -326,7 +320,7 @@ fn play(elf: &Path, pass: &Pass, plan: Option<reset::Plan>) -> Result<Played> {
     let (reference, truth) = std::thread::scope(|s| {
         let truth = s.spawn(|| {
             pass.truth
-                .agile()
+                .as_deref()
                 .map(|a| {
                     let dem = pass.dem.as_ref();
                     truth::check(a, &firmware, &controller, dem, &pass.terrain, &navs)
@@ -521,7 +515,6 @@ fn reference_check(
     rel_tolerance: f64,
     dem: Option<&(DemGrid, Vec<i16>)>,
 ) -> Result<ReferenceCheck> {
-    use controller::golden::{bus_update, bus_update_on_dem};
     let dem = match dem {
         Some((g, h)) => {
             Some(DemTile::new(*g, h).map_err(|e| anyhow!("the pass's DEM: {}", e.name()))?)
@@ -544,20 +537,9 @@ fn reference_check(
             ));
             continue;
         };
-        let (scene, plan, h) = (controller.scene(), controller.plan(), &input.heights_m[..]);
-        let t_gps = t_us + check::epoch_us();
-        let tile = match (&dem, input.dem) {
-            (Some(t), true) => Some(t),
-            _ => None,
-        };
-        let golden = match (&input.source, tile) {
-            (check::Source::Nav(nav), _) => controller::golden::update(scene, plan, h, nav, t_gps),
-            (check::Source::Bus(g, a, sc), None) => bus_update(scene, plan, h, g, a, sc, t_gps),
-            (check::Source::Bus(g, a, sc), Some(tile)) => {
-                bus_update_on_dem(scene, plan, h, g, a, sc, t_gps, tile)
-            }
-        }
-        .map_err(|e| anyhow!("reference at {t_us} us: {}", e.name()))?;
+        let golden = input
+            .reference(controller, t_us, dem.as_ref(), None)
+            .map_err(|e| anyhow!("reference at {t_us} us: {}", e.name()))?;
         for r in periods.records().iter().filter(|r| !r.held) {
             let Some(exact) = golden
                 .segments
@@ -574,16 +556,22 @@ fn reference_check(
                 // Where a sample's line of sight grazes a ridge, the reference itself
                 // jumps between two grounds for an attitude change far below the
                 // firmware's f32 rounding: compare with the reference turned by that.
-                let turned = match (&input.source, tile) {
-                    (check::Source::Bus(g, a, sc), tile) => turned_references(a, |a| match tile {
-                        Some(tile) => bus_update_on_dem(scene, plan, h, g, a, sc, t_gps, tile),
-                        None => bus_update(scene, plan, h, g, a, sc, t_gps),
-                    }),
-                    _ => Vec::new(),
+                let turned = match &input.source {
+                    check::Source::Bus(_, a, _) => turned_attitudes(a),
+                    check::Source::Nav(_) => Vec::new(),
                 };
+                let turned = turned.iter().filter_map(|a| {
+                    input
+                        .reference(controller, t_us, dem.as_ref(), Some(a))
+                        .ok()
+                });
                 let nearest = turned
-                    .iter()
-                    .filter_map(|u| u.segments.iter().flatten().find(|g| g.index == r.index))
+                    .filter_map(|u| {
+                        u.segments
+                            .into_iter()
+                            .flatten()
+                            .find(|g| g.index == r.index)
+                    })
                     .map(|g| (f64::from(r.ticks) - g.ticks_exact).abs())
                     .fold(f64::INFINITY, f64::min);
                 if nearest <= rel_tolerance * exact + 0.5 {
@@ -618,24 +606,18 @@ fn reference_check(
 /// (components to 6e-8), B rounded to f32 and turned in f32.
 const F32_ATTITUDE_RAD: f64 = 3e-7;
 
-/// The reference of `a` turned by +-[`F32_ATTITUDE_RAD`] about each body axis.
-fn turned_references(
-    a: &controller::bus::StarAttitude,
-    reference: impl Fn(
-        &controller::bus::StarAttitude,
-    ) -> Result<controller::golden::UpdateGolden, core_math::ModelError>,
-) -> Vec<controller::golden::UpdateGolden> {
+/// `a` turned by +-[`F32_ATTITUDE_RAD`] about each body axis.
+fn turned_attitudes(a: &controller::bus::StarAttitude) -> Vec<controller::bus::StarAttitude> {
     (0..6)
-        .filter_map(|k| {
+        .map(|k| {
             let mut e = [0.0f64; 3];
             e[k / 2] = if k % 2 == 0 { 0.5 } else { -0.5 } * F32_ATTITUDE_RAD;
             let q = bus::q_mul(a.q.map(f64::from), [1.0, e[0], e[1], e[2]]);
             let n = q.iter().map(|x| x * x).sum::<f64>().sqrt();
-            let turned = controller::bus::StarAttitude {
+            controller::bus::StarAttitude {
                 q: q.map(|x| (x / n) as f32),
                 ..*a
-            };
-            reference(&turned).ok()
+            }
         })
         .collect()
 }
@@ -928,7 +910,7 @@ fn print_table(pass: &Pass, played: &Played, every_s: u64, segments: &[u8]) {
 /// Roll, pitch and yaw flown at `t_us` (a built-in pass), or of the last NAV sample at
 /// or before it, propagated at their rates (deg).
 fn telemetry_attitude_deg(pass: &Pass, t_us: u64) -> Option<[f64; 3]> {
-    if let Some(truth) = pass.truth.agile() {
+    if let Some(truth) = pass.truth.as_deref() {
         let a = truth.attitude(t_us as f64 * 1e-6);
         return Some([a.roll_rad, a.pitch_rad, a.yaw_rad].map(f64::to_degrees));
     }

@@ -8,11 +8,13 @@ use std::sync::atomic::{AtomicU64, Ordering};
 
 use controller::bus::{Gnss, StarAttitude};
 use controller::frame::{kind, Decoder, Event};
-use controller::golden::NavInput;
+use controller::golden::{self, NavInput, UpdateGolden};
 use controller::report::{Periods, Status};
 use controller::session::Session;
 use controller::{Config, Controller, LinePeriodSink, Scene};
+use core_math::earth::dem::DemTile;
 use core_math::earth::frames::TimeScales;
+use core_math::ModelError;
 
 /// GPS time of the pass's t = 0 (us): frames carry GPS time, the checks and reports
 /// pass time. One pass is played at a time; `scenario::build` and `play` set it.
@@ -103,6 +105,32 @@ pub struct InForce {
     pub source: Source,
     pub heights_m: Vec<f32>,
     pub dem: bool,
+}
+
+impl InForce {
+    /// The f64 reference of the update at pass time `t_us` on these inputs
+    /// (`controller::golden`), on the pass's DEM `tile` if one was in force, with the
+    /// star tracker's attitude `turned` instead of the one received when given.
+    pub fn reference(
+        &self,
+        c: &Controller,
+        t_us: u64,
+        tile: Option<&DemTile<'_, i16>>,
+        turned: Option<&StarAttitude>,
+    ) -> Result<UpdateGolden, ModelError> {
+        let (scene, plan, h) = (c.scene(), c.plan(), &self.heights_m[..]);
+        let t_gps = t_us + epoch_us();
+        match (&self.source, tile.filter(|_| self.dem)) {
+            (Source::Nav(nav), _) => golden::update(scene, plan, h, nav, t_gps),
+            (Source::Bus(g, a, sc), None) => {
+                golden::bus_update(scene, plan, h, g, turned.unwrap_or(a), sc, t_gps)
+            }
+            (Source::Bus(g, a, sc), Some(tile)) => {
+                let a = turned.unwrap_or(a);
+                golden::bus_update_on_dem(scene, plan, h, g, a, sc, t_gps, tile)
+            }
+        }
+    }
 }
 
 #[derive(Clone, Debug)]

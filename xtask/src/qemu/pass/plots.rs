@@ -112,7 +112,7 @@ pub fn pass_plots(pass: &Pass, firmware: &Downlink, dir: &Path) -> Result<()> {
                 .map(|y| (*t as f64 * 1e-6, f64::from(y) * 1e3))
         })
         .collect();
-    let flown: Vec<(f64, f64)> = match pass.truth.agile() {
+    let flown: Vec<(f64, f64)> = match pass.truth.as_deref() {
         Some(truth) => truth
             .yaw
             .iter()

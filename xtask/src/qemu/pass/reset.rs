@@ -4,7 +4,7 @@
 //! updates after the recovery differ from a run without the reset (docs/target.md,
 //! "Faults and resets").
 
-use anyhow::{anyhow, bail, Context, Result};
+use anyhow::{bail, Context, Result};
 use std::collections::BTreeMap;
 use std::io::{BufRead, BufReader, Write};
 use std::os::unix::net::UnixStream;
@@ -31,7 +31,12 @@ impl Plan {
     /// A reset at `at_s` losing `loses_s` of frames, checked against a pass ending at
     /// `end_us`.
     pub fn new(at_s: f64, loses_s: f64, end_us: u64) -> Result<Plan> {
-        check_instant(at_s, end_us)?;
+        if !(at_s > 0.0 && at_s * 1e6 < end_us as f64) {
+            bail!(
+                "--reset-at {at_s}: the pass runs from 0 to {:.1} s",
+                end_us as f64 * 1e-6
+            );
+        }
         if !(loses_s >= 0.0 && (at_s + loses_s) * 1e6 < end_us as f64) {
             bail!(
                 "--reset-loses {loses_s}: the frames lost must end before the pass does ({:.1} s)",
@@ -435,15 +440,4 @@ fn kind_name(k: u8) -> String {
         kind::TIME_SCALES => "TIME_SCALES".into(),
         other => format!("kind {other:#04x}"),
     }
-}
-
-/// The reset instant on the command line, checked against the pass.
-fn check_instant(at_s: f64, end_us: u64) -> Result<()> {
-    if !(at_s > 0.0 && at_s * 1e6 < end_us as f64) {
-        return Err(anyhow!(
-            "--reset-at {at_s}: the pass runs from 0 to {:.1} s",
-            end_us as f64 * 1e-6
-        ));
-    }
-    Ok(())
 }

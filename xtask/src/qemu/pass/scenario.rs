@@ -226,24 +226,6 @@ impl AgileTruth {
     }
 }
 
-/// The state the reference check holds the firmware to.
-#[derive(Clone, Debug)]
-pub enum Truth {
-    /// A built-in pass: orbit, attitude, terrain, exact at any instant.
-    Agile(Box<AgileTruth>),
-    /// A user's file: only the telemetry is known.
-    Telemetry,
-}
-
-impl Truth {
-    pub fn agile(&self) -> Option<&AgileTruth> {
-        match self {
-            Truth::Agile(a) => Some(a),
-            Truth::Telemetry => None,
-        }
-    }
-}
-
 /// A fault to inject at a pass time `t_s` (the time of its entry in [`Pass::faults`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Inject {
@@ -423,7 +405,9 @@ pub struct Pass {
     pub tick_us: u64,
     /// Last instant of the pass (us): TIME frames run up to it.
     pub end_us: u64,
-    pub truth: Truth,
+    /// A built-in pass's truth: orbit, attitude, terrain, exact at any instant (None: a
+    /// user's file, of which only the telemetry is known).
+    pub truth: Option<Box<AgileTruth>>,
     /// The faults to inject, each at its pass time (s).
     pub faults: Vec<(f64, Inject)>,
     /// The DEM tile uploaded before imaging (the built-in passes'), grid and heights.
@@ -659,7 +643,7 @@ pub fn build(m: Manoeuvres, dem: (DemGrid, Vec<i16>), tick_us: u64) -> Result<Pa
         terrain,
         tick_us,
         end_us,
-        truth: Truth::Agile(Box::new(truth)),
+        truth: Some(Box::new(truth)),
         faults: m.faults,
         dem: Some(dem),
         epoch_us,
@@ -875,7 +859,7 @@ pub fn from_csv(path: &std::path::Path, tick_us: u64) -> Result<Pass> {
         tick_us,
         end_us,
         terrain: Vec::new(),
-        truth: Truth::Telemetry,
+        truth: None,
         faults: Vec::new(),
         dem: None,
         epoch_us: 0,
@@ -897,7 +881,7 @@ pub fn to_csv(pass: &Pass, path: &std::path::Path) -> Result<()> {
     let mut out = crate::csv::Writer::new(&preamble, &CSV_COLUMNS)?;
     // A built-in pass's NAV frames: the truth's state in I0 and Part I's attitude at
     // 4 Hz (what a NAV client would send for it).
-    let navs: Vec<(u64, Nav)> = match pass.truth.agile() {
+    let navs: Vec<(u64, Nav)> = match pass.truth.as_deref() {
         Some(truth) => (0..=pass.end_us / 250_000)
             .map(|k| (k * 250_000, truth.nav(k as f64 * 0.25)))
             .collect(),

@@ -179,7 +179,7 @@ pub fn build(pass: &Pass) -> Result<Stream> {
     let after = |t_us: u64| times.iter().position(|&t| t > t_us).unwrap_or(times.len());
     let truth = pass
         .truth
-        .agile()
+        .as_deref()
         .context("faults are injected into the built-in passes only");
     // The truth's frames tagged `t_s` (a fix 50 ms before).
     let gnss = |t_s: f64| {
@@ -278,7 +278,7 @@ pub fn build(pass: &Pass) -> Result<Stream> {
     if let (Some(&t0), Some(&t1)) = (times.first(), times.get(1)) {
         let dem = pass.dem.as_ref().filter(|_| t1 > t0 + 100);
         if t1 > t0 + 1 {
-            let bus = pass.truth.agile().is_some();
+            let bus = pass.truth.as_deref().is_some();
             for bytes in uploads(&mut frames, bus, dem, t0) {
                 extra.push((1, Item { bytes, fault: None }));
             }
