@@ -37,7 +37,6 @@ use controller::report::{mode_from_u8, Periods, Status};
 use controller::{Config, Fault, Mode};
 use core_math::earth::dem::{DemGrid, DemTile};
 
-use crate::plot::Plot;
 use check::{Downlink, EARTH_FIXED_REL_TOLERANCE, F32_REL_TOLERANCE};
 use scenario::Pass;
 
@@ -159,11 +158,7 @@ pub fn run(args: &RunArgs) -> Result<()> {
         .plot
         .clone()
         .unwrap_or_else(|| workspace_root().join("target/pass/line-periods.png"));
-    plot_periods(&pass, &result, &plot)?;
-    println!("plot: {}", plot.display());
-    if let Some(dir) = plot.parent() {
-        plots::pass_plots(&pass, &result.firmware, dir)?;
-    }
+    plots::pass_plots(&pass, &result.firmware, &plot)?;
     println!(
         "wall time {:.1} s for {:.0} s of orbit",
         started.elapsed().as_secs_f64(),
@@ -924,18 +919,4 @@ fn telemetry_attitude_deg(pass: &Pass, t_us: u64) -> Option<[f64; 3]> {
         (a.pitch_rad + a.pitch_rate_rad_s * dt).to_degrees(),
         (a.yaw_rad + a.yaw_rate_rad_s * dt).to_degrees(),
     ])
-}
-
-/// The line period of every segment over time, as programmed.
-fn plot_periods(pass: &Pass, played: &Played, path: &Path) -> Result<()> {
-    let plot = Plot::new(
-        &format!("Line periods programmed by the firmware, {}", pass.name),
-        "time (s)",
-        "line period (ms)",
-    );
-    if let Some(dir) = path.parent() {
-        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-    }
-    let series = plots::per_segment(&played.firmware, true, |r| f64::from(r.ticks) * 1e-4);
-    plots::save(pass, plot, series, path)
 }
