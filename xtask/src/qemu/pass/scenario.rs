@@ -812,41 +812,34 @@ pub fn from_csv(path: &std::path::Path, tick_us: u64) -> Result<Pass> {
     let cols = table.columns(&CSV_COLUMNS)?;
     let mut samples = Vec::with_capacity(table.rows.len());
     for (i, row) in table.rows.iter().enumerate() {
-        let line = i + 2;
-        let field = |k: usize| -> Result<f64> {
+        let at = || format!("{}: line {}", path.display(), i + 2);
+        let mut v = [0.0f64; CSV_COLUMNS.len()];
+        for ((x, &col), name) in v.iter_mut().zip(&cols).zip(CSV_COLUMNS) {
             let text = row
-                .get(cols[k])
-                .with_context(|| format!("{}: line {line}: too few fields", path.display()))?;
-            text.parse::<f64>().map_err(|_| {
-                anyhow!(
-                    "{}: line {line}: `{text}` is not a number ({})",
-                    path.display(),
-                    CSV_COLUMNS[k]
-                )
-            })
-        };
-        let t_s = field(0)?;
-        if !(0.0..1e9).contains(&t_s) {
-            bail!("{}: line {line}: time {t_s} s out of range", path.display());
+                .get(col)
+                .with_context(|| format!("{}: too few fields", at()))?;
+            *x = (text.parse())
+                .map_err(|_| anyhow!("{}: `{text}` is not a number ({name})", at()))?;
         }
-        let v = |k: usize| field(k);
-        samples.push(Sample {
-            t_us: us(t_s),
-            msg: Msg::Nav(Nav {
-                state: StateVector {
-                    position_m: [v(1)?, v(2)?, v(3)?],
-                    velocity_mps: [v(4)?, v(5)?, v(6)?],
-                },
-                attitude: Attitude {
-                    roll_rad: v(7)? as f32,
-                    pitch_rad: v(8)? as f32,
-                    yaw_rad: v(9)? as f32,
-                    roll_rate_rad_s: v(10)? as f32,
-                    pitch_rate_rad_s: v(11)? as f32,
-                    yaw_rate_rad_s: v(12)? as f32,
-                },
-            }),
-        });
+        let [t_s, rx, ry, rz, vx, vy, vz, a @ ..] = v;
+        if !(0.0..1e9).contains(&t_s) {
+            bail!("{}: time {t_s} s out of range", at());
+        }
+        let [roll, pitch, yaw, roll_rate, pitch_rate, yaw_rate] = a.map(|x| x as f32);
+        let state = StateVector {
+            position_m: [rx, ry, rz],
+            velocity_mps: [vx, vy, vz],
+        };
+        let attitude = Attitude {
+            roll_rad: roll,
+            pitch_rad: pitch,
+            yaw_rad: yaw,
+            roll_rate_rad_s: roll_rate,
+            pitch_rate_rad_s: pitch_rate,
+            yaw_rate_rad_s: yaw_rate,
+        };
+        let msg = Msg::Nav(Nav { state, attitude });
+        samples.push(Sample { t_us: us(t_s), msg });
     }
     let end_us = samples
         .iter()
