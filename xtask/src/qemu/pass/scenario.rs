@@ -234,47 +234,35 @@ pub enum Inject {
     /// The NAV frame at `t_s` cut short after its header and 20 payload bytes.
     Truncate,
     /// `bytes` bytes of line noise (never a sync byte) after the frame at `t_s`.
-    Noise {
-        bytes: usize,
-    },
+    Noise { bytes: usize },
     /// After the frame at `t_s`, a good NAV frame time-tagged `back_s` earlier.
-    Backwards {
-        back_s: f64,
-    },
+    Backwards { back_s: f64 },
     /// An extra NAV frame at `t_s` with a NaN velocity component.
     NaN,
     /// An extra NAV frame at `t_s` placing the spacecraft at `altitude_m`.
-    Altitude {
-        altitude_m: f64,
-    },
+    Altitude { altitude_m: f64 },
     /// No NAV frame strictly between `t_s` and `t_s + len_s` (TIME goes on).
-    Gap {
-        len_s: f64,
-    },
+    Gap { len_s: f64 },
     /// After the frame at `t_s`, a TIME frame (valid CRC) tagged `tag_us`: beyond the
     /// time window, so refused as `time_jump` (issue 13's first defect).
-    TimeTag {
-        tag_us: u64,
-    },
+    TimeTag { tag_us: u64 },
     /// An extra SCENE frame at `t_s` that the camera cannot use: refused as
     /// `invalid_scene` (issue 13's third defect).
     BadScene(SceneProbe),
     /// An extra TERRAIN frame at `t_s` with every height `height_m` (outside
     /// -500..=9 000 m): refused as `out_of_range`.
-    Terrain {
-        height_m: f32,
-    },
+    Terrain { height_m: f32 },
     /// An extra NAV frame at `t_s` whose roll rate (0.5 rad/s) would carry it out of
     /// the scene's envelope: refused as `attitude_outside_model` (issue 12).
     Envelope,
     /// An extra DEM frame at `t_s` the camera refuses (issue 23).
     Dem(DemProbe),
-    /// The bus frames the pass injects at `t_s`, each refused alone (issue 23): an
-    /// ATTITUDE whose quaternion's norm is 1.01 (`bad_quaternion`), a GNSS fix a second
-    /// after its frame's tag (`fix_time`), TIME_SCALES with 70 leap seconds
-    /// (`time_scales`).
+    /// An extra ATTITUDE at `t_s` whose quaternion's norm is 1.01: `bad_quaternion`
+    /// (issue 23).
     Quaternion,
+    /// An extra GNSS frame at `t_s` whose fix is a second after its tag: `fix_time`.
     FixAfterTag,
+    /// An extra TIME_SCALES at `t_s` with 70 leap seconds: `time_scales`.
     LeapSeconds,
 }
 
