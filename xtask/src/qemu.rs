@@ -54,18 +54,20 @@ pub const NO_FPU_TARGET: &str = "thumbv7m-none-eabi";
 pub fn test_target() -> Result<()> {
     let started = Instant::now();
     ensure_target_tools()?;
+    let clippy = |target: &str, args: &str| {
+        let mut all = vec!["clippy"];
+        all.extend(args.split(' '));
+        all.extend(["--target", target, "--", "-D", "warnings"]);
+        cargo(&all)
+    };
     // core-math with its default backends and as the lean flight build links it (the
     // f32 closed form only), the controller.
-    let lints: [&[&str]; 3] = [
-        &["--package", "core-math", "--lib"],
-        &["--package", "core-math", "--lib", "--no-default-features"],
-        &["--package", "controller", "--lib"],
-    ];
-    for which in lints {
-        let mut args = vec!["clippy"];
-        args.extend_from_slice(which);
-        args.extend_from_slice(&["--target", TARGET, "--", "-D", "warnings"]);
-        cargo(&args)?;
+    for lib in [
+        "core-math --lib",
+        "core-math --lib --no-default-features",
+        "controller --lib",
+    ] {
+        clippy(TARGET, &format!("--package {lib}"))?;
     }
     // The firmware's binaries with every feature but the other boards', for each board;
     // the hil-tests; and both with the RTT logger of a real STM32F405.
@@ -79,37 +81,21 @@ pub fn test_target() -> Result<()> {
         ("hil-tests", Board::Stm32f405, &["defmt-rtt"]),
     ];
     for (package, board, extra) in board_lints {
-        let features = board.cargo_features(extra);
-        let mut args = vec!["clippy", "--package", package, "--all-targets"];
-        args.extend(features.iter().map(String::as_str));
-        args.extend_from_slice(&["--target", board.target(), "--", "-D", "warnings"]);
-        cargo(&args)?;
+        let features = board.cargo_features(extra).join(" ");
+        clippy(
+            board.target(),
+            &format!("--package {package} --all-targets {features}"),
+        )?;
     }
     // For a core without an FPU: the controller as the Cortex-M3 board builds it
     // (fixed-point pixels), and each fixed-point backend alone (the real Earth's
     // without `sphere`, as an FPU-less flight build would link it).
-    let no_fpu: [&[&str]; 3] = [
-        &["controller", "--lib", "--features", "earth-fixed"],
-        &[
-            "core-math",
-            "--lib",
-            "--no-default-features",
-            "--features",
-            "fixed-point",
-        ],
-        &[
-            "core-math",
-            "--lib",
-            "--no-default-features",
-            "--features",
-            "earth-fixed",
-        ],
-    ];
-    for which in no_fpu {
-        let mut args = vec!["clippy", "--package"];
-        args.extend_from_slice(which);
-        args.extend_from_slice(&["--target", NO_FPU_TARGET, "--", "-D", "warnings"]);
-        cargo(&args)?;
+    for lib in [
+        "controller --lib --features earth-fixed",
+        "core-math --lib --no-default-features --features fixed-point",
+        "core-math --lib --no-default-features --features earth-fixed",
+    ] {
+        clippy(NO_FPU_TARGET, &format!("--package {lib}"))?;
     }
     let runner = runner_config()?;
     for board in Board::ALL {

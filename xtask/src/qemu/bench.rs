@@ -106,21 +106,11 @@ pub fn measure(board: Board, log_to_stderr: bool) -> Result<BenchCounts> {
 fn measure_on(board: Board, log_to_stderr: bool, profile: Option<usize>) -> Result<BenchCounts> {
     ensure_target_tools()?;
     let elf = build_firmware(board, "bench", true, &["bench"], &[])?;
-    let dir = elf
-        .parent()
-        .context("bench ELF has no folder")?
-        .to_path_buf();
-    let plugin = build_plugin(&dir)?;
-    let (start, stop) = marker_addresses(&elf)?;
-    let counts_path = dir.join("bench-counts.txt");
-    let pcs_path = dir.join("bench-pcs.txt");
-    let _ = std::fs::remove_file(&counts_path);
+    let counts_path = elf.with_file_name("bench-counts.txt");
+    let pcs_path = elf.with_file_name("bench-pcs.txt");
     let _ = std::fs::remove_file(&pcs_path);
-    let mut plugin_args = format!(
-        "{},start={start:#x},stop={stop:#x},out={}",
-        plugin.display(),
-        counts_path.display()
-    );
+    let (start, stop) = (|n: &str| n == "bench_start", |n: &str| n == "bench_stop");
+    let mut plugin_args = stopwatch(&elf, start, stop, &counts_path)?;
     if let Some(region) = profile {
         plugin_args += &format!(",profile={region},pcs={}", pcs_path.display());
     }
@@ -171,8 +161,28 @@ fn measure_on(board: Board, log_to_stderr: bool, profile: Option<usize>) -> Resu
     })
 }
 
+/// The `-plugin` argument of the stopwatch plugin (built next to `elf`) counting the
+/// guest instructions from the function `start` picks to the one `stop` picks (their
+/// mangled names), into `out`.
+pub(super) fn stopwatch(
+    elf: &Path,
+    start: impl Fn(&str) -> bool,
+    stop: impl Fn(&str) -> bool,
+    out: &Path,
+) -> Result<String> {
+    let plugin = build_plugin(elf.parent().context("the ELF has no folder")?)?;
+    let start = symbol_address(elf, start).context("the start of the count")?;
+    let stop = symbol_address(elf, stop).context("the end of the count")?;
+    let _ = std::fs::remove_file(out);
+    Ok(format!(
+        "{},start={start:#x},stop={stop:#x},out={}",
+        plugin.display(),
+        out.display()
+    ))
+}
+
 /// Compiles the plugin next to the bench ELF (a few hundred ms with gcc).
-pub(super) fn build_plugin(dir: &Path) -> Result<PathBuf> {
+fn build_plugin(dir: &Path) -> Result<PathBuf> {
     if !tools::have("gcc") {
         tools::apt_install(&["gcc", "libc6-dev"], "gcc (to build the QEMU plugin)")?;
     }
@@ -196,17 +206,9 @@ pub(super) fn build_plugin(dir: &Path) -> Result<PathBuf> {
     }
 }
 
-/// Addresses of the first instructions of the two markers (Thumb bit cleared).
-fn marker_addresses(elf: &Path) -> Result<(u64, u64)> {
-    Ok((
-        symbol_address(elf, |n| n == "bench_start")?,
-        symbol_address(elf, |n| n == "bench_stop")?,
-    ))
-}
-
 /// The address of the first instruction of the function whose (mangled) name `is`
 /// picks, Thumb bit cleared.
-pub(super) fn symbol_address(elf: &Path, is: impl Fn(&str) -> bool) -> Result<u64> {
+fn symbol_address(elf: &Path, is: impl Fn(&str) -> bool) -> Result<u64> {
     let bytes = std::fs::read(elf).with_context(|| format!("cannot read {}", elf.display()))?;
     let file =
         object::File::parse(&*bytes).with_context(|| format!("cannot parse {}", elf.display()))?;

@@ -37,7 +37,6 @@ use controller::report::{mode_from_u8, Periods, Status};
 use controller::{Config, Fault, Mode};
 use core_math::earth::dem::{DemGrid, DemTile};
 
-use crate::plot::Plot;
 use check::{Downlink, EARTH_FIXED_REL_TOLERANCE, F32_REL_TOLERANCE};
 use scenario::Pass;
 
@@ -159,17 +158,13 @@ pub fn run(args: &RunArgs) -> Result<()> {
         .plot
         .clone()
         .unwrap_or_else(|| workspace_root().join("target/pass/line-periods.png"));
-    plot_periods(&pass, &result, &plot)?;
-    println!("plot: {}", plot.display());
-    if let Some(dir) = plot.parent() {
-        plots::pass_plots(&pass, &result.firmware, dir)?;
-    }
+    plots::pass_plots(&pass, &result.firmware, &plot)?;
     println!(
         "wall time {:.1} s for {:.0} s of orbit",
         started.elapsed().as_secs_f64(),
         pass.end_us as f64 * 1e-6
     );
-    result.finish()
+    result.verdict.finish()
 }
 
 /// `cargo xtask run --export-telemetry FILE`: the default pass's NAV samples as CSV.
@@ -202,7 +197,7 @@ pub fn e2e_test(board: Board) -> Result<()> {
     let pass = scenario::short_pass(dem, Config::default().update_period_us)?;
     let elf = build_firmware(board, "firmware", true, &[], &[])?;
     let result = play(&elf, &pass, None)?;
-    result.finish()?;
+    result.verdict.finish()?;
     // The same pass with a reset (docs/target.md, "Faults and resets").
     let loses_s = match board {
         Board::Stm32f405 => 0.0,
@@ -210,7 +205,7 @@ pub fn e2e_test(board: Board) -> Result<()> {
     };
     let plan = reset::Plan::new(RESET_TEST_AT_S, loses_s, pass.end_us)?;
     let reset = play(&elf, &pass, Some(plan))?;
-    reset.finish()?;
+    reset.verdict.finish()?;
     eprintln!(
         "xtask: end-to-end pass test (and with a reset at {RESET_TEST_AT_S} s losing {loses_s} s of frames) passed on {} in {:.1} s",
         board.name(),
@@ -219,108 +214,38 @@ pub fn e2e_test(board: Board) -> Result<()> {
     Ok(())
 }
 
-/// Everything a played pass gave, and the verdicts.
-struct Played {
-    firmware: Downlink,
-    status: i32,
-    tx_bytes: usize,
-    rx_bytes: usize,
-    injected: Vec<(String, Option<Fault>)>,
-    noise_bytes: usize,
-    reference: ReferenceCheck,
-    /// The relative tolerance the reference check allowed on top of half a tick.
-    rel_tolerance: f64,
-    /// What it is made of, for the report.
-    tolerance_note: &'static str,
-    /// Updates whose PERIODS differ from the twin's (or exist in one run only).
-    changed: usize,
-    changed_examples: Vec<String>,
-    /// Final STATUS of the firmware.
-    final_status: Option<Status>,
-    count_failures: Vec<String>,
-    /// The truth checks of a built-in pass (none for a user's telemetry).
-    truth: Option<truth::Report>,
-    /// With `--reset-at`: what the reset cost.
-    reset: Option<reset::Report>,
+/// What a pass says after its table: its report lines and its failed checks, in the
+/// order printed (a failure as `FAILED: ...`).
+#[derive(Default)]
+struct Verdict(Vec<(bool, String)>);
+
+impl Verdict {
+    fn say(&mut self, line: String) {
+        self.0.push((false, line));
+    }
+
+    fn fail(&mut self, failure: String) {
+        self.0.push((true, failure));
+    }
+
+    /// Prints every line; an error if a check failed.
+    fn finish(&self) -> Result<()> {
+        for (failed, text) in &self.0 {
+            println!("{}{text}", if *failed { "FAILED: " } else { "" });
+        }
+        match self.0.iter().filter(|(failed, _)| *failed).count() {
+            0 => Ok(()),
+            n => Err(anyhow!("{n} check(s) failed (see above)")),
+        }
+    }
 }
 
-impl Played {
-    fn rejected(&self) -> u32 {
-        self.final_status.as_ref().map_or(0, Status::total)
-    }
-
-    /// Prints the verdict lines (the last two in the fixed format) and fails on any
-    /// broken check.
-    fn finish(&self) -> Result<()> {
-        let mut problems = Vec::new();
-        if self.status != 0 {
-            problems.push(format!("the firmware exited with status {}", self.status));
-        }
-        // A reset comes between two frames, when the firmware has sent all it owed: it
-        // cuts none.
-        if self.firmware.bad_frames > 0 || self.firmware.skipped_bytes > 0 {
-            problems.push(format!(
-                "the downlink had {} bad frames and {} stray bytes",
-                self.firmware.bad_frames, self.firmware.skipped_bytes
-            ));
-        }
-        if self.reference.compared == 0 {
-            problems.push("no period was compared with the reference".into());
-        }
-        if let Some(n) = self
-            .final_status
-            .map(|s| s.downlink_dropped)
-            .filter(|&n| n > 0)
-        {
-            problems.push(format!(
-                "the firmware dropped {n} downlink frames whole (its transmit queue had no room: STATUS)"
-            ));
-        }
-        problems.extend(self.reference.failures.iter().take(5).cloned());
-        problems.extend(self.changed_examples.iter().take(5).cloned());
-        problems.extend(self.count_failures.iter().cloned());
-        let counted = self.injected.iter().filter(|(_, f)| f.is_some()).count();
-        let noise = self.injected.len() - counted;
-        if noise > 0 {
-            let skipped = self.final_status.as_ref().map_or(0, |s| s.skipped_bytes);
-            println!(
-                "noise: {} bytes in {noise} burst(s) injected; the decoder skipped {skipped} bytes (the noise and the remains of the rejected frames)",
-                self.noise_bytes
-            );
-        }
-        println!(
-            "reference: largest |ticks - reference| {:.4} ticks (allowed: 0.5 for the rounding to whole ticks + {:.0e} x ticks for {})",
-            self.reference.max_ticks, self.rel_tolerance, self.tolerance_note
-        );
-        for p in &problems {
-            println!("FAILED: {p}");
-        }
-        println!(
-            "reference check: max relative difference {:.3e} over {} periods ({} at a jump of the reference between two grounds, compared with it turned by the firmware's f32 attitude rounding, {F32_ATTITUDE_RAD:.0e} rad)",
-            self.reference.max_rel, self.reference.compared, self.reference.at_jumps
-        );
-        if let Some(t) = &self.truth {
-            t.print();
-            problems.extend(t.problems());
-        }
-        if let Some(r) = &self.reset {
-            r.print();
-            for p in r.problems() {
-                println!("FAILED: {p}");
-                problems.push(p);
-            }
-        }
-        println!(
-            "faults: injected {counted}, rejected {}, outputs changed by faults {}",
-            self.rejected(),
-            self.changed
-        );
-        if problems.is_empty() {
-            Ok(())
-        } else {
-            Err(anyhow!("{} check(s) failed (see above)", problems.len()))
-        }
-    }
+/// What a played pass gave: the firmware's downlink, the bytes each way, the verdict.
+struct Played {
+    firmware: Downlink,
+    tx_bytes: usize,
+    rx_bytes: usize,
+    verdict: Verdict,
 }
 
 /// Plays `pass` through the firmware `elf` and runs every check; with a reset `plan`,
@@ -352,70 +277,37 @@ fn play(elf: &Path, pass: &Pass, plan: Option<reset::Plan>) -> Result<Played> {
         )?),
         None => None,
     };
-    let cut = trigger.as_ref().map(|(t, _)| (t.cut, t.resume));
-    let QemuRun {
-        status,
-        downlink: downlink_bytes,
-        log,
-        reset_after_us,
-        boot_instructions,
-    } = run_qemu(elf, &uplink, trigger)?;
-    let firmware = Downlink::decode(&downlink_bytes);
+    let run = run_qemu(elf, &uplink, trigger)?;
+    let firmware = Downlink::decode(&run.downlink);
     let t_twin = Instant::now();
 
     // The twin: the stream without the injected faults, and a host run of the faulty
     // stream (whose STATUS must equal the firmware's: same code, same bytes).
     let clean = stream.clean();
-    let (twin, mut navs) = check::twin(&clean, config)?;
-    let (faulty_twin, _) = check::twin(&uplink, config)?;
+    let twin_run = check::HostRun::new(&clean, config)?;
+    let twin = twin_run.downlink();
+    let faulty_twin = check::HostRun::new(&uplink, config)?.downlink();
     let twin_s = t_twin.elapsed().as_secs_f64();
-
-    let reset = match (plan, reset_after_us, cut) {
-        (Some(plan), Some(t_us), Some((cut, resume))) => {
-            let got = reset::Uplink::split(&uplink, cut, resume);
-            let (clean_cut, clean_resume) = plan.cuts(&clean);
-            let clean_got = reset::Uplink::split(&clean, clean_cut, clean_resume);
-            // The reference takes the inputs the firmware had: none of the lost frames,
-            // and the attitude blend restarted by the reset.
-            navs = check::reset_inputs(clean_got.before, clean_got.rest, config)?;
-            Some(reset::Report::new(
-                t_us,
-                &firmware,
-                &twin,
-                &log,
-                got,
-                clean_got,
-                boot_instructions,
-                config,
-            )?)
+    let (navs, (changed, changed_examples), reset) = match plan {
+        None => (twin_run.inputs, compare_with_twin(&firmware, &twin), None),
+        Some(plan) => {
+            let (verdict, inputs, changed) =
+                reset::check(plan, &run, &firmware, &twin, &uplink, &clean, config)?;
+            (inputs, changed, Some(verdict))
         }
-        (Some(plan), ..) => bail!("the pass never reached {} s: no reset was made", plan.at_s),
-        (None, ..) => None,
-    };
-    let (changed, changed_examples) = match &reset {
-        None => compare_with_twin(&firmware, &twin),
-        Some(r) => r.changed_by_faults.clone(),
     };
     // The scene of the checks: the one the pass uploads at its start.
     let mut controller = check::new_controller(config)?;
     controller
-        .set_scene(scenario::pass_scene(pass.truth.agile().is_some()))
+        .set_scene(scenario::pass_scene(pass.truth.as_deref().is_some()))
         .map_err(|f| anyhow!("the pass's scene was refused: {}", f.name()))?;
     let t_check = Instant::now();
-    let (rel_tolerance, tolerance_note) = if config.fixed_point_pixels {
-        (
-            F32_REL_TOLERANCE + EARTH_FIXED_REL_TOLERANCE,
-            "the f32 update and the fixed-point pixels",
-        )
-    } else {
-        (F32_REL_TOLERANCE, "the f32 closed form")
-    };
     // The truth check beside the reference check: each evaluates the f64 reference of
     // every update.
     let (reference, truth) = std::thread::scope(|s| {
         let truth = s.spawn(|| {
             pass.truth
-                .agile()
+                .as_deref()
                 .map(|a| {
                     let dem = pass.dem.as_ref();
                     truth::check(a, &firmware, &controller, dem, &pass.terrain, &navs)
@@ -423,7 +315,8 @@ fn play(elf: &Path, pass: &Pass, plan: Option<reset::Plan>) -> Result<Played> {
                 .transpose()
         });
         let dem = pass.dem.as_ref();
-        let reference = reference_check(&firmware, &navs, &controller, rel_tolerance, dem);
+        let fixed = config.fixed_point_pixels;
+        let reference = reference_check(&firmware, &navs, &controller, fixed, dem);
         (reference, truth.join())
     });
     let reference = reference?;
@@ -434,21 +327,43 @@ fn play(elf: &Path, pass: &Pass, plan: Option<reset::Plan>) -> Result<Played> {
         twin_s + t_check.elapsed().as_secs_f64()
     );
 
+    let mut v = Verdict::default();
     let final_status = firmware.final_status().copied();
-    let faulty_twin_status = faulty_twin.final_status().copied();
-    let mut count_failures = Vec::new();
-    match (&final_status, &faulty_twin_status) {
+    let counted = stream.injected.iter().flatten().count();
+    let noise = stream.injected.len() - counted;
+    if noise > 0 {
+        let skipped = final_status.as_ref().map_or(0, |s| s.skipped_bytes);
+        v.say(format!(
+            "noise: {} bytes in {noise} burst(s) injected; the decoder skipped {skipped} bytes (the noise and the remains of the rejected frames)",
+            stream.noise_bytes()
+        ));
+    }
+    v.0.extend(reference.0);
+    if run.status != 0 {
+        v.fail(format!("the firmware exited with status {}", run.status));
+    }
+    // A reset comes between two frames, when the firmware has sent all it owed: it cuts
+    // none.
+    if firmware.bad_frames > 0 || firmware.skipped_bytes > 0 {
+        v.fail(format!(
+            "the downlink had {} bad frames and {} stray bytes",
+            firmware.bad_frames, firmware.skipped_bytes
+        ));
+    }
+    if let Some(n) = final_status.map(|s| s.downlink_dropped).filter(|&n| n > 0) {
+        v.fail(format!(
+            "the firmware dropped {n} downlink frames whole (its transmit queue had no room: STATUS)"
+        ));
+    }
+    changed_examples.into_iter().take(5).for_each(|e| v.fail(e));
+    match (&final_status, faulty_twin.final_status()) {
         // The counters start afresh at a reset: the recovery's own checks replace these.
         _ if reset.is_some() => {}
         (Some(fw), Some(host)) => {
             for f in Fault::ALL {
-                let expected = stream
-                    .injected
-                    .iter()
-                    .filter(|(_, e)| *e == Some(f))
-                    .count() as u32;
+                let expected = stream.injected.iter().filter(|e| **e == Some(f)).count() as u32;
                 if fw.count(f) != expected {
-                    count_failures.push(format!(
+                    v.fail(format!(
                         "fault counter {}: {} in the firmware's STATUS, {expected} injected",
                         f.name(),
                         fw.count(f)
@@ -456,7 +371,7 @@ fn play(elf: &Path, pass: &Pass, plan: Option<reset::Plan>) -> Result<Played> {
                 }
             }
             if fw != host {
-                count_failures.push(format!(
+                v.fail(format!(
                     "the firmware's final STATUS differs from the host run of the same bytes: {fw:?} vs {host:?}"
                 ));
             }
@@ -468,43 +383,41 @@ fn play(elf: &Path, pass: &Pass, plan: Option<reset::Plan>) -> Result<Played> {
                     d.in_force_id, d.tiles_committed, d.upload_id, g.nrows, g.ncols
                 );
                 if d.in_force_id != scenario::PASS_DEM_ID || d.tiles_committed != 1 {
-                    count_failures.push(format!(
+                    v.fail(format!(
                         "the DEM tile uploaded at the start is not in force: {d:?}"
                     ));
                 }
             }
         }
-        _ => count_failures.push("no final STATUS frame".into()),
+        _ => v.fail("no final STATUS frame".into()),
     }
     // Issues 23 and 24's stack budget, against the firmware's own high-water mark (its
     // last log line; after a reset, the one since the reset).
-    let marks: Vec<usize> = log
+    match run
+        .log
         .iter()
         .filter_map(|m| stack_high_water_bytes(m))
-        .collect();
-    match marks.iter().max() {
-        None => count_failures.push("the firmware logged no stack high-water mark".into()),
-        Some(&b) if b > STACK_BUDGET_BYTES => count_failures.push(format!(
+        .max()
+    {
+        None => v.fail("the firmware logged no stack high-water mark".into()),
+        Some(b) if b > STACK_BUDGET_BYTES => v.fail(format!(
             "stack high-water mark {b} bytes, over the budget of {STACK_BUDGET_BYTES}"
         )),
         Some(_) => {}
     }
+    if let Some(t) = &truth {
+        t.verdict(&mut v);
+    }
+    v.0.extend(reset.into_iter().flat_map(|r| r.0));
+    v.say(format!(
+        "faults: injected {counted}, rejected {}, outputs changed by faults {changed}",
+        final_status.as_ref().map_or(0, Status::total)
+    ));
     Ok(Played {
         tx_bytes: uplink.len(),
-        rx_bytes: downlink_bytes.len(),
+        rx_bytes: run.downlink.len(),
         firmware,
-        status,
-        injected: stream.injected.clone(),
-        noise_bytes: stream.noise_bytes(),
-        reference,
-        rel_tolerance,
-        tolerance_note,
-        changed,
-        changed_examples,
-        final_status,
-        count_failures,
-        truth,
-        reset,
+        verdict: v,
     })
 }
 
@@ -568,16 +481,25 @@ fn describe(p: Option<&Vec<u8>>) -> String {
 
 /// Every fresh (not held) period of the firmware against the f64 reference of the same
 /// update on the firmware's own inputs (`controller::golden`: the NAV frame and terrain
-/// in force, as the host twin had them). Returns the largest relative difference, the
-/// largest in ticks, the count, the failures.
+/// in force, as the host twin had them), within the tolerance of the f32 update (and of
+/// the `fixed_point_pixels`): the largest differences, the periods compared, how many of
+/// them matched only the reference turned by the firmware's f32 attitude rounding (a jump
+/// of the reference between two grounds), the failures.
 fn reference_check(
     firmware: &Downlink,
-    inputs: &BTreeMap<u64, check::InForce>,
+    inputs: &check::Inputs,
     controller: &controller::Controller,
-    rel_tolerance: f64,
+    fixed_point_pixels: bool,
     dem: Option<&(DemGrid, Vec<i16>)>,
-) -> Result<ReferenceCheck> {
-    use controller::golden::{bus_update, bus_update_on_dem};
+) -> Result<Verdict> {
+    let (rel_tolerance, tolerance_note) = if fixed_point_pixels {
+        (
+            F32_REL_TOLERANCE + EARTH_FIXED_REL_TOLERANCE,
+            "the f32 update and the fixed-point pixels",
+        )
+    } else {
+        (F32_REL_TOLERANCE, "the f32 closed form")
+    };
     let dem = match dem {
         Some((g, h)) => {
             Some(DemTile::new(*g, h).map_err(|e| anyhow!("the pass's DEM: {}", e.name()))?)
@@ -600,20 +522,9 @@ fn reference_check(
             ));
             continue;
         };
-        let (scene, plan, h) = (controller.scene(), controller.plan(), &input.heights_m[..]);
-        let t_gps = t_us + check::epoch_us();
-        let tile = match (&dem, input.dem) {
-            (Some(t), true) => Some(t),
-            _ => None,
-        };
-        let golden = match (&input.source, tile) {
-            (check::Source::Nav(nav), _) => controller::golden::update(scene, plan, h, nav, t_gps),
-            (check::Source::Bus(g, a, sc), None) => bus_update(scene, plan, h, g, a, sc, t_gps),
-            (check::Source::Bus(g, a, sc), Some(tile)) => {
-                bus_update_on_dem(scene, plan, h, g, a, sc, t_gps, tile)
-            }
-        }
-        .map_err(|e| anyhow!("reference at {t_us} us: {}", e.name()))?;
+        let golden = input
+            .reference(controller, t_us, dem.as_ref(), None)
+            .map_err(|e| anyhow!("reference at {t_us} us: {}", e.name()))?;
         for r in periods.records().iter().filter(|r| !r.held) {
             let Some(exact) = golden
                 .segments
@@ -630,16 +541,22 @@ fn reference_check(
                 // Where a sample's line of sight grazes a ridge, the reference itself
                 // jumps between two grounds for an attitude change far below the
                 // firmware's f32 rounding: compare with the reference turned by that.
-                let turned = match (&input.source, tile) {
-                    (check::Source::Bus(g, a, sc), tile) => turned_references(a, |a| match tile {
-                        Some(tile) => bus_update_on_dem(scene, plan, h, g, a, sc, t_gps, tile),
-                        None => bus_update(scene, plan, h, g, a, sc, t_gps),
-                    }),
-                    _ => Vec::new(),
+                let turned = match &input.source {
+                    check::Source::Bus(_, a, _) => turned_attitudes(a),
+                    check::Source::Nav(_) => Vec::new(),
                 };
+                let turned = turned.iter().filter_map(|a| {
+                    input
+                        .reference(controller, t_us, dem.as_ref(), Some(a))
+                        .ok()
+                });
                 let nearest = turned
-                    .iter()
-                    .filter_map(|u| u.segments.iter().flatten().find(|g| g.index == r.index))
+                    .filter_map(|u| {
+                        u.segments
+                            .into_iter()
+                            .flatten()
+                            .find(|g| g.index == r.index)
+                    })
                     .map(|g| (f64::from(r.ticks) - g.ticks_exact).abs())
                     .fold(f64::INFINITY, f64::min);
                 if nearest <= rel_tolerance * exact + 0.5 {
@@ -661,50 +578,38 @@ fn reference_check(
             }
         }
     }
-    Ok(ReferenceCheck {
-        max_rel,
-        max_ticks,
-        compared,
-        at_jumps,
-        failures,
-    })
+    let mut v = Verdict::default();
+    v.say(format!(
+        "reference: largest |ticks - reference| {max_ticks:.4} ticks (allowed: 0.5 for the rounding to whole ticks + {rel_tolerance:.0e} x ticks for {tolerance_note})"
+    ));
+    if compared == 0 {
+        v.fail("no period was compared with the reference".into());
+    }
+    failures.into_iter().take(5).for_each(|f| v.fail(f));
+    v.say(format!(
+        "reference check: max relative difference {max_rel:.3e} over {compared} periods ({at_jumps} at a jump of the reference between two grounds, compared with it turned by the firmware's f32 attitude rounding, {F32_ATTITUDE_RAD:.0e} rad)"
+    ));
+    Ok(v)
 }
 
 /// The f32 rounding of the attitude the firmware carries (rad): the quaternion
 /// (components to 6e-8), B rounded to f32 and turned in f32.
 const F32_ATTITUDE_RAD: f64 = 3e-7;
 
-/// The reference of `a` turned by +-[`F32_ATTITUDE_RAD`] about each body axis.
-fn turned_references(
-    a: &controller::bus::StarAttitude,
-    reference: impl Fn(
-        &controller::bus::StarAttitude,
-    ) -> Result<controller::golden::UpdateGolden, core_math::ModelError>,
-) -> Vec<controller::golden::UpdateGolden> {
+/// `a` turned by +-[`F32_ATTITUDE_RAD`] about each body axis.
+fn turned_attitudes(a: &controller::bus::StarAttitude) -> Vec<controller::bus::StarAttitude> {
     (0..6)
-        .filter_map(|k| {
+        .map(|k| {
             let mut e = [0.0f64; 3];
             e[k / 2] = if k % 2 == 0 { 0.5 } else { -0.5 } * F32_ATTITUDE_RAD;
             let q = bus::q_mul(a.q.map(f64::from), [1.0, e[0], e[1], e[2]]);
             let n = q.iter().map(|x| x * x).sum::<f64>().sqrt();
-            let turned = controller::bus::StarAttitude {
+            controller::bus::StarAttitude {
                 q: q.map(|x| (x / n) as f32),
                 ..*a
-            };
-            reference(&turned).ok()
+            }
         })
         .collect()
-}
-
-/// What the reference check found: the largest differences, the periods compared, how
-/// many of them matched only the reference turned by the firmware's f32 attitude
-/// rounding (a jump of the reference between two grounds), and the failures.
-struct ReferenceCheck {
-    max_rel: f64,
-    max_ticks: f64,
-    compared: usize,
-    at_jumps: usize,
-    failures: Vec<String>,
 }
 
 /// What a QEMU run of a pass gave.
@@ -984,7 +889,7 @@ fn print_table(pass: &Pass, played: &Played, every_s: u64, segments: &[u8]) {
 /// Roll, pitch and yaw flown at `t_us` (a built-in pass), or of the last NAV sample at
 /// or before it, propagated at their rates (deg).
 fn telemetry_attitude_deg(pass: &Pass, t_us: u64) -> Option<[f64; 3]> {
-    if let Some(truth) = pass.truth.agile() {
+    if let Some(truth) = pass.truth.as_deref() {
         let a = truth.attitude(t_us as f64 * 1e-6);
         return Some([a.roll_rad, a.pitch_rad, a.yaw_rad].map(f64::to_degrees));
     }
@@ -998,18 +903,4 @@ fn telemetry_attitude_deg(pass: &Pass, t_us: u64) -> Option<[f64; 3]> {
         (a.pitch_rad + a.pitch_rate_rad_s * dt).to_degrees(),
         (a.yaw_rad + a.yaw_rate_rad_s * dt).to_degrees(),
     ])
-}
-
-/// The line period of every segment over time, as programmed.
-fn plot_periods(pass: &Pass, played: &Played, path: &Path) -> Result<()> {
-    let plot = Plot::new(
-        &format!("Line periods programmed by the firmware, {}", pass.name),
-        "time (s)",
-        "line period (ms)",
-    );
-    if let Some(dir) = path.parent() {
-        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-    }
-    let series = plots::per_segment(&played.firmware, true, |r| f64::from(r.ticks) * 1e-4);
-    plots::save(pass, plot, series, path)
 }

@@ -8,11 +8,13 @@ use std::sync::atomic::{AtomicU64, Ordering};
 
 use controller::bus::{Gnss, StarAttitude};
 use controller::frame::{kind, Decoder, Event};
-use controller::golden::NavInput;
+use controller::golden::{self, NavInput, UpdateGolden};
 use controller::report::{Periods, Status};
 use controller::session::Session;
 use controller::{Config, Controller, LinePeriodSink, Scene};
+use core_math::earth::dem::DemTile;
 use core_math::earth::frames::TimeScales;
+use core_math::ModelError;
 
 /// GPS time of the pass's t = 0 (us): frames carry GPS time, the checks and reports
 /// pass time. One pass is played at a time; `scenario::build` and `play` set it.
@@ -105,85 +107,143 @@ pub struct InForce {
     pub dem: bool,
 }
 
+impl InForce {
+    /// The f64 reference of the update at pass time `t_us` on these inputs
+    /// (`controller::golden`), on the pass's DEM `tile` if one was in force, with the
+    /// star tracker's attitude `turned` instead of the one received when given.
+    pub fn reference(
+        &self,
+        c: &Controller,
+        t_us: u64,
+        tile: Option<&DemTile<'_, i16>>,
+        turned: Option<&StarAttitude>,
+    ) -> Result<UpdateGolden, ModelError> {
+        let (scene, plan, h) = (c.scene(), c.plan(), &self.heights_m[..]);
+        let t_gps = t_us + epoch_us();
+        match (&self.source, tile.filter(|_| self.dem)) {
+            (Source::Nav(nav), _) => golden::update(scene, plan, h, nav, t_gps),
+            (Source::Bus(g, a, sc), None) => {
+                golden::bus_update(scene, plan, h, g, turned.unwrap_or(a), sc, t_gps)
+            }
+            (Source::Bus(g, a, sc), Some(tile)) => {
+                let a = turned.unwrap_or(a);
+                golden::bus_update_on_dem(scene, plan, h, g, a, sc, t_gps, tile)
+            }
+        }
+    }
+}
+
 #[derive(Clone, Debug)]
 pub enum Source {
     Nav(NavInput),
     Bus(Gnss, StarAttitude, TimeScales),
 }
 
-/// A host run of `bytes` through a `Session`, as the firmware does, byte by byte.
-/// Also returns the NAV frame and terrain in force at each update (the inputs of the
-/// reference check).
-pub fn twin(bytes: &[u8], config: Config) -> Result<(Downlink, BTreeMap<u64, InForce>)> {
-    Ok(twin_of(Session::new(new_controller(config)?), bytes))
+/// The inputs in force at each update, by update instant.
+pub type Inputs = BTreeMap<u64, InForce>;
+
+/// A host run of the firmware's session: the session after it, the frames it sent, and
+/// the inputs in force at each update (the reference check's).
+pub struct HostRun {
+    pub session: Session,
+    pub sent: Vec<u8>,
+    pub inputs: Inputs,
 }
 
-/// [`twin`] from `session` on.
-fn twin_of(mut session: Session, bytes: &[u8]) -> (Downlink, BTreeMap<u64, InForce>) {
-    let mut out = Vec::new();
-    let mut inputs = BTreeMap::new();
-    for &b in bytes {
-        let mut periods_sent = false;
-        let ended = session.feed(&[b], &mut Accept, |frame| {
-            periods_sent |= frame.get(3) == Some(&kind::PERIODS);
-            out.extend_from_slice(frame);
-        });
-        if periods_sent {
-            let c = &session.controller;
-            let source = match (c.nav(), c.gnss(), c.bus_attitude()) {
-                (Some(nav), ..) => Some(Source::Nav(NavInput {
-                    state: nav.propagator.state,
-                    attitude: nav.attitude,
-                    time_us: nav.time_us,
-                })),
-                (None, Some(g), Some(a)) => {
-                    // The fix as received: v = v_I - w x r.
-                    let (r, v, w) = (
-                        g.propagator.state.position_m,
-                        g.propagator.state.velocity_mps,
-                        core_math::EARTH_RATE_RAD_S,
-                    );
-                    let gnss = Gnss {
-                        fix_us: g.fix_us,
-                        position_m: r,
-                        velocity_mps: [v[0] + w * r[1], v[1] - w * r[0], v[2]],
-                    };
-                    Some(Source::Bus(gnss, a.received, *c.time_scales()))
+impl HostRun {
+    /// A session after power-on fed `bytes`.
+    pub fn new(bytes: &[u8], config: Config) -> Result<HostRun> {
+        Ok(HostRun::from(Session::new(new_controller(config)?), bytes))
+    }
+
+    /// The host's model of a reset between two frames: `prefix` after power-on, then a
+    /// core that comes up with `cause` (its `resets`-th since power-on), restores the
+    /// snapshot the first session kept, and runs `suffix`: the frames both sent, as the
+    /// firmware's downlink would carry them, and the inputs both had in force (the
+    /// attitude blend restarted by the reset included).
+    pub fn reset(
+        prefix: &[u8],
+        suffix: &[u8],
+        cause: controller::fault::ResetCause,
+        resets: u32,
+        config: Config,
+    ) -> Result<HostRun> {
+        let HostRun {
+            session,
+            mut sent,
+            mut inputs,
+        } = HostRun::new(prefix, config)?;
+        let after = Session::new(restarted(session, cause, resets, config)?);
+        let after = HostRun::from(after, suffix);
+        sent.extend_from_slice(&after.sent);
+        inputs.extend(after.inputs);
+        Ok(HostRun {
+            sent,
+            inputs,
+            ..after
+        })
+    }
+
+    /// `bytes` through `session` byte by byte, as the firmware takes them.
+    fn from(mut session: Session, bytes: &[u8]) -> HostRun {
+        let mut sent = Vec::new();
+        let mut inputs = BTreeMap::new();
+        for &b in bytes {
+            let mut periods_sent = false;
+            let ended = session.feed(&[b], &mut Accept, |frame| {
+                periods_sent |= frame.get(3) == Some(&kind::PERIODS);
+                sent.extend_from_slice(frame);
+            });
+            if let (true, Some(t)) = (periods_sent, session.controller.last_update_us()) {
+                if let Some(in_force) = in_force(&session.controller) {
+                    inputs.insert(pass_us(t), in_force);
                 }
-                _ => None,
-            };
-            if let (Some(source), Some(t)) = (source, c.last_update_us()) {
-                inputs.insert(
-                    pass_us(t),
-                    InForce {
-                        source,
-                        heights_m: c.heights_m().to_vec(),
-                        dem: c.dem_tile().is_some(),
-                    },
-                );
+            }
+            if ended {
+                break;
             }
         }
-        if ended {
-            break;
+        HostRun {
+            session,
+            sent,
+            inputs,
         }
     }
-    (Downlink::decode(&out), inputs)
+
+    pub fn downlink(&self) -> Downlink {
+        Downlink::decode(&self.sent)
+    }
 }
 
-/// The inputs in force at each update of a host run of the reset's model
-/// ([`reset_twin`]): what the firmware had in force, the attitude blend restarted by
-/// the reset included.
-pub fn reset_inputs(
-    prefix: &[u8],
-    suffix: &[u8],
-    config: Config,
-) -> Result<BTreeMap<u64, InForce>> {
-    let mut inputs = twin(prefix, config)?.1;
-    let (before, _) = host_run(prefix, config)?;
-    let cause = controller::fault::ResetCause::ALL[0];
-    let after = restarted(before, cause, 1, config)?;
-    inputs.extend(twin_of(Session::new(after), suffix).1);
-    Ok(inputs)
+/// What `c` has in force for its update.
+fn in_force(c: &Controller) -> Option<InForce> {
+    let source = match (c.nav(), c.gnss(), c.bus_attitude()) {
+        (Some(nav), ..) => Source::Nav(NavInput {
+            state: nav.propagator.state,
+            attitude: nav.attitude,
+            time_us: nav.time_us,
+        }),
+        (None, Some(g), Some(a)) => {
+            // The fix as received: v = v_I - w x r.
+            let (r, v, w) = (
+                g.propagator.state.position_m,
+                g.propagator.state.velocity_mps,
+                core_math::EARTH_RATE_RAD_S,
+            );
+            let gnss = Gnss {
+                fix_us: g.fix_us,
+                position_m: r,
+                velocity_mps: [v[0] + w * r[1], v[1] - w * r[0], v[2]],
+            };
+            Source::Bus(gnss, a.received, *c.time_scales())
+        }
+        _ => return None,
+    };
+    Some(InForce {
+        source,
+        heights_m: c.heights_m().to_vec(),
+        dem: c.dem_tile().is_some(),
+    })
 }
 
 /// Relative tolerance of the f32 general form against the reference (the rounding to
@@ -196,24 +256,6 @@ pub const F32_REL_TOLERANCE: f64 = 1e-6;
 /// backend's target from 1 deg of the limb outward, which its error bound and survey
 /// meet (docs/fixed-point.md, "The error bound").
 pub const EARTH_FIXED_REL_TOLERANCE: f64 = 2e-6;
-
-/// The host's model of a reset between two frames: `prefix` through a session, then a
-/// core that comes up with `cause` (its `resets`-th since power-on), restores the
-/// snapshot the first session kept, and runs `suffix`. Returns the frames each part
-/// sent, as the firmware's downlink would carry them.
-pub fn reset_twin(
-    prefix: &[u8],
-    suffix: &[u8],
-    cause: controller::fault::ResetCause,
-    resets: u32,
-    config: Config,
-) -> Result<(Vec<u8>, Vec<u8>)> {
-    let (before, out_before) = host_run(prefix, config)?;
-    let mut after = Session::new(restarted(before, cause, resets, config)?);
-    let mut out_after = Vec::new();
-    after.feed(suffix, &mut Accept, |f| out_after.extend_from_slice(f));
-    Ok((out_before, out_after))
-}
 
 /// The controller after a reset of `before`'s: blank, its snapshot restored, the DEM
 /// tile memory kept.
@@ -265,14 +307,6 @@ pub fn cut_before(uplink: &[u8], at_us: u64) -> usize {
         }
     }
     cut
-}
-
-/// A session after power-on fed `bytes`, and the frames it sent.
-pub fn host_run(bytes: &[u8], config: Config) -> Result<(Session, Vec<u8>)> {
-    let mut session = Session::new(new_controller(config)?);
-    let mut out = Vec::new();
-    session.feed(bytes, &mut Accept, |f| out.extend_from_slice(f));
-    Ok((session, out))
 }
 
 /// How many whole frames `bytes` holds.

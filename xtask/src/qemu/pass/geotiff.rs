@@ -8,12 +8,13 @@ use anyhow::{anyhow, bail, Context, Result};
 use core_math::earth::dem::{DemGrid, DemTile};
 use core_math::earth::frames::{self, TimeScales};
 use core_math::earth::{Attitude, EarthGeometry};
-use core_math::vector::dot;
+use core_math::vector::{add, dot, scale};
 use core_math::EARTH_RATE_RAD_S;
 use std::path::Path;
 use tiff::decoder::{Decoder, DecodingResult};
 use tiff::tags::Tag;
 
+use super::bus::{mat_vec, transpose};
 use super::scenario::{self, Manoeuvres};
 
 /// The tile shipped with the repository, relative to the workspace root.
@@ -129,25 +130,14 @@ pub fn write(path: &Path) -> Result<()> {
         Tag::ModelTiepointTag,
         &[0.0, 0.0, 0.0, west, north, 0.0][..],
     )?;
-    let keys: [u16; 16] = [
-        1,
-        1,
-        0,
-        3,
-        MODEL_TYPE,
-        0,
-        1,
-        2,
-        RASTER_TYPE,
-        0,
-        1,
-        2,
-        GEOGRAPHIC_TYPE,
-        0,
-        1,
-        4326,
+    // The header (version 1.1.0, 3 keys), then each key: id, location, count, value.
+    let keys: [[u16; 4]; 4] = [
+        [1, 1, 0, 3],
+        [MODEL_TYPE, 0, 1, 2],
+        [RASTER_TYPE, 0, 1, 2],
+        [GEOGRAPHIC_TYPE, 0, 1, 4326],
     ];
-    tags.write_tag(Tag::GeoKeyDirectoryTag, &keys[..])?;
+    tags.write_tag(Tag::GeoKeyDirectoryTag, keys.as_flattened())?;
     image.write_data(&rows)?;
     let (min, max) = rows
         .iter()
@@ -206,20 +196,16 @@ fn look_centre() -> Result<(f64, f64)> {
         let c2t = frames::c2t(gps0_s + orbit_s, &scales).map_err(|e| anyhow!(e.name()))?;
         let b = g.attitude.camera_to_inertial;
         let r = state.position_m;
-        {
-            let d: [f64; 3] = std::array::from_fn(|i| -b[i][2]);
-            let (dd, rd, rr) = (dot(d, d), dot(r, d), dot(r, r));
-            let s = (-rd - (rd * rd - dd * (rr - 6.371e6f64.powi(2))).sqrt()) / dd;
-            let x0: [f64; 3] = std::array::from_fn(|i| r[i] + s * d[i]);
-            // I (the ITRF at the epoch) to the ITRF at the instant.
-            let gcrf: [f64; 3] = std::array::from_fn(|i| (0..3).map(|k| c2t0[k][i] * x0[k]).sum());
-            let x: [f64; 3] = std::array::from_fn(|i| (0..3).map(|k| c2t[i][k] * gcrf[k]).sum());
-            let (la, lo, _) =
-                frames::geodetic_from_itrf(x, &controller::EARTH).map_err(|e| anyhow!(e.name()))?;
-            let (la, lo) = (la.to_degrees(), lo.to_degrees());
-            lat = (lat.0.min(la), lat.1.max(la));
-            lon = (lon.0.min(lo), lon.1.max(lo));
-        }
+        let d: [f64; 3] = std::array::from_fn(|i| -b[i][2]);
+        let (dd, rd, rr) = (dot(d, d), dot(r, d), dot(r, r));
+        let s = (-rd - (rd * rd - dd * (rr - 6.371e6f64.powi(2))).sqrt()) / dd;
+        // I (the ITRF at the epoch) to the ITRF at the instant.
+        let x = mat_vec(&c2t, mat_vec(&transpose(&c2t0), add(r, scale(s, d))));
+        let (la, lo, _) =
+            frames::geodetic_from_itrf(x, &controller::EARTH).map_err(|e| anyhow!(e.name()))?;
+        let (la, lo) = (la.to_degrees(), lo.to_degrees());
+        lat = (lat.0.min(la), lat.1.max(la));
+        lon = (lon.0.min(lo), lon.1.max(lo));
     }
     println!(
         "the looks span {:.2}..{:.2} N, {:.2}..{:.2} E",

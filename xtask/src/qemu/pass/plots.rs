@@ -12,7 +12,7 @@ use super::scenario::Pass;
 
 /// One series per segment of `value` over the pass, from every record (only those not
 /// held unless `with_held`).
-pub(super) fn per_segment(
+fn per_segment(
     firmware: &Downlink,
     with_held: bool,
     value: impl Fn(&controller::SegmentOutput) -> f64,
@@ -37,12 +37,7 @@ fn framed(pass: &Pass, plot: Plot) -> Plot {
 }
 
 /// `plot` with one series per segment, written to `path`.
-pub(super) fn save(
-    pass: &Pass,
-    plot: Plot,
-    series: BTreeMap<u8, Vec<(f64, f64)>>,
-    path: &Path,
-) -> Result<()> {
+fn save(pass: &Pass, plot: Plot, series: BTreeMap<u8, Vec<(f64, f64)>>, path: &Path) -> Result<()> {
     let mut plot = framed(pass, plot);
     for (i, (index, points)) in series.into_iter().enumerate() {
         plot = plot.series(Series::line(&format!("segment {index}"), points).palette(i));
@@ -50,9 +45,22 @@ pub(super) fn save(
     plot.save(path)
 }
 
-/// Writes drift.png, mtf.png, terrain.png and yaw.png into `dir`.
-pub fn pass_plots(pass: &Pass, firmware: &Downlink, dir: &Path) -> Result<()> {
+/// Writes the line periods programmed by the firmware to `periods` (and says so), and
+/// drift.png, mtf.png, terrain.png and yaw.png beside it.
+pub fn pass_plots(pass: &Pass, firmware: &Downlink, periods: &Path) -> Result<()> {
+    let dir = periods.parent().unwrap_or(Path::new(""));
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    save(
+        pass,
+        Plot::new(
+            &format!("Line periods programmed by the firmware, {}", pass.name),
+            "time (s)",
+            "line period (ms)",
+        ),
+        per_segment(firmware, true, |r| f64::from(r.ticks) * 1e-4),
+        periods,
+    )?;
+    println!("plot: {}", periods.display());
     save(
         pass,
         Plot::new(
@@ -112,7 +120,7 @@ pub fn pass_plots(pass: &Pass, firmware: &Downlink, dir: &Path) -> Result<()> {
                 .map(|y| (*t as f64 * 1e-6, f64::from(y) * 1e3))
         })
         .collect();
-    let flown: Vec<(f64, f64)> = match pass.truth.agile() {
+    let flown: Vec<(f64, f64)> = match pass.truth.as_deref() {
         Some(truth) => truth
             .yaw
             .iter()

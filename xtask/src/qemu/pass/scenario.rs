@@ -226,67 +226,43 @@ impl AgileTruth {
     }
 }
 
-/// The state the reference check holds the firmware to.
-#[derive(Clone, Debug)]
-pub enum Truth {
-    /// A built-in pass: orbit, attitude, terrain, exact at any instant.
-    Agile(Box<AgileTruth>),
-    /// A user's file: only the telemetry is known.
-    Telemetry,
-}
-
-impl Truth {
-    pub fn agile(&self) -> Option<&AgileTruth> {
-        match self {
-            Truth::Agile(a) => Some(a),
-            Truth::Telemetry => None,
-        }
-    }
-}
-
-/// A fault to inject, at a time in seconds.
+/// A fault to inject at a pass time `t_s` (the time of its entry in [`Pass::faults`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub enum FaultSpec {
+pub enum Inject {
     /// One bit of the NAV frame at `t_s` flipped in its payload (the frame is lost).
-    BitFlip { t_s: f64 },
+    BitFlip,
     /// The NAV frame at `t_s` cut short after its header and 20 payload bytes.
-    Truncate { t_s: f64 },
+    Truncate,
     /// `bytes` bytes of line noise (never a sync byte) after the frame at `t_s`.
-    Noise { t_s: f64, bytes: usize },
+    Noise { bytes: usize },
     /// After the frame at `t_s`, a good NAV frame time-tagged `back_s` earlier.
-    Backwards { t_s: f64, back_s: f64 },
+    Backwards { back_s: f64 },
     /// An extra NAV frame at `t_s` with a NaN velocity component.
-    NaN { t_s: f64 },
+    NaN,
     /// An extra NAV frame at `t_s` placing the spacecraft at `altitude_m`.
-    Altitude { t_s: f64, altitude_m: f64 },
-    /// No NAV frame strictly between `from_s` and `from_s + len_s` (TIME goes on).
-    Gap { from_s: f64, len_s: f64 },
+    Altitude { altitude_m: f64 },
+    /// No NAV frame strictly between `t_s` and `t_s + len_s` (TIME goes on).
+    Gap { len_s: f64 },
     /// After the frame at `t_s`, a TIME frame (valid CRC) tagged `tag_us`: beyond the
     /// time window, so refused as `time_jump` (issue 13's first defect).
-    TimeTag { t_s: f64, tag_us: u64 },
+    TimeTag { tag_us: u64 },
     /// An extra SCENE frame at `t_s` that the camera cannot use: refused as
     /// `invalid_scene` (issue 13's third defect).
-    BadScene { t_s: f64, probe: SceneProbe },
+    BadScene(SceneProbe),
     /// An extra TERRAIN frame at `t_s` with every height `height_m` (outside
     /// -500..=9 000 m): refused as `out_of_range`.
-    Terrain { t_s: f64, height_m: f32 },
+    Terrain { height_m: f32 },
     /// An extra NAV frame at `t_s` whose roll rate (0.5 rad/s) would carry it out of
     /// the scene's envelope: refused as `attitude_outside_model` (issue 12).
-    Envelope { t_s: f64 },
+    Envelope,
     /// An extra DEM frame at `t_s` the camera refuses (issue 23).
-    Dem { t_s: f64, probe: DemProbe },
-    /// An extra bus frame at `t_s` the camera refuses (issue 23).
-    Bus { t_s: f64, probe: BusProbe },
-}
-
-/// The bus frames the pass injects, each refused alone.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum BusProbe {
-    /// An ATTITUDE whose quaternion's norm is 1.01: `bad_quaternion`.
+    Dem(DemProbe),
+    /// An extra ATTITUDE at `t_s` whose quaternion's norm is 1.01: `bad_quaternion`
+    /// (issue 23).
     Quaternion,
-    /// A GNSS fix a second after its frame's tag: `fix_time`.
+    /// An extra GNSS frame at `t_s` whose fix is a second after its tag: `fix_time`.
     FixAfterTag,
-    /// TIME_SCALES with 70 leap seconds: `time_scales`.
+    /// An extra TIME_SCALES at `t_s` with 70 leap seconds: `time_scales`.
     LeapSeconds,
 }
 
@@ -317,14 +293,6 @@ pub fn pass_scene(bus: bool) -> controller::Scene {
 pub const PASS_DEM_ID: u32 = 23;
 
 impl DemProbe {
-    pub fn label(&self) -> &'static str {
-        match self {
-            DemProbe::Pole => "a tile past 88 deg",
-            DemProbe::StrayChunk => "a chunk of no upload",
-            DemProbe::SameId => "the id of the tile in force",
-        }
-    }
-
     /// The payload's kind, the payload, and the fault it must be refused with.
     pub fn frame(&self, (grid, heights): &(DemGrid, Vec<i16>)) -> (u8, Vec<u8>, Fault) {
         let (grid, crc) = (*grid, controller::dem::heights_crc32(heights));
@@ -375,16 +343,6 @@ impl SceneProbe {
         SceneProbe::Segments17,
     ];
 
-    pub fn label(&self) -> &'static str {
-        match self {
-            SceneProbe::ActiveByte2 => "active byte 2",
-            SceneProbe::Stages65535 => "65 535 TDI stages",
-            SceneProbe::NoneActive => "no active segment",
-            SceneProbe::Overlap => "overlapping segments",
-            SceneProbe::Segments17 => "17 segments",
-        }
-    }
-
     /// The SCENE payload: the paper's scene, then the edit.
     pub fn payload(&self) -> Vec<u8> {
         use controller::scene::{SCENE_HEADER_LEN, SEGMENT_LEN};
@@ -423,34 +381,6 @@ impl SceneProbe {
     }
 }
 
-impl FaultSpec {
-    pub fn label(&self) -> String {
-        match self {
-            FaultSpec::BitFlip { t_s } => format!("bit flip in the frame at {t_s} s"),
-            FaultSpec::Truncate { t_s } => format!("truncated frame at {t_s} s"),
-            FaultSpec::Noise { t_s, bytes } => format!("{bytes} noise bytes at {t_s} s"),
-            FaultSpec::Backwards { t_s, back_s } => {
-                format!("GNSS time-tagged {back_s} s back at {t_s} s")
-            }
-            FaultSpec::NaN { t_s } => format!("NaN velocity in GNSS at {t_s} s"),
-            FaultSpec::Altitude { t_s, altitude_m } => {
-                format!("altitude {} km in GNSS at {t_s} s", altitude_m / 1e3)
-            }
-            FaultSpec::Gap { from_s, len_s } => format!("{len_s} s bus gap from {from_s} s"),
-            FaultSpec::TimeTag { t_s, tag_us } => format!("TIME tagged {tag_us} us at {t_s} s"),
-            FaultSpec::BadScene { t_s, probe } => {
-                format!("SCENE with {} at {t_s} s", probe.label())
-            }
-            FaultSpec::Terrain { t_s, height_m } => {
-                format!("TERRAIN at {height_m} m at {t_s} s")
-            }
-            FaultSpec::Envelope { t_s } => format!("ATTITUDE rolling at 0.5 rad/s at {t_s} s"),
-            FaultSpec::Dem { t_s, probe } => format!("DEM frame with {} at {t_s} s", probe.label()),
-            FaultSpec::Bus { t_s, probe } => format!("{probe:?} bus frame at {t_s} s"),
-        }
-    }
-}
-
 /// A pass: telemetry, truth, faults.
 #[derive(Clone, Debug)]
 pub struct Pass {
@@ -463,8 +393,11 @@ pub struct Pass {
     pub tick_us: u64,
     /// Last instant of the pass (us): TIME frames run up to it.
     pub end_us: u64,
-    pub truth: Truth,
-    pub faults: Vec<FaultSpec>,
+    /// A built-in pass's truth: orbit, attitude, terrain, exact at any instant (None: a
+    /// user's file, of which only the telemetry is known).
+    pub truth: Option<Box<AgileTruth>>,
+    /// The faults to inject, each at its pass time (s).
+    pub faults: Vec<(f64, Inject)>,
     /// The DEM tile uploaded before imaging (the built-in passes'), grid and heights.
     pub dem: Option<(DemGrid, Vec<i16>)>,
     /// GPS time of t = 0 (us): the frames' time tags are this plus pass time.
@@ -561,7 +494,8 @@ pub struct Manoeuvres {
     pub duration_s: f64,
     pub roll: Profile,
     pub pitch: Profile,
-    pub faults: Vec<FaultSpec>,
+    /// The faults to inject, each at its pass time (s).
+    pub faults: Vec<(f64, Inject)>,
 }
 
 /// Plays `m` through a host run of the firmware's controller to fly the yaw it asks
@@ -576,8 +510,8 @@ pub fn build(m: Manoeuvres, dem: (DemGrid, Vec<i16>), tick_us: u64) -> Result<Pa
     let epoch_us = EPOCH_GPS_US + us(m.start_s);
     super::check::set_epoch(epoch_us);
     let in_gap = |t_us: u64| {
-        m.faults.iter().any(|f| match *f {
-            FaultSpec::Gap { from_s, len_s } => t_us > us(from_s) && t_us < us(from_s + len_s),
+        m.faults.iter().any(|&(t_s, f)| match f {
+            Inject::Gap { len_s } => t_us > us(t_s) && t_us < us(t_s + len_s),
             _ => false,
         })
     };
@@ -697,7 +631,7 @@ pub fn build(m: Manoeuvres, dem: (DemGrid, Vec<i16>), tick_us: u64) -> Result<Pa
         terrain,
         tick_us,
         end_us,
-        truth: Truth::Agile(Box::new(truth)),
+        truth: Some(Box::new(truth)),
         faults: m.faults,
         dem: Some(dem),
         epoch_us,
@@ -726,40 +660,30 @@ pub fn terrain_payload(heights: &[f32]) -> Vec<u8> {
 /// The link probes of issue 13 from `t0_s` on: a TIME frame tagged 2^64 - 1, one an
 /// hour ahead, then each SCENE the camera cannot use; every one must be refused under
 /// its own counter and change nothing.
-pub fn link_probes(t0_s: f64) -> Vec<FaultSpec> {
+fn link_probes(t0_s: f64) -> Vec<(f64, Inject)> {
     let mut out = vec![
-        FaultSpec::TimeTag {
-            t_s: t0_s,
-            tag_us: u64::MAX,
-        },
-        FaultSpec::TimeTag {
-            t_s: t0_s + 0.5,
-            tag_us: us(t0_s + 0.5 + 3600.0),
-        },
+        (t0_s, Inject::TimeTag { tag_us: u64::MAX }),
+        (
+            t0_s + 0.5,
+            Inject::TimeTag {
+                tag_us: us(t0_s + 0.5 + 3600.0),
+            },
+        ),
     ];
     for (k, probe) in SceneProbe::ALL.into_iter().enumerate() {
-        out.push(FaultSpec::BadScene {
-            t_s: t0_s + 1.005 + 0.001 * k as f64,
-            probe,
-        });
+        out.push((t0_s + 1.005 + 0.001 * k as f64, Inject::BadScene(probe)));
     }
     out
 }
 
 /// The bus probes of issue 23 from `t0_s` on, a second apart.
-fn bus_probes(t0_s: f64) -> Vec<FaultSpec> {
+fn bus_probes(t0_s: f64) -> [(f64, Inject); 3] {
+    use Inject::{FixAfterTag, LeapSeconds, Quaternion};
     [
-        BusProbe::Quaternion,
-        BusProbe::FixAfterTag,
-        BusProbe::LeapSeconds,
+        (t0_s, Quaternion),
+        (t0_s + 1.0, FixAfterTag),
+        (t0_s + 2.0, LeapSeconds),
     ]
-    .into_iter()
-    .enumerate()
-    .map(|(k, probe)| FaultSpec::Bus {
-        t_s: t0_s + k as f64,
-        probe,
-    })
-    .collect()
 }
 
 fn deg(corners: &[(f64, f64)]) -> Profile {
@@ -783,33 +707,19 @@ pub fn default_pass(dem: (DemGrid, Vec<i16>), tick_us: u64) -> Result<Pass> {
 
 /// The default pass's manoeuvres, terrain and faults.
 pub fn default_manoeuvres() -> Manoeuvres {
+    use Inject::*;
     let mut faults = vec![
-        FaultSpec::BitFlip { t_s: 30.0 },
-        FaultSpec::BitFlip { t_s: 70.5 },
-        FaultSpec::Truncate { t_s: 120.2 },
-        FaultSpec::Noise {
-            t_s: 150.0,
-            bytes: 48,
-        },
-        FaultSpec::Backwards {
-            t_s: 190.0,
-            back_s: 1.0,
-        },
-        FaultSpec::Terrain {
-            t_s: 230.335,
-            height_m: 9_500.0,
-        },
-        FaultSpec::Envelope { t_s: 240.125 },
-        FaultSpec::NaN { t_s: 250.125 },
-        FaultSpec::Altitude {
-            t_s: 310.125,
-            altitude_m: 100e3,
-        },
-        FaultSpec::BitFlip { t_s: 410.0 },
-        FaultSpec::Gap {
-            from_s: 520.0,
-            len_s: 2.0,
-        },
+        (30.0, BitFlip),
+        (70.5, BitFlip),
+        (120.2, Truncate),
+        (150.0, Noise { bytes: 48 }),
+        (190.0, Backwards { back_s: 1.0 }),
+        (230.335, Terrain { height_m: 9_500.0 }),
+        (240.125, Envelope),
+        (250.125, NaN),
+        (310.125, Altitude { altitude_m: 100e3 }),
+        (410.0, BitFlip),
+        (520.0, Gap { len_s: 2.0 }),
     ];
     faults.extend(link_probes(160.0));
     faults.extend(bus_probes(200.125));
@@ -831,44 +741,21 @@ pub fn short_pass(dem: (DemGrid, Vec<i16>), tick_us: u64) -> Result<Pass> {
 
 /// The short pass's manoeuvres, terrain and faults.
 pub fn short_manoeuvres() -> Manoeuvres {
+    use Inject::*;
     let mut faults = vec![
-        FaultSpec::BitFlip { t_s: 5.0 },
-        FaultSpec::Truncate { t_s: 8.0 },
-        FaultSpec::Noise {
-            t_s: 12.0,
-            bytes: 40,
-        },
-        FaultSpec::Backwards {
-            t_s: 15.0,
-            back_s: 0.5,
-        },
-        FaultSpec::NaN { t_s: 18.125 },
-        FaultSpec::Terrain {
-            t_s: 22.335,
-            height_m: -800.0,
-        },
-        FaultSpec::Envelope { t_s: 24.125 },
-        FaultSpec::Altitude {
-            t_s: 26.125,
-            altitude_m: 100e3,
-        },
-        FaultSpec::BitFlip { t_s: 40.0 },
-        FaultSpec::Gap {
-            from_s: 52.0,
-            len_s: 2.0,
-        },
-        FaultSpec::Dem {
-            t_s: 33.0105,
-            probe: DemProbe::Pole,
-        },
-        FaultSpec::Dem {
-            t_s: 33.0305,
-            probe: DemProbe::StrayChunk,
-        },
-        FaultSpec::Dem {
-            t_s: 33.0505,
-            probe: DemProbe::SameId,
-        },
+        (5.0, BitFlip),
+        (8.0, Truncate),
+        (12.0, Noise { bytes: 40 }),
+        (15.0, Backwards { back_s: 0.5 }),
+        (18.125, NaN),
+        (22.335, Terrain { height_m: -800.0 }),
+        (24.125, Envelope),
+        (26.125, Altitude { altitude_m: 100e3 }),
+        (40.0, BitFlip),
+        (52.0, Gap { len_s: 2.0 }),
+        (33.0105, Dem(DemProbe::Pole)),
+        (33.0305, Dem(DemProbe::StrayChunk)),
+        (33.0505, Dem(DemProbe::SameId)),
     ];
     faults.extend(link_probes(28.0));
     faults.extend(bus_probes(34.125));
@@ -913,41 +800,34 @@ pub fn from_csv(path: &std::path::Path, tick_us: u64) -> Result<Pass> {
     let cols = table.columns(&CSV_COLUMNS)?;
     let mut samples = Vec::with_capacity(table.rows.len());
     for (i, row) in table.rows.iter().enumerate() {
-        let line = i + 2;
-        let field = |k: usize| -> Result<f64> {
+        let at = || format!("{}: line {}", path.display(), i + 2);
+        let mut v = [0.0f64; CSV_COLUMNS.len()];
+        for ((x, &col), name) in v.iter_mut().zip(&cols).zip(CSV_COLUMNS) {
             let text = row
-                .get(cols[k])
-                .with_context(|| format!("{}: line {line}: too few fields", path.display()))?;
-            text.parse::<f64>().map_err(|_| {
-                anyhow!(
-                    "{}: line {line}: `{text}` is not a number ({})",
-                    path.display(),
-                    CSV_COLUMNS[k]
-                )
-            })
-        };
-        let t_s = field(0)?;
-        if !(0.0..1e9).contains(&t_s) {
-            bail!("{}: line {line}: time {t_s} s out of range", path.display());
+                .get(col)
+                .with_context(|| format!("{}: too few fields", at()))?;
+            *x = (text.parse())
+                .map_err(|_| anyhow!("{}: `{text}` is not a number ({name})", at()))?;
         }
-        let v = |k: usize| field(k);
-        samples.push(Sample {
-            t_us: us(t_s),
-            msg: Msg::Nav(Nav {
-                state: StateVector {
-                    position_m: [v(1)?, v(2)?, v(3)?],
-                    velocity_mps: [v(4)?, v(5)?, v(6)?],
-                },
-                attitude: Attitude {
-                    roll_rad: v(7)? as f32,
-                    pitch_rad: v(8)? as f32,
-                    yaw_rad: v(9)? as f32,
-                    roll_rate_rad_s: v(10)? as f32,
-                    pitch_rate_rad_s: v(11)? as f32,
-                    yaw_rate_rad_s: v(12)? as f32,
-                },
-            }),
-        });
+        let [t_s, rx, ry, rz, vx, vy, vz, a @ ..] = v;
+        if !(0.0..1e9).contains(&t_s) {
+            bail!("{}: time {t_s} s out of range", at());
+        }
+        let [roll, pitch, yaw, roll_rate, pitch_rate, yaw_rate] = a.map(|x| x as f32);
+        let state = StateVector {
+            position_m: [rx, ry, rz],
+            velocity_mps: [vx, vy, vz],
+        };
+        let attitude = Attitude {
+            roll_rad: roll,
+            pitch_rad: pitch,
+            yaw_rad: yaw,
+            roll_rate_rad_s: roll_rate,
+            pitch_rate_rad_s: pitch_rate,
+            yaw_rate_rad_s: yaw_rate,
+        };
+        let msg = Msg::Nav(Nav { state, attitude });
+        samples.push(Sample { t_us: us(t_s), msg });
     }
     let end_us = samples
         .iter()
@@ -960,7 +840,7 @@ pub fn from_csv(path: &std::path::Path, tick_us: u64) -> Result<Pass> {
         tick_us,
         end_us,
         terrain: Vec::new(),
-        truth: Truth::Telemetry,
+        truth: None,
         faults: Vec::new(),
         dem: None,
         epoch_us: 0,
@@ -982,7 +862,7 @@ pub fn to_csv(pass: &Pass, path: &std::path::Path) -> Result<()> {
     let mut out = crate::csv::Writer::new(&preamble, &CSV_COLUMNS)?;
     // A built-in pass's NAV frames: the truth's state in I0 and Part I's attitude at
     // 4 Hz (what a NAV client would send for it).
-    let navs: Vec<(u64, Nav)> = match pass.truth.agile() {
+    let navs: Vec<(u64, Nav)> = match pass.truth.as_deref() {
         Some(truth) => (0..=pass.end_us / 250_000)
             .map(|k| (k * 250_000, truth.nav(k as f64 * 0.25)))
             .collect(),

@@ -17,7 +17,7 @@ use controller::EARTH;
 use core_math::vector::{norm, scale};
 
 use super::bus::SCALES;
-use super::scenario::{schedule, terrain_payload, us, BusProbe, FaultSpec, Msg, Pass, SlotKind};
+use super::scenario::{schedule, terrain_payload, us, Inject, Msg, Pass, SlotKind};
 
 /// One piece of the stream.
 #[derive(Clone, Debug)]
@@ -30,9 +30,18 @@ pub struct Item {
 /// The built stream and what the injection should produce.
 pub struct Stream {
     pub items: Vec<Item>,
-    /// Per injected fault: its label and the fault counter it must increment (None:
-    /// noise, which the decoder skips and counts as skipped bytes, not as a fault).
-    pub injected: Vec<(String, Option<Fault>)>,
+    /// Per injected fault: the fault counter it must increment (None: noise, which the
+    /// decoder skips and counts as skipped bytes, not as a fault).
+    pub injected: Vec<Option<Fault>>,
+}
+
+impl Item {
+    fn fault(bytes: Vec<u8>, k: usize) -> Item {
+        Item {
+            bytes,
+            fault: Some(k),
+        }
+    }
 }
 
 impl Stream {
@@ -170,7 +179,7 @@ pub fn build(pass: &Pass) -> Result<Stream> {
     let after = |t_us: u64| times.iter().position(|&t| t > t_us).unwrap_or(times.len());
     let truth = pass
         .truth
-        .agile()
+        .as_deref()
         .context("faults are injected into the built-in passes only");
     // The truth's frames tagged `t_s` (a fix 50 ms before).
     let gnss = |t_s: f64| {
@@ -181,107 +190,95 @@ pub fn build(pass: &Pass) -> Result<Stream> {
     };
     let star =
         |t_s: f64| -> Result<_> { truth.as_ref().map_err(|e| anyhow!("{e}"))?.star(t_s, None) };
-    for (k, f) in pass.faults.iter().enumerate() {
+    for (k, &(t_s, f)) in pass.faults.iter().enumerate() {
+        let gnss_msg = |frames: &mut Frames, g| frames.msg(us(t_s), &Msg::Gnss(g));
+        let star_msg = |frames: &mut Frames, a| frames.msg(us(t_s), &Msg::Attitude(a));
         // What the fault changes in place, or the frame (or noise) it adds after the
         // frames of `t_s`; and the counter it must increment.
-        let (added, expect) = match *f {
-            FaultSpec::BitFlip { t_s } => {
+        let (added, expect) = match f {
+            Inject::BitFlip => {
                 let i = item_at(t_s)?;
-                items[i].bytes = bit_flip(&items[i].bytes)?;
-                items[i].fault = Some(k);
+                items[i] = Item::fault(bit_flip(&items[i].bytes)?, k);
                 (None, Some(Fault::BadCrc))
             }
-            FaultSpec::Truncate { t_s } => {
+            Inject::Truncate => {
                 let i = item_at(t_s)?;
-                items[i].bytes = truncate(&items[i].bytes)?;
-                items[i].fault = Some(k);
+                items[i] = Item::fault(truncate(&items[i].bytes)?, k);
                 (None, Some(Fault::Truncated))
             }
-            FaultSpec::Noise { t_s, bytes } => (Some((t_s, noise(bytes, k as u64))), None),
-            FaultSpec::Backwards { t_s, back_s } => {
+            Inject::Noise { bytes } => (Some(noise(bytes, k as u64)), None),
+            Inject::Backwards { back_s } => {
                 let t_old = t_s - back_s;
                 let bytes = frames.msg(us(t_old), &Msg::Gnss(gnss(t_old)?));
-                (Some((t_s, bytes)), Some(Fault::TimeWentBackwards))
+                (Some(bytes), Some(Fault::TimeWentBackwards))
             }
-            FaultSpec::NaN { t_s } => {
+            Inject::NaN => {
                 let mut g = gnss(t_s)?;
                 g.velocity_mps[0] = f64::NAN;
-                (
-                    Some((t_s, frames.msg(us(t_s), &Msg::Gnss(g)))),
-                    Some(Fault::NonFinite),
-                )
+                (Some(gnss_msg(&mut frames, g)), Some(Fault::NonFinite))
             }
-            FaultSpec::Altitude { t_s, altitude_m } => {
+            Inject::Altitude { altitude_m } => {
                 let mut g = gnss(t_s)?;
                 let r = g.position_m;
                 g.position_m = scale((EARTH.a_m + altitude_m) / norm(r), r);
-                (
-                    Some((t_s, frames.msg(us(t_s), &Msg::Gnss(g)))),
-                    Some(Fault::OutOfRange),
-                )
+                (Some(gnss_msg(&mut frames, g)), Some(Fault::OutOfRange))
             }
             // Cut out of the samples already: missing telemetry, in both runs.
-            FaultSpec::Gap { .. } => (None, Some(Fault::Stale)),
-            FaultSpec::TimeTag { t_s, tag_us } => {
-                let bytes = frames.frame(kind::TIME, tag_us, &[]);
-                (Some((t_s, bytes)), Some(Fault::TimeJump))
-            }
-            FaultSpec::BadScene { t_s, probe } => {
+            Inject::Gap { .. } => (None, Some(Fault::Stale)),
+            Inject::TimeTag { tag_us } => (
+                Some(frames.frame(kind::TIME, tag_us, &[])),
+                Some(Fault::TimeJump),
+            ),
+            Inject::BadScene(probe) => {
                 let bytes = frames.frame(kind::SCENE, us(t_s), &probe.payload());
-                (Some((t_s, bytes)), Some(Fault::InvalidScene))
+                (Some(bytes), Some(Fault::InvalidScene))
             }
-            FaultSpec::Terrain { t_s, height_m } => {
+            Inject::Terrain { height_m } => {
                 let n = pass.terrain.first().map_or(0, |t| t.1.len());
                 let bytes =
                     frames.frame(kind::TERRAIN, us(t_s), &terrain_payload(&vec![height_m; n]));
-                (Some((t_s, bytes)), Some(Fault::OutOfRange))
+                (Some(bytes), Some(Fault::OutOfRange))
             }
-            FaultSpec::Dem { t_s, probe } => {
+            Inject::Dem(probe) => {
                 let (k, payload, fault) =
                     probe.frame(pass.dem.as_ref().context("DEM faults need a tile")?);
-                (Some((t_s, frames.frame(k, us(t_s), &payload))), Some(fault))
+                (Some(frames.frame(k, us(t_s), &payload)), Some(fault))
             }
-            FaultSpec::Envelope { t_s } => {
+            Inject::Envelope => {
                 let mut a = star(t_s)?;
                 a.body_rate_rad_s[0] = 0.5;
                 (
-                    Some((t_s, frames.msg(us(t_s), &Msg::Attitude(a)))),
+                    Some(star_msg(&mut frames, a)),
                     Some(Fault::AttitudeOutsideModel),
                 )
             }
-            FaultSpec::Bus { t_s, probe } => {
-                let (bytes, fault) = match probe {
-                    BusProbe::Quaternion => {
-                        let mut a = star(t_s)?;
-                        a.q = a.q.map(|x| x * 1.01);
-                        (frames.msg(us(t_s), &Msg::Attitude(a)), Fault::BadQuaternion)
-                    }
-                    BusProbe::FixAfterTag => {
-                        let mut g = gnss(t_s)?;
-                        g.fix_us = pass.epoch_us + us(t_s + 1.0);
-                        (frames.msg(us(t_s), &Msg::Gnss(g)), Fault::FixTime)
-                    }
-                    BusProbe::LeapSeconds => {
-                        let mut p = [0u8; 8];
-                        let n = encode_time_scales(70, 0.0, &mut p).unwrap_or(0);
-                        let bytes = frames.frame(kind::TIME_SCALES, us(t_s), &p[..n]);
-                        (bytes, Fault::TimeScales)
-                    }
-                };
-                (Some((t_s, bytes)), Some(fault))
+            Inject::Quaternion => {
+                let mut a = star(t_s)?;
+                a.q = a.q.map(|x| x * 1.01);
+                (Some(star_msg(&mut frames, a)), Some(Fault::BadQuaternion))
+            }
+            Inject::FixAfterTag => {
+                let mut g = gnss(t_s)?;
+                g.fix_us = pass.epoch_us + us(t_s + 1.0);
+                (Some(gnss_msg(&mut frames, g)), Some(Fault::FixTime))
+            }
+            Inject::LeapSeconds => {
+                let mut p = [0u8; 8];
+                let n = encode_time_scales(70, 0.0, &mut p).unwrap_or(0);
+                let bytes = frames.frame(kind::TIME_SCALES, us(t_s), &p[..n]);
+                (Some(bytes), Some(Fault::TimeScales))
             }
         };
-        if let Some((t_s, bytes)) = added {
-            let fault = Some(k);
-            extra.push((after(us(t_s)), Item { bytes, fault }));
+        if let Some(bytes) = added {
+            extra.push((after(us(t_s)), Item::fault(bytes, k)));
         }
-        injected.push((f.label(), expect));
+        injected.push(expect);
     }
     // The ground's uploads after the first frame, before the first tick.
     if let (Some(&t0), Some(&t1)) = (times.first(), times.get(1)) {
         let dem = pass.dem.as_ref().filter(|_| t1 > t0 + 100);
         if t1 > t0 + 1 {
-            let bus = pass.truth.agile().is_some();
+            let bus = pass.truth.as_deref().is_some();
             for bytes in uploads(&mut frames, bus, dem, t0) {
                 extra.push((1, Item { bytes, fault: None }));
             }

@@ -17,13 +17,13 @@ use core_math::vector::norm;
 use core_math::{Backend, EarthCamera, EarthReference, StateVector, EARTH_RATE_RAD_S};
 
 use super::bus::{mat_mul, mat_vec, transpose, SCALES};
-use super::check::{Downlink, InForce, Source};
+use super::check::{Downlink, Inputs, Source};
 use super::scenario::AgileTruth;
 use super::scenario::{ATTITUDE_PERIOD_US, GNSS_PERIOD_US};
+use super::Verdict;
 use crate::ellipsoid::round_geometry;
 use core_math::earth::dem::{DemGrid, DemTile};
 use core_math::earth::frames::CelestialPole;
-use std::collections::BTreeMap;
 
 /// The issue's budget for this controller's error against the truth (relative period).
 const MODEL_GAIN_BUDGET: f64 = 1e-4;
@@ -105,7 +105,7 @@ pub fn check(
     controller: &Controller,
     dem: Option<&(DemGrid, Vec<i16>)>,
     terrain: &[(u64, Vec<f32>)],
-    inputs: &BTreeMap<u64, InForce>,
+    inputs: &Inputs,
 ) -> Result<Report> {
     let scene = controller.scene();
     let plan = controller.plan();
@@ -325,12 +325,13 @@ fn c2t_error_rad(truth: &AgileTruth, firmware: &Downlink) -> Result<f64> {
 }
 
 impl Report {
-    pub fn print(&self) {
-        println!(
+    /// The report's lines, and the issue's acceptance conditions on a built-in pass.
+    pub fn verdict(&self, v: &mut Verdict) {
+        v.say(format!(
             "pass: max |roll| {:.1} deg, max |pitch| {:.1} deg, max |yaw| {:.2} deg, ground height {:.0}..{:.0} m, eccentricity {:.5}",
             self.max_roll_deg, self.max_pitch_deg, self.max_yaw_deg, self.heights_m.0, self.heights_m.1, self.eccentricity
-        );
-        println!(
+        ));
+        v.say(format!(
             "model gain: the paper's model would be off by {:.3e}, this controller by {:.3e} (largest relative period error against the truth over {} updates: J2 orbit, attitude flown, Earth orientation from ERFA, the ground on the DEM and the terrain profile off it; paper's worst at {:.2} s segment {}, firmware's at {:.2} s segment {})",
             self.paper.0,
             self.firmware.0,
@@ -339,25 +340,25 @@ impl Report {
             self.paper.2,
             self.firmware.1 as f64 * 1e-6,
             self.firmware.2
-        );
-        println!(
+        ));
+        v.say(format!(
             "  after a lost frame (the attitude in force older than 0.1 s or the fix older than 1.05 s): {:.3e} (at {:.2} s segment {}), counted apart; issue 23's budget, {MODEL_GAIN_BUDGET:.0e}, on the line above: {}",
             self.after_loss.0,
             self.after_loss.1 as f64 * 1e-6,
             self.after_loss.2,
             if self.firmware.0 <= MODEL_GAIN_BUDGET { "met" } else { "NOT met (reported, not checked)" }
-        );
+        ));
         if let Some((rows, cols, spacing_m)) = self.dem {
-            println!(
+            v.say(format!(
                 "terrain: DEM {rows} x {cols} nodes at {spacing_m:.0} m; per-segment heights at 1 Hz would be off by {:.3e}, the DEM route by {:.3e} (largest relative period error against the truth over every tenth update: the f64 reference on the DEM's height under each segment's centre uploaded at 1 Hz; the firmware, no frame lost)",
                 self.sampled[0], self.sampled[2]
-            );
+            ));
         }
-        println!(
+        v.say(format!(
             "frames: a GCRF state taken as the frame of date would be off by {:.3e}; the firmware's C2T is within {:.1e} rad of IAU 2006/2000A (ERFA's c2t06a, every second of the pass)",
             self.sampled[1], self.c2t_rad
-        );
-        println!(
+        ));
+        v.say(format!(
             "drift: max |drift| {:.1} mrad unsteered, {:.1} mrad with yaw steering; worst segment MTF {:.3} (over the {} updates of the imaging holds; worst MTF at {:.2} s, segment {}; at the array centre {:.1} mrad unsteered, {:.3} mrad steered)",
             self.drift_unsteered * 1e3,
             self.drift_steered * 1e3,
@@ -367,21 +368,15 @@ impl Report {
             self.worst_mtf.2,
             self.centre_unsteered * 1e3,
             self.centre_steered * 1e3
-        );
-    }
-
-    /// The issue's acceptance conditions on a built-in pass.
-    pub fn problems(&self) -> Vec<String> {
-        let mut p = Vec::new();
+        ));
         if self.updates == 0 {
-            p.push("no update was checked against the truth".into());
+            v.fail("no update was checked against the truth".into());
         }
         if self.firmware.0.is_nan() || self.firmware.0 > 0.1 * self.paper.0 {
-            p.push(format!(
+            v.fail(format!(
                 "the controller's period error {:.3e} is more than a tenth of the paper model's {:.3e}",
                 self.firmware.0, self.paper.0
             ));
         }
-        p
     }
 }
