@@ -94,16 +94,22 @@ pub fn pass_plots(pass: &Pass, firmware: &Downlink, periods: &Path) -> Result<()
                 .push((*t_us as f64 * 1e-6, f64::from(*h)));
         }
     }
-    save(
-        pass,
-        Plot::new(
-            &format!("Ground height uploaded by TERRAIN frames, {}", pass.name),
-            "time (s)",
-            "height above WGS 84 (m)",
-        ),
-        terrain,
-        &dir.join("terrain.png"),
-    )?;
+    // A user's telemetry file carries NAV frames only: no terrain to draw, and an empty
+    // plot must not cost the pass its verdict lines.
+    if terrain.is_empty() {
+        println!("terrain.png: not written, the pass uploads no TERRAIN frame");
+    } else {
+        save(
+            pass,
+            Plot::new(
+                &format!("Ground height uploaded by TERRAIN frames, {}", pass.name),
+                "time (s)",
+                "height above WGS 84 (m)",
+            ),
+            terrain,
+            &dir.join("terrain.png"),
+        )?;
+    }
     let yaw = Plot::new(
         &format!(
             "Yaw steering: the firmware's request and the yaw flown, {}",
@@ -135,4 +141,37 @@ pub fn pass_plots(pass: &Pass, firmware: &Downlink, periods: &Path) -> Result<()
         .series(Series::line("yaw flown", flown).palette(0))
         .series(Series::line("correction requested", requests).palette(1))
         .save(&dir.join("yaw.png"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::{check, geotiff, scenario, stream};
+    use super::*;
+    use controller::Config;
+
+    /// A user's telemetry (the short pass written as CSV and read back: NAV frames, no
+    /// TERRAIN) played through the host's session gives every plot but the terrain's.
+    #[test]
+    fn a_users_telemetry_is_plotted_without_terrain() -> Result<()> {
+        let tick_us = Config::default().update_period_us;
+        let dem = geotiff::read(&crate::qemu::workspace_root().join(geotiff::PASS_DEM_PATH))?;
+        let dir = std::env::temp_dir().join(format!("xtask-plots-{}", std::process::id()));
+        std::fs::create_dir_all(&dir)?;
+        let csv = dir.join("telemetry.csv");
+        scenario::to_csv(&scenario::short_pass(dem, tick_us)?, &csv)?;
+        let pass = scenario::from_csv(&csv, tick_us)?;
+        assert!(pass.terrain.is_empty() && pass.truth.is_none());
+        check::set_epoch(pass.epoch_us);
+        let sent = check::HostRun::new(&stream::build(&pass)?.clean(), Config::default())?;
+        let periods = dir.join("line-periods.png");
+        let result = pass_plots(&pass, &sent.downlink(), &periods);
+        let written: Vec<bool> = ["line-periods.png", "drift.png", "terrain.png"]
+            .iter()
+            .map(|f| dir.join(f).exists())
+            .collect();
+        std::fs::remove_dir_all(&dir)?;
+        result?;
+        assert_eq!(written, [true, true, false]);
+        Ok(())
+    }
 }
