@@ -268,7 +268,7 @@ fn short_path(path: &str) -> &str {
 /// The call graph's edges that lead to a panic handler (`rust_begin_unwind`, defmt's
 /// `_defmt_panic`), from every caller outside `core` and the handlers themselves: the
 /// code to change. Branch targets come from decoding each function's Thumb-2 branches
-/// (BL, B, B.W, B<c>, B<c>.W, CB(N)Z), skipping literal pools (`$d` mapping symbols).
+/// (`BL`, `B`, `B.W`, `B<c>`, `B<c>.W`, `CB(N)Z`), skipping literal pools (`$d` mapping symbols).
 fn panic_calls(file: &object::File<'_>) -> BTreeMap<String, BTreeSet<String>> {
     struct Func<'a> {
         start: u64,

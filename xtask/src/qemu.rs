@@ -12,7 +12,7 @@
 //!   `tools/qemu-runner`.
 //! - `cargo xtask bench`: guest instruction counts from a QEMU TCG plugin.
 //! - `cargo xtask size`, `cargo xtask flash`: each board's flash and RAM ([`board`]);
-//!   the flight binary on a real board through probe-rs ([`flash`]).
+//!   the flight binary on a real board through probe-rs ([`mod@flash`]).
 //! - [`test_target`]: clippy for the target crates, the hil-tests under QEMU and the
 //!   end-to-end pass test ([`e2e_test`]), on every board.
 

@@ -17,13 +17,14 @@ pub fn run() -> Result<()> {
     // The default members are the host crates; the target crates are linted by
     // `qemu::test_target` for thumbv7em.
     cargo(&["clippy", "--all-targets", "--", "-D", "warnings"])?;
-    // The API docs of the math and the controller, every feature on: a broken or
-    // private intra-doc link fails here rather than rotting unseen.
-    eprintln!("xtask: cargo doc --no-deps -p core-math -p controller --all-features (RUSTDOCFLAGS=-D warnings)");
+    // The API docs of the math, the controller and these tasks, every feature on: a
+    // broken or private intra-doc link fails here rather than rotting unseen.
+    eprintln!("xtask: cargo doc --no-deps -p core-math -p controller -p xtask --all-features (RUSTDOCFLAGS=-D warnings)");
     crate::qemu::status(
         crate::qemu::cargo_command()
             .args(["doc", "--no-deps", "--all-features"])
             .args(["--package", "core-math", "--package", "controller"])
+            .args(["--package", "xtask"])
             .env("RUSTDOCFLAGS", "-D warnings"),
     )?;
     // Host unit, property and golden tests of the math and the controller, optimised
