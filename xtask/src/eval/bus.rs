@@ -278,15 +278,13 @@ pub(super) fn evaluate_bus_general<T: Real + Display>(
 pub(super) fn evaluate_bus_fixed(case: &BusCase) -> Result<Vec<String>, RowError> {
     let (camera, n_px) = (&case.camera, case.n_px);
     let m = match &case.geometry {
-        BusRowGeometry::Angles(g) => {
-            EARTH_FIXED.evaluate(camera, &earth_fixed::geometry_from_f64(g)?, n_px)?
-        }
+        BusRowGeometry::Angles(g) => crate::accuracy::EARTH_FIXED_MOTION(camera, g, n_px)?,
         BusRowGeometry::Quaternion(g) => {
             let p = EARTH_FIXED.pixel(camera, n_px)?;
-            EARTH_FIXED.motion(&EARTH_FIXED.update_inertial(g)?, &p)?
+            earth_fixed::motion_to_f64(&EARTH_FIXED.motion(&EARTH_FIXED.update_inertial(g)?, &p)?)
         }
     };
-    Ok(earth_numbers(camera, &earth_fixed::motion_to_f64(&m))?)
+    Ok(earth_numbers(camera, &m)?)
 }
 
 /// G's geodetic latitude and longitude (deg) and height (m) on the row's ellipsoid, for

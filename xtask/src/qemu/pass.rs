@@ -536,8 +536,9 @@ fn reference_check(
                 failures.push(format!("segment {} is not in the plan", r.index));
                 continue;
             };
+            let allowed = rel_tolerance * exact + 0.5;
             let mut diff = (f64::from(r.ticks) - exact).abs();
-            if diff > rel_tolerance * exact + 0.5 {
+            if diff > allowed {
                 // Where a sample's line of sight grazes a ridge, the reference itself
                 // jumps between two grounds for an attitude change far below the
                 // firmware's f32 rounding: compare with the reference turned by that.
@@ -559,7 +560,7 @@ fn reference_check(
                     })
                     .map(|g| (f64::from(r.ticks) - g.ticks_exact).abs())
                     .fold(f64::INFINITY, f64::min);
-                if nearest <= rel_tolerance * exact + 0.5 {
+                if nearest <= allowed {
                     diff = nearest;
                     at_jumps += 1;
                 }
@@ -568,7 +569,7 @@ fn reference_check(
             max_rel = max_rel.max(rel);
             max_ticks = max_ticks.max(diff);
             compared += 1;
-            if diff > rel_tolerance * exact + 0.5 {
+            if diff > allowed {
                 failures.push(format!(
                     "update at {:.3} s, segment {}: {} ticks, reference {exact:.3} (relative {rel:.2e})",
                     t_us as f64 * 1e-6,
